@@ -1,0 +1,10 @@
+"""pkmlab: design-optimisation workbench for parallel manipulators."""
+
+from .config import load_mechanism
+from .errors import ParameterError
+from .mechanisms import REGISTRY, Luzi3, Mechanism, PSU6, UPS6
+
+__version__ = "0.1.0"
+
+__all__ = ["load_mechanism", "ParameterError", "REGISTRY", "Mechanism", "PSU6", "UPS6", "Luzi3",
+           "__version__"]

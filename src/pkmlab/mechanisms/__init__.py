@@ -1,0 +1,18 @@
+"""Mechanism families, registered by name.
+
+A new family adds one module defining a :class:`~pkmlab.mechanisms.base.Mechanism` subclass and
+one entry in :data:`REGISTRY` (plus its YAML model in :mod:`pkmlab.config`).
+"""
+
+from __future__ import annotations
+
+from .base import AssemblyModes, FKResult, IKResult, LEG_STATUS, Mechanism
+from .luzi3 import Luzi3
+from .psu6 import PSU6
+from .ups6 import UPS6
+
+#: family name → mechanism class
+REGISTRY: dict[str, type[Mechanism]] = {cls.family: cls for cls in (PSU6, UPS6, Luzi3)}
+
+__all__ = ["REGISTRY", "Mechanism", "IKResult", "FKResult", "AssemblyModes", "LEG_STATUS",
+           "PSU6", "UPS6", "Luzi3"]

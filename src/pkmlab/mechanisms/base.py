@@ -1,0 +1,344 @@
+"""What every mechanism family shares: result types, validation helpers and generic solvers.
+
+A family module defines a frozen dataclass subclassing :class:`Mechanism` that supplies
+geometry plus four family-specific pieces:
+
+* ``_ik_one`` — a numba per-pose inverse kinematics function (see :mod:`._kernels`);
+* ``_gparams()`` — the geometry packed as one float array for that function;
+* ``_jacobian(p, R)`` — the analytic velocity Jacobian ``(N, 6, 6)``;
+* ``_closure(p, R, q)`` — loop-closure residuals ``(N, 6)`` in mm and their derivative with
+  respect to the tool twist ``(N, 6, 6)``, used by Newton's method.
+
+Forward kinematics, the assembly-mode search and the nominal-pose search are generic and live
+here, so a new family adds one module and a registry entry, nothing else.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+from scipy.optimize import brentq
+from scipy.spatial.transform import Rotation
+
+from ..errors import ParameterError
+from ..poses import as_frames, exp_so3, frames_to_poses, log_so3
+from . import _kernels
+
+log = logging.getLogger(__name__)
+
+__all__ = [
+    "LEG_STATUS",
+    "IKResult",
+    "FKResult",
+    "AssemblyModes",
+    "Mechanism",
+    "as_points",
+    "as_stroke",
+]
+
+#: Leg status / pose reason codes of :meth:`Mechanism.inverse`, by severity.
+LEG_STATUS = {
+    _kernels.OK: "ok",
+    _kernels.BELOW_STROKE: "stroke below minimum",
+    _kernels.ABOVE_STROKE: "stroke above maximum",
+    _kernels.DEGENERATE: "degenerate leg geometry",
+    _kernels.NO_SOLUTION: "no real solution",
+    _kernels.INVALID_INPUT: "non-finite pose",
+}
+
+
+@dataclass(frozen=True)
+class IKResult:
+    """Inverse kinematics of N poses.
+
+    Attributes:
+        q: actuator values ``(N, 6)`` in mm; NaN only where ``leg_status`` is
+            ``no real solution``, ``degenerate leg geometry`` or ``non-finite pose``.
+        valid: ``(N,)`` True where every leg is solvable and within its stroke.
+        reason: ``(N,)`` int code, the most severe leg status (keys of ``LEG_STATUS``).
+        leg_status: ``(N, 6)`` int code per leg.
+    """
+
+    q: np.ndarray
+    valid: np.ndarray
+    reason: np.ndarray
+    leg_status: np.ndarray
+
+    @property
+    def reason_text(self) -> np.ndarray:
+        """``(N,)`` human-readable reason per pose."""
+        return np.array([LEG_STATUS[int(c)] for c in self.reason], dtype=object)
+
+
+@dataclass(frozen=True)
+class FKResult:
+    """Forward kinematics of N actuator vectors.
+
+    Attributes:
+        pose: ``(N, 6)`` tool pose (mm, rad); NaN where not converged.
+        converged: ``(N,)`` residual below tolerance in the mechanism's working mode.
+        residual: ``(N,)`` largest loop-closure error in mm.
+        iterations: ``(N,)`` Newton iterations used (continuation steps add up).
+        status: ``(N,)`` ``"ok"``, ``"not converged"`` or ``"singular"``.
+    """
+
+    pose: np.ndarray
+    converged: np.ndarray
+    residual: np.ndarray
+    iterations: np.ndarray
+    status: np.ndarray
+
+
+@dataclass(frozen=True)
+class AssemblyModes:
+    """All assembly modes found for one actuator vector, nominal-closest first.
+
+    Attributes:
+        pose: ``(M, 6)`` tool poses (mm, rad).
+        residual: ``(M,)`` largest loop-closure error in mm.
+        working_mode: ``(M,)`` True where the pose's inverse kinematics (the family's working
+            branch, e.g. the positive root of the 6-PSU) reproduces the actuator values.
+        distance: ``(M,)`` distance to the nominal pose (mm + characteristic length · rad).
+        starts: number of starting points used.
+    """
+
+    pose: np.ndarray
+    residual: np.ndarray
+    working_mode: np.ndarray
+    distance: np.ndarray
+    starts: int
+
+
+# ---------------------------------------------------------------------------------------------
+# validation helpers shared by the families
+
+
+def as_points(value: Any, field: str, count: int) -> np.ndarray:
+    """Validate a ``(count, 3)`` array of finite coordinates with no two points coincident."""
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (count, 3):
+        raise ParameterError(field, f"an array of shape ({count}, 3) in mm", arr.shape)
+    if not np.all(np.isfinite(arr)):
+        raise ParameterError(field, "finite coordinates", arr.tolist())
+    d = np.linalg.norm(arr[:, None, :] - arr[None, :, :], axis=-1)
+    i, j = np.triu_indices(count, 1)
+    close = d[i, j] < 1e-6
+    if np.any(close):
+        a, b = i[close][0], j[close][0]
+        raise ParameterError(field, "distinct joint centres (no two closer than 1e-6 mm)",
+                             f"points {a + 1} and {b + 1} coincide at {arr[a].tolist()}")
+    arr = arr.copy()
+    arr.setflags(write=False)
+    return arr
+
+
+def as_stroke(value: Any, field: str = "stroke", positive: bool = False) -> tuple[float, float]:
+    """Validate an actuator window ``[min, max]`` with min < max (and min > 0 if ``positive``)."""
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (2,) or not np.all(np.isfinite(arr)):
+        raise ParameterError(field, "[min, max], two finite numbers in mm", value)
+    if arr[0] >= arr[1]:
+        raise ParameterError(field, "[min, max] with min < max", arr.tolist())
+    if positive and arr[0] <= 0:
+        raise ParameterError(field, "[min, max] with 0 < min (a length)", arr.tolist())
+    return float(arr[0]), float(arr[1])
+
+
+def as_positive(value: Any, field: str, shape: tuple[int, ...] = ()) -> np.ndarray | float:
+    arr = np.asarray(value, dtype=float)
+    if shape and arr.shape == ():
+        arr = np.full(shape, float(arr))
+    if arr.shape != shape or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        what = "a length > 0 mm" if not shape else f"a length > 0 mm or {shape[0]} of them"
+        raise ParameterError(field, what, value if arr.size > 1 else float(arr))
+    return float(arr) if not shape else arr
+
+
+def as_vector3(value: Any, field: str) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise ParameterError(field, "[x, y, z], three finite numbers in mm", value)
+    arr = arr.copy()
+    arr.setflags(write=False)
+    return arr
+
+
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Mechanism:
+    """Base of every mechanism family (geometry lives in the subclass)."""
+
+    family: ClassVar[str] = ""
+    actuator_names: ClassVar[tuple[str, ...]] = ("q1", "q2", "q3", "q4", "q5", "q6")
+    name: str = field(default="", kw_only=True)
+    nominal: np.ndarray | None = field(default=None, kw_only=True, repr=False)
+    description: dict = field(default_factory=dict, kw_only=True, repr=False, compare=False)
+
+    # ---- family hooks ----------------------------------------------------------------------
+    _ik_one: ClassVar[Any] = None
+
+    def _gparams(self) -> np.ndarray:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _jacobian(self, p: np.ndarray, R: np.ndarray) -> np.ndarray:  # pragma: no cover
+        raise NotImplementedError
+
+    def _closure(self, p, R, q):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    @property
+    def stroke(self) -> tuple[float, float]:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    @property
+    def scale(self) -> float:
+        """Characteristic size in mm (tolerances and multi-start boxes scale with it)."""
+        raise NotImplementedError  # pragma: no cover
+
+    # ---- public API ------------------------------------------------------------------------
+    @property
+    def actuator_limits(self) -> np.ndarray:
+        """``(6, 2)`` actuator windows [min, max] in mm."""
+        lo, hi = self.stroke
+        return np.tile([lo, hi], (6, 1))
+
+    @property
+    def nominal_pose(self) -> np.ndarray:
+        """``(6,)`` nominal tool pose (mm, rad): given, or level and centred at mid-stroke."""
+        if self.nominal is not None:
+            return np.array(self.nominal, dtype=float)
+        return self._mid_stroke_pose()
+
+    def inverse(self, poses: np.ndarray) -> IKResult:
+        """Actuator values of poses ``(N, 6)`` / ``(N, 4, 4)`` → :class:`IKResult`."""
+        X = np.asarray(poses, dtype=float)
+        lo, hi = self.stroke
+        g = self._gparams()
+        if X.ndim <= 2 and X.shape[-1] == 6:
+            X2 = np.ascontiguousarray(X.reshape(-1, 6))
+            n = X2.shape[0]
+            q = np.empty((n, 6))
+            st = np.empty((n, 6), dtype=np.int8)
+            _kernels.drive_euler(type(self)._ik_one, X2, g, lo, hi, q, st)
+        else:
+            p, R = as_frames(X)
+            n = p.shape[0]
+            q = np.empty((n, 6))
+            st = np.empty((n, 6), dtype=np.int8)
+            _kernels.drive_frames(type(self)._ik_one, np.ascontiguousarray(p),
+                                  np.ascontiguousarray(R), g, lo, hi, q, st)
+        reason = st.max(axis=1)
+        return IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st)
+
+    def jacobian(self, poses: np.ndarray) -> np.ndarray:
+        """Analytic velocity Jacobian ``(N, 6, 6)``: ``q̇ = J · [v; ω]``.
+
+        ``v`` (mm/s) is the velocity of the tool-frame origin and ``ω`` (rad/s) the angular
+        velocity, both in the base frame. Rows of legs with no real solution are NaN; use
+        :meth:`inverse` for the mask and reason.
+        """
+        p, R = as_frames(poses)
+        return self._jacobian(p, R)
+
+    def forward(self, q: np.ndarray, guess: np.ndarray | None = None, *, tol: float = 1e-9,
+                max_iter: int = 50) -> FKResult:
+        """Forward kinematics by Newton's method with the analytic Jacobian.
+
+        Args:
+            q: actuator values ``(6,)`` or ``(N, 6)`` in mm.
+            guess: starting pose(s) ``(6,)`` or ``(N, 6)``; default the nominal pose. Where
+                Newton from the guess fails or lands outside the working mode, the solve is
+                repeated by continuation from the nominal pose along a straight actuator path.
+            tol: convergence tolerance on the loop-closure residual in mm.
+        """
+        from .solvers import forward_newton
+
+        return forward_newton(self, q, guess, tol=tol, max_iter=max_iter)
+
+    def assembly_modes(self, q: np.ndarray, *, starts: int = 1500, seed: int = 0,
+                       tol: float = 1e-9) -> AssemblyModes:
+        """All real assembly modes for one actuator vector ``(6,)``, by multi-start Newton.
+
+        Starting points: the nominal pose, plus ``starts`` poses with positions uniform in a
+        box of half-size ``2·scale`` around the base centre and orientations uniform on SO(3)
+        (seeded). Solutions are de-duplicated (1e-6·scale mm, 1e-6 rad) and sorted by distance
+        to the nominal pose.
+        """
+        from .solvers import multistart_modes
+
+        return multistart_modes(self, q, starts=starts, seed=seed, tol=tol)
+
+    def describe(self) -> dict:
+        """Plain-dict summary of the geometry for display and JSON."""
+        return {"family": self.family, "name": self.name, **self.description}
+
+    # ---- helpers -----------------------------------------------------------------------------
+    def _ik_frames_raw(self, p: np.ndarray, R: np.ndarray) -> IKResult:
+        """Inverse kinematics ignoring the stroke window (geometry only)."""
+        g = self._gparams()
+        n = p.shape[0]
+        q = np.empty((n, 6))
+        st = np.empty((n, 6), dtype=np.int8)
+        _kernels.drive_frames(type(self)._ik_one, np.ascontiguousarray(p),
+                              np.ascontiguousarray(R), g, -np.inf, np.inf, q, st)
+        reason = st.max(axis=1)
+        return IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st)
+
+    def _level_yaw(self) -> float:
+        """Rotation about z (rad) of the platform frame at the symmetric, level pose."""
+        return 0.0
+
+    def _mid_stroke_pose(self) -> np.ndarray:
+        """Level, centred pose whose mean actuator value is mid-stroke (highest such z)."""
+        lo, hi = self.stroke
+        mid = 0.5 * (lo + hi)
+        yaw = self._level_yaw()
+        Rz = np.array([[[np.cos(yaw), -np.sin(yaw), 0.0], [np.sin(yaw), np.cos(yaw), 0.0],
+                        [0.0, 0.0, 1.0]]])
+
+        def mean_q(z: float) -> float:
+            r = self._ik_frames_raw(np.array([[0.0, 0.0, z]]), Rz)
+            return float(np.mean(r.q[0])) - mid if r.valid[0] else np.nan
+
+        S = self.scale
+        zs = np.linspace(3.0 * S + hi, -S, 801)
+        vals = np.array([mean_q(z) for z in zs])
+        for k in range(len(zs) - 1):
+            a, b = vals[k], vals[k + 1]
+            if np.isfinite(a) and np.isfinite(b) and a * b <= 0:
+                z = brentq(mean_q, zs[k + 1], zs[k], xtol=1e-12)
+                return np.array([0.0, 0.0, z, 0.0, 0.0, yaw])
+        raise ParameterError(f"{self.family}.stroke",
+                             "a window whose mid-point is reachable by a level, centred platform",
+                             list(self.stroke))
+
+    def _random_starts(self, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+        rng = np.random.default_rng(seed)
+        S = self.scale
+        centre = np.array([0.0, 0.0, self.nominal_pose[2] * 0.0])
+        p = centre + rng.uniform(-2 * S, 2 * S, size=(n, 3))
+        R = Rotation.random(n, random_state=rng).as_matrix()
+        return p, R
+
+    def _pose_distance(self, p: np.ndarray, R: np.ndarray) -> np.ndarray:
+        pn, Rn = as_frames(self.nominal_pose)
+        rot = np.linalg.norm(log_so3(np.einsum("ji,njk->nik", Rn[0], R)), axis=-1)
+        return np.linalg.norm(p - pn, axis=-1) + self.scale * rot
+
+
+def frames_from(poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Alias of :func:`pkmlab.poses.as_frames` for family modules."""
+    return as_frames(poses)
+
+
+def step_frames(p: np.ndarray, R: np.ndarray, twist: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Apply a base-frame twist displacement ``(N, 6)`` to frames: p += v, R ← exp(ω)·R."""
+    return p + twist[:, :3], exp_so3(twist[:, 3:]) @ R
+
+
+__all__ += ["frames_from", "step_frames", "frames_to_poses"]

@@ -1,0 +1,413 @@
+"""Over-constrained modified Gough–Stewart platform with three planar chains.
+
+Luzi, Sancisi & Parenti Castelli, "A new direct position analysis solution for an
+over-constrained Gough–Stewart platform". Chain i has base points ``A_i1, A_i2``, two actuated
+legs ``A_ij B_ij`` and an upper link ``B_i1 B_i2`` of length ``l`` whose midpoint is the platform
+U-joint ``C_i``. The chain stays in the plane γ_i through ``A_i1, A_i2, C_i`` and the upper
+link lies both in γ_i and in the platform plane σ, so
+
+    u_i = r_i × (C_i - A_i1)        (normal of γ_i, r_i = A_i2 - A_i1)
+    t_i = ± (k × u_i) / |k × u_i|   (k = platform normal; sign: t_i · r_i ≥ 0)
+    B_i1 = C_i - (l/2)·t_i,  B_i2 = C_i + (l/2)·t_i,  q_ij = |B_ij - A_ij|
+
+which is the closed-form inverse kinematics. The platform frame is the paper's S_P: origin at
+C_1, y axis along C_1 → C_3, z axis normal to σ. Actuators are ordered
+``[l11, l12, l21, l22, l31, l32]`` as in the paper's Table 1.
+
+The module also implements the paper's reduced direct position analysis in ψ1..ψ4
+(eqs. 1-13) and the ψ ↔ pose conversion; see ``docs/validation.md`` for the conventions and
+the errata found.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from ..errors import ParameterError
+from ..poses import as_frames, frames_to_poses, skew
+from . import _kernels
+from .base import Mechanism, as_points, as_positive, as_stroke, as_vector3
+
+__all__ = ["Luzi3", "pose_to_psi", "psi_to_pose", "reduced_dpa", "ReducedDPAResult"]
+
+
+@njit(cache=True)
+def _luzi_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st):
+    half = 0.5 * g[27]
+    kx, ky, kz = r02, r12, r22
+    for i in range(3):
+        a1x, a1y, a1z = g[6 * i], g[6 * i + 1], g[6 * i + 2]
+        a2x, a2y, a2z = g[6 * i + 3], g[6 * i + 4], g[6 * i + 5]
+        ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
+        cx = px + r00 * ux + r01 * uy + r02 * uz
+        cy = py + r10 * ux + r11 * uy + r12 * uz
+        cz = pz + r20 * ux + r21 * uy + r22 * uz
+        rx, ry, rz = a2x - a1x, a2y - a1y, a2z - a1z
+        dx, dy, dz = cx - a1x, cy - a1y, cz - a1z
+        wx, wy, wz = ry * dz - rz * dy, rz * dx - rx * dz, rx * dy - ry * dx
+        nx, ny, nz = ky * wz - kz * wy, kz * wx - kx * wz, kx * wy - ky * wx
+        nn = math.sqrt(nx * nx + ny * ny + nz * nz)
+        scale = math.sqrt(rx * rx + ry * ry + rz * rz) * math.sqrt(dx * dx + dy * dy + dz * dz)
+        if not nn > 1e-12 * scale:
+            q[2 * i] = np.nan
+            q[2 * i + 1] = np.nan
+            st[2 * i] = _kernels.DEGENERATE
+            st[2 * i + 1] = _kernels.DEGENERATE
+            continue
+        s = half / nn if nx * rx + ny * ry + nz * rz >= 0.0 else -half / nn
+        ex, ey, ez = cx - s * nx - a1x, cy - s * ny - a1y, cz - s * nz - a1z
+        v1 = math.sqrt(ex * ex + ey * ey + ez * ez)
+        ex, ey, ez = cx + s * nx - a2x, cy + s * ny - a2y, cz + s * nz - a2z
+        v2 = math.sqrt(ex * ex + ey * ey + ez * ez)
+        q[2 * i], q[2 * i + 1] = v1, v2
+        st[2 * i] = _kernels.stroke_status(v1, qmin, qmax)
+        st[2 * i + 1] = _kernels.stroke_status(v2, qmin, qmax)
+
+
+@dataclass(frozen=True)
+class Luzi3(Mechanism):
+    """Three-chain over-constrained Gough–Stewart geometry.
+
+    Attributes:
+        base_points: ``(6, 3)`` ``[A11, A12, A21, A22, A31, A32]`` (mm, base frame).
+        platform_points: ``(3, 3)`` ``C_i`` in the platform frame S_P (mm).
+        upper_link: length ``l`` of each upper link ``B_i1 B_i2`` (mm).
+        stroke_window: actuator-length window (min, max) in mm.
+        tool_offset: ``(3,)`` tool-frame origin in S_P (mm).
+    """
+
+    family = "luzi3"
+    actuator_names = ("l11", "l12", "l21", "l22", "l31", "l32")
+
+    base_points: np.ndarray
+    platform_points: np.ndarray
+    upper_link: float
+    stroke_window: tuple[float, float]
+    tool_offset: np.ndarray = (0.0, 0.0, 0.0)  # type: ignore[assignment]
+
+    _ik_one = _luzi_one
+
+    def __post_init__(self):
+        set_ = object.__setattr__
+        set_(self, "base_points", as_points(self.base_points, "base_points", 6))
+        set_(self, "platform_points", as_points(self.platform_points, "platform_points", 3))
+        set_(self, "upper_link", as_positive(self.upper_link, "upper_link"))
+        set_(self, "stroke_window", as_stroke(self.stroke_window, "stroke", positive=True))
+        set_(self, "tool_offset", as_vector3(self.tool_offset, "tool_offset"))
+        chord = np.linalg.norm(self.base_points[1::2] - self.base_points[0::2], axis=1)
+        if np.any(chord <= self.upper_link):
+            i = int(np.argmin(chord))
+            raise ParameterError("upper_link", f"shorter than chain {i + 1}'s base chord "
+                                 f"|A{i + 1}1 A{i + 1}2| = {chord[i]:.3f} mm", self.upper_link)
+
+    @classmethod
+    def from_paper(cls, *, base_diameter=840.0, phi=math.pi / 9, platform_diameter=280.0,
+                   upper_link=100.0, stroke=(750.0, 1150.0), tool_offset=None, name: str = "",
+                   nominal=None) -> Luzi3:
+        """The paper's parametrisation (Sect. 4).
+
+        Base points on a circle of ``base_diameter``; consecutive points of different chains
+        subtend ``phi``, so each chain's two points subtend ``120° - phi``; chain 1 is centred
+        at -90° so that x ∥ A11→A12 (the paper's S_B). ``C_i`` form an equilateral triangle
+        inscribed in ``platform_diameter``, C_i facing chain i. ``tool_offset=None`` puts the
+        tool frame at the platform centre. Angles in rad, lengths in mm.
+        """
+        if not (0 < phi < 2 * math.pi / 3):
+            raise ParameterError("phi", "an angle in (0°, 120°)", math.degrees(phi))
+        for fname, v in (("base_diameter", base_diameter),
+                         ("platform_diameter", platform_diameter)):
+            if not (np.isfinite(v) and v > 0):
+                raise ParameterError(fname, "a length > 0 mm", v)
+        centre = -math.pi / 2 + 2 * math.pi / 3 * np.arange(3)
+        half = (2 * math.pi / 3 - phi) / 2
+        ang = np.stack([centre - half, centre + half], axis=1).ravel()
+        rb = base_diameter / 2
+        A = np.stack([rb * np.cos(ang), rb * np.sin(ang), np.zeros(6)], axis=1)
+        rp = platform_diameter / 2
+        C = np.stack([rp * np.cos(centre), rp * np.sin(centre), np.zeros(3)], axis=1)
+        y = (C[2] - C[0]) / np.linalg.norm(C[2] - C[0])
+        z = np.array([0.0, 0.0, 1.0])
+        F = np.stack([np.cross(y, z), y, z], axis=1)          # S_P axes at the level pose
+        c = (C - C[0]) @ F
+        offset = c.mean(axis=0) if tool_offset is None else tool_offset
+        desc = {"generator": "Luzi et al. Sect. 4", "base_diameter_mm": base_diameter,
+                "phi_deg": math.degrees(phi), "platform_diameter_mm": platform_diameter}
+        return cls(A, c, upper_link, stroke, offset, name=name, nominal=nominal,
+                   description=desc)
+
+    # ---- family hooks ----------------------------------------------------------------------
+    @property
+    def stroke(self) -> tuple[float, float]:
+        return self.stroke_window
+
+    @property
+    def scale(self) -> float:
+        return float(np.max(np.linalg.norm(self.base_points, axis=1))
+                     + np.max(np.linalg.norm(self.platform_points - self.tool_offset, axis=1))
+                     + self.stroke[1])
+
+    def _tool_points(self) -> np.ndarray:
+        return self.platform_points - self.tool_offset
+
+    def _gparams(self) -> np.ndarray:
+        return np.concatenate([self.base_points.ravel(), self._tool_points().ravel(),
+                               [self.upper_link]])
+
+    def _level_yaw(self) -> float:
+        """Yaw that points C_1 (seen from the platform centre) at chain 1's base midpoint."""
+        c = self.platform_points[0] - self.platform_points.mean(axis=0)
+        m = 0.5 * (self.base_points[0] + self.base_points[1]) - self.base_points.mean(axis=0)
+        return float(np.arctan2(m[1], m[0]) - np.arctan2(c[1], c[0]))
+
+    def _chains(self, p, R):
+        """Leg lengths ``(N, 6)`` and their twist derivative ``(N, 6, 6)``."""
+        n_pose = p.shape[0]
+        A1, A2 = self.base_points[0::2], self.base_points[1::2]            # (3, 3)
+        r = A2 - A1
+        rho = np.einsum("nij,kj->nki", R, self._tool_points())            # (N, 3, 3)
+        C = p[:, None, :] + rho
+        k = R[:, :, 2]                                                      # (N, 3)
+        eye = np.broadcast_to(np.eye(3), (n_pose, 3, 3, 3))
+        MC = np.concatenate([eye, -skew(rho)], axis=-1)                    # (N, 3, 3, 6)
+        Mk = np.concatenate([np.zeros((n_pose, 3, 3)), -skew(k)], axis=-1)  # (N, 3, 6)
+        w = np.cross(r, C - A1)                                             # (N, 3, 3)
+        Mw = np.einsum("kij,nkjm->nkim", skew(r), MC)
+        n = np.cross(k[:, None, :], w)
+        Mn = (-np.einsum("nkij,njm->nkim", skew(w), Mk)
+              + np.einsum("nij,nkjm->nkim", skew(k), Mw))
+        nn = np.linalg.norm(n, axis=-1)
+        sgn = np.where(np.einsum("nki,ki->nk", n, r) >= 0, 1.0, -1.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = n * (sgn / nn)[..., None]
+            P = np.eye(3) - t[..., :, None] * t[..., None, :]
+            Mt = np.einsum("nkij,nkjm->nkim", P, Mn) * (sgn / nn)[..., None, None]
+            half = 0.5 * self.upper_link
+            e1 = C - half * t - A1
+            e2 = C + half * t - A2
+            q1, q2 = np.linalg.norm(e1, axis=-1), np.linalg.norm(e2, axis=-1)
+            J1 = np.einsum("nki,nkim->nkm", e1 / q1[..., None], MC - half * Mt)
+            J2 = np.einsum("nki,nkim->nkm", e2 / q2[..., None], MC + half * Mt)
+        q = np.stack([q1, q2], axis=-1).reshape(n_pose, 6)
+        J = np.stack([J1, J2], axis=2).reshape(n_pose, 6, 6)
+        return q, J
+
+    def _jacobian(self, p, R):
+        return self._chains(p, R)[1]
+
+    def _closure(self, p, R, q):
+        qq, J = self._chains(p, R)
+        return qq - q, J
+
+    def describe(self) -> dict:
+        d = super().describe()
+        d.update(upper_link_mm=self.upper_link, stroke_mm=list(self.stroke),
+                 tool_offset_mm=self.tool_offset.tolist(),
+                 base_points_mm=self.base_points.tolist(),
+                 platform_points_mm=self.platform_points.tolist())
+        return d
+
+    # ---- ψ parametrisation ---------------------------------------------------------------
+    def chain1_frame(self) -> np.ndarray:
+        """Columns: x ∥ A11→A12, y = ẑ × x (normalised), z = x × y. Identity for the paper."""
+        ex = self.base_points[1] - self.base_points[0]
+        ex = ex / np.linalg.norm(ex)
+        ey = np.cross([0.0, 0.0, 1.0], ex)
+        ey /= np.linalg.norm(ey)
+        return np.stack([ex, ey, np.cross(ex, ey)], axis=1)
+
+
+# ---------------------------------------------------------------------------------------------
+# The paper's ψ parametrisation.
+#
+# Conventions adopted (see docs/validation.md): r_1 points from A11 to A12 (eq. 5 measures ψ1
+# from +x, which contradicts the text's "r_i = A_i2 A_i1"); eq. (7) is the intrinsic product
+# R = F1·Rx(ψ2)·Rz(θ)·Rx(ψ3)·Rz(ψ4) with F1 the chain-1 frame (identity for the paper's S_B):
+# about x (not t_1) by ψ2, about the chain-plane normal u_1 by θ, about t_1 by ψ3 and about k
+# by ψ4.
+
+
+def _rx(a):
+    c, s = np.cos(a), np.sin(a)
+    R = np.zeros(np.shape(a) + (3, 3))
+    R[..., 0, 0] = 1.0
+    R[..., 1, 1], R[..., 1, 2], R[..., 2, 1], R[..., 2, 2] = c, -s, s, c
+    return R
+
+
+def _rz(a):
+    c, s = np.cos(a), np.sin(a)
+    R = np.zeros(np.shape(a) + (3, 3))
+    R[..., 2, 2] = 1.0
+    R[..., 0, 0], R[..., 0, 1], R[..., 1, 0], R[..., 1, 1] = c, -s, s, c
+    return R
+
+
+def four_bar_theta(mech: Luzi3, psi1, l11, l12, branch: int = -1):
+    """Eqs. (1)-(3): the upper-link angle θ of chain 1 from ψ1 and the chain-1 leg lengths.
+
+    ``branch=-1`` is the paper's root ``(-b - sqrt(b² - 4ac)) / 2a``; ``+1`` the other one.
+    Returns NaN where the four-bar cannot close (negative discriminant).
+    """
+    r1 = np.linalg.norm(mech.base_points[1] - mech.base_points[0])
+    ll = mech.upper_link
+    h1, h2 = r1 / l11, r1 / ll
+    h4 = (-r1**2 - l11**2 - ll**2 + l12**2) / (2 * ll * l11)
+    a = -h1 + (1 + h2) * np.cos(psi1) + h4
+    b = -2 * np.sin(psi1)
+    c = h1 - (1 - h2) * np.cos(psi1) + h4
+    disc = b * b - 4 * a * c
+    with np.errstate(invalid="ignore", divide="ignore"):
+        root = np.sqrt(disc)
+        # Same root in two algebraically equal forms; use the better-conditioned one.
+        num = -b + branch * root
+        alt_den = -b - branch * root
+        t = np.where(np.abs(2 * a) > np.abs(alt_den), num / (2 * a), 2 * c / alt_den)
+    return np.where(disc >= 0, 2 * np.arctan(t), np.nan)
+
+
+def psi_to_pose(mech: Luzi3, psi, l11, l12, branch: int = -1) -> np.ndarray:
+    """ψ ``(N, 4)`` plus chain-1 lengths → tool poses ``(N, 6)`` (NaN where θ is not real)."""
+    psi = np.atleast_2d(np.asarray(psi, dtype=float))
+    p1, p2, p3, p4 = psi.T
+    theta = four_bar_theta(mech, p1, l11, l12, branch)
+    F = mech.chain1_frame()
+    leg = np.stack([np.cos(p1), np.sin(p1) * np.cos(p2), np.sin(p1) * np.sin(p2)], axis=-1)
+    up = np.stack([np.cos(theta), np.sin(theta) * np.cos(p2), np.sin(theta) * np.sin(p2)], -1)
+    C1 = mech.base_points[0] + (np.asarray(l11)[..., None] * leg
+                                + 0.5 * mech.upper_link * up) @ F.T
+    R = F @ _rx(p2) @ _rz(theta) @ _rx(p3) @ _rz(p4)
+    origin = C1 - np.einsum("nij,j->ni", R, mech.platform_points[0])
+    tool = origin + np.einsum("nij,j->ni", R, mech.tool_offset)
+    return frames_to_poses(tool, R)
+
+
+def pose_to_psi(mech: Luzi3, poses) -> np.ndarray:
+    """Tool poses ``(N, 6)`` / ``(N, 4, 4)`` → the paper's ψ1..ψ4 ``(N, 4)``."""
+    p, R = as_frames(poses)
+    F = mech.chain1_frame()
+    origin = p - np.einsum("nij,j->ni", R, mech.tool_offset)
+    C1 = origin + np.einsum("nij,j->ni", R, mech.platform_points[0])
+    d = (C1 - mech.base_points[0]) @ F
+    psi2 = np.arctan2(d[:, 2], d[:, 1])
+    e = np.stack([np.zeros_like(psi2), np.cos(psi2), np.sin(psi2)], axis=1)
+    k = R[:, :, 2] @ F
+    r = np.array([1.0, 0.0, 0.0])
+    n = np.cross(k, np.cross(r, d))
+    n *= np.where(n[:, 0] >= 0, 1.0, -1.0)[:, None]
+    t = n / np.linalg.norm(n, axis=1, keepdims=True)
+    theta = np.arctan2(np.einsum("ni,ni->n", t, e), t[:, 0])
+    b = d - 0.5 * mech.upper_link * t
+    psi1 = np.arctan2(np.einsum("ni,ni->n", b, e), b[:, 0])
+    N = np.swapaxes(_rz(theta), -1, -2) @ np.swapaxes(_rx(psi2), -1, -2) @ (F.T @ R)
+    psi4 = np.arctan2(-N[:, 0, 1], N[:, 0, 0])
+    psi3 = np.arctan2(-N[:, 1, 2], N[:, 2, 2])
+    return np.stack([psi1, psi2, psi3, psi4], axis=1)
+
+
+def _reduced_residual(mech: Luzi3, psi, q, branch: int) -> np.ndarray:
+    """Eq. (13): the four closure residuals (mm) of chains 2 and 3, t_i from eq. (10)."""
+    pose = psi_to_pose(mech, psi, q[0], q[1], branch)
+    p, R = as_frames(pose)
+    rho = np.einsum("nij,kj->nki", R, mech.platform_points - mech.tool_offset)
+    C = p[:, None, :] + rho
+    k = R[:, None, :, 2]
+    A1, A2 = mech.base_points[0::2], mech.base_points[1::2]
+    m = np.cross(k, np.cross(A2 - A1, C - A1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = m / np.linalg.norm(m, axis=-1, keepdims=True)
+    half = 0.5 * mech.upper_link
+    l1 = np.linalg.norm(C - half * t - A1, axis=-1)
+    l2 = np.linalg.norm(C + half * t - A2, axis=-1)
+    res = np.stack([l1 - q[0::2], l2 - q[1::2]], axis=-1)     # (N, 3 chains, 2)
+    return res[:, 1:, :].reshape(-1, 4)
+
+
+@dataclass(frozen=True)
+class ReducedDPAResult:
+    """Solutions of the reduced system (13), physically consistent ones first.
+
+    Attributes:
+        psi: ``(M, 4)`` roots of eq. (13) (rad, wrapped to (-π, π]).
+        branch: ``(M,)`` four-bar root used for θ (-1: the paper's).
+        residual: ``(M,)`` largest residual of eq. (13) in mm.
+        pose: ``(M, 6)`` tool poses.
+        physical: ``(M,)`` True where the full inverse kinematics of the pose reproduces all
+            six actuator lengths (false roots come from t_i's sign in eq. 10).
+        ik_error: ``(M,)`` largest |q_IK(pose) - q| in mm.
+    """
+
+    psi: np.ndarray
+    branch: np.ndarray
+    residual: np.ndarray
+    pose: np.ndarray
+    physical: np.ndarray
+    ik_error: np.ndarray
+
+
+def reduced_dpa(mech: Luzi3, q, *, grid: int = 6, tol: float = 1e-9,
+                max_iter: int = 60) -> ReducedDPAResult:
+    """Solve the paper's 4-equation system (13) in ψ1..ψ4 by multi-start Newton.
+
+    Starts: a ``grid × grid`` lattice in (ψ1, ψ2) over (0, π) times a ``(grid+2)²`` lattice in
+    (ψ3, ψ4) over (-π, π], for both four-bar branches. The Jacobian of (13) is taken by central
+    differences (step 1e-7 rad); this solver is a cross-check of :meth:`Luzi3.forward`, which
+    uses the analytic Jacobian of the full closure.
+    """
+    q = np.asarray(q, dtype=float).reshape(6)
+    a12 = np.linspace(0.1, math.pi - 0.1, grid)
+    a34 = np.linspace(-math.pi, math.pi, grid + 2, endpoint=False)
+    starts = np.stack(np.meshgrid(a12, a12, a34, a34, indexing="ij"), -1).reshape(-1, 4)
+    out_psi, out_branch, out_res = [], [], []
+    h = 1e-7
+    for branch in (-1, 1):
+        x = starts.copy()
+        for _ in range(max_iter):
+            f = _reduced_residual(mech, x, q, branch)
+            ok = np.all(np.isfinite(f), axis=1)
+            x, f = x[ok], f[ok]
+            if x.shape[0] == 0:
+                break
+            Jm = np.empty((x.shape[0], 4, 4))
+            for j in range(4):
+                dx = np.zeros(4)
+                dx[j] = h
+                Jm[:, :, j] = (_reduced_residual(mech, x + dx, q, branch)
+                               - _reduced_residual(mech, x - dx, q, branch)) / (2 * h)
+            good = np.all(np.isfinite(Jm), axis=(1, 2)) & (np.abs(np.linalg.det(Jm)) > 1e-300)
+            x, f, Jm = x[good], f[good], Jm[good]
+            step = -np.linalg.solve(Jm, f[..., None])[..., 0]
+            big = np.max(np.abs(step), axis=1)
+            step *= np.minimum(1.0, 0.3 / np.maximum(big, 1e-300))[:, None]
+            x = x + step
+        f = _reduced_residual(mech, x, q, branch)
+        res = np.max(np.abs(f), axis=1)
+        conv = res < tol
+        out_psi.append(x[conv])
+        out_res.append(res[conv])
+        out_branch.append(np.full(int(conv.sum()), branch))
+    psi = (np.concatenate(out_psi) + np.pi) % (2 * np.pi) - np.pi
+    res = np.concatenate(out_res)
+    branch = np.concatenate(out_branch)
+    keep: list[int] = []
+    for i in np.argsort(res):
+        if keep and np.any((np.max(np.abs(psi[keep] - psi[i]), axis=1) < 1e-6)
+                           & (branch[keep] == branch[i])):
+            continue
+        keep.append(int(i))
+    psi, res, branch = psi[keep], res[keep], branch[keep]
+    pose = np.concatenate([psi_to_pose(mech, psi[branch == b], q[0], q[1], b)
+                           for b in (-1, 1)]) if psi.size else np.zeros((0, 6))
+    order = np.concatenate([np.flatnonzero(branch == b) for b in (-1, 1)])
+    psi, res, branch = psi[order], res[order], branch[order]
+    p, R = as_frames(pose) if pose.size else (np.zeros((0, 3)), np.zeros((0, 3, 3)))
+    ik = mech._ik_frames_raw(p, R)
+    with np.errstate(invalid="ignore"):
+        err = np.max(np.abs(ik.q - q), axis=1) if pose.size else np.zeros(0)
+    physical = np.isfinite(err) & (err < 1e-6)
+    rank = np.lexsort((mech._pose_distance(p, R) if pose.size else np.zeros(0), ~physical))
+    return ReducedDPAResult(psi=psi[rank], branch=branch[rank], residual=res[rank],
+                            pose=pose[rank], physical=physical[rank], ik_error=err[rank])

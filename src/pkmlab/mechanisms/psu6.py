@@ -1,0 +1,180 @@
+"""6-PSU: six vertical prismatic actuators, fixed-length links, S and U joints.
+
+Hopkins & Williams (2002), "Modified 6-PSU platform" (ParaDex / HexaSlide family).
+
+Leg i: the slider sits at ``B_i + q_i·ẑ`` (``B_i`` is its position at actuator value 0) and a
+link of length ``l_i`` joins it to the platform joint ``W_i = p + R·(P_i - O)``, where ``O`` is
+the tool offset in the platform frame. With ``a_i = W_i - B_i - q_i·ẑ`` and ``|a_i| = l_i``:
+
+    q_i = W_iz - B_iz - sqrt(l_i² - (W_ix - B_ix)² - (W_iy - B_iy)²)      (positive root, eq. 6)
+
+Differentiating ``|a_i|² = l_i²`` gives the velocity Jacobian row
+``J_i = [a_iᵀ, (r_i × a_i)ᵀ] / a_iz`` with ``r_i = R·(P_i - O)``; it is singular (serial
+singularity) when the link is horizontal (a_iz → 0).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from ..errors import ParameterError
+from . import _kernels
+from .base import Mechanism, as_points, as_positive, as_stroke, as_vector3
+from .layout import equal_leg_base_angle, paired_layout
+
+__all__ = ["PSU6"]
+
+
+@njit(cache=True)
+def _psu_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st):
+    for i in range(6):
+        bx, by, bz = g[3 * i], g[3 * i + 1], g[3 * i + 2]
+        ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
+        ll = g[36 + i]
+        ax = px + r00 * ux + r01 * uy + r02 * uz - bx
+        ay = py + r10 * ux + r11 * uy + r12 * uz - by
+        wz = pz + r20 * ux + r21 * uy + r22 * uz
+        h2 = ll * ll - ax * ax - ay * ay
+        if h2 < 0.0:
+            q[i] = np.nan
+            st[i] = _kernels.NO_SOLUTION
+        else:
+            v = wz - bz - math.sqrt(h2)
+            q[i] = v
+            st[i] = _kernels.stroke_status(v, qmin, qmax)
+
+
+@dataclass(frozen=True)
+class PSU6(Mechanism):
+    """6-PSU geometry.
+
+    Attributes:
+        base_points: ``(6, 3)`` slider positions at actuator value 0 (mm, base frame); sliders
+            move along +z.
+        platform_points: ``(6, 3)`` U-joint centres in the platform frame (mm).
+        link_length: ``(6,)`` link lengths (mm).
+        stroke_window: actuator window (min, max) in mm.
+        tool_offset: ``(3,)`` tool-frame origin in the platform frame (mm); the tool frame has
+            the platform frame's orientation (the paper's {H}, 47 mm above {P}).
+    """
+
+    family = "psu6"
+
+    base_points: np.ndarray
+    platform_points: np.ndarray
+    link_length: np.ndarray
+    stroke_window: tuple[float, float]
+    tool_offset: np.ndarray = (0.0, 0.0, 0.0)  # type: ignore[assignment]
+
+    _ik_one = _psu_one
+
+    def __post_init__(self):
+        set_ = object.__setattr__
+        set_(self, "base_points", as_points(self.base_points, "base_points", 6))
+        set_(self, "platform_points", as_points(self.platform_points, "platform_points", 6))
+        set_(self, "link_length", as_positive(self.link_length, "link_length", (6,)))
+        set_(self, "stroke_window", as_stroke(self.stroke_window, "stroke"))
+        set_(self, "tool_offset", as_vector3(self.tool_offset, "tool_offset"))
+        self.link_length.setflags(write=False)
+        span = np.linalg.norm((self.base_points - self._level_joints())[:, :2], axis=1)
+        if np.any(span >= self.link_length):
+            i = int(np.argmax(span - self.link_length))
+            raise ParameterError("link_length",
+                                 f"longer than leg {i + 1}'s horizontal span at the level "
+                                 f"centred pose ({span[i]:.3f} mm)", float(self.link_length[i]))
+
+    # ---- generator ---------------------------------------------------------------------------
+    @classmethod
+    def from_circles(cls, *, base_radii=(100.0, 165.0), platform_radii=(50.0, 80.0),
+                     base_pair_angle: float | None = None,
+                     platform_rotation: float = math.radians(33.7),
+                     base_pair_separation: float = 0.0, platform_pair_separation: float = 0.0,
+                     pairing: str = "same", link_length=225.0, stroke=(0.0, 101.6),
+                     tool_offset=(0.0, 0.0, 47.0), name: str = "", nominal=None) -> PSU6:
+        """Paired concentric-circle layout (see :mod:`pkmlab.mechanisms.layout`).
+
+        Defaults are the Hopkins & Williams prototype: radii 100/165 mm (base) and 50/80 mm
+        (platform), ρ = 33.7°, 225 mm links, 101.6 mm stroke, {H} 47 mm above {P}.
+        ``base_pair_angle=None`` solves β so that all legs are equal at the level pose, as the
+        paper states; inner = outer radius with pair separations gives the single-circle
+        ParaDex layout. Angles in rad, lengths in mm.
+        """
+        base_radii, platform_radii = _radii(base_radii, "base_radii"), \
+            _radii(platform_radii, "platform_radii")
+        auto = base_pair_angle is None
+        if auto:
+            base_pair_angle = equal_leg_base_angle(base_radii, platform_radii, platform_rotation,
+                                                   base_pair_separation,
+                                                   platform_pair_separation, pairing)
+        B, P = paired_layout(base_radii, platform_radii, base_pair_angle, platform_rotation,
+                             base_pair_separation, platform_pair_separation, pairing)
+        desc = {
+            "generator": "paired concentric circles",
+            "base_radii_mm": list(base_radii), "platform_radii_mm": list(platform_radii),
+            "base_pair_angle_deg": math.degrees(base_pair_angle),
+            "base_pair_angle_source": "solved for equal legs" if auto else "given",
+            "platform_rotation_deg": math.degrees(platform_rotation),
+            "base_pair_separation_deg": math.degrees(base_pair_separation),
+            "platform_pair_separation_deg": math.degrees(platform_pair_separation),
+            "pairing": pairing,
+        }
+        return cls(B, P, link_length, stroke, tool_offset, name=name, nominal=nominal,
+                   description=desc)
+
+    # ---- family hooks ----------------------------------------------------------------------
+    @property
+    def stroke(self) -> tuple[float, float]:
+        return self.stroke_window
+
+    @property
+    def scale(self) -> float:
+        return float(np.max(np.linalg.norm(self.base_points, axis=1))
+                     + np.max(np.linalg.norm(self.platform_points, axis=1))
+                     + np.max(self.link_length) + (self.stroke[1] - self.stroke[0]))
+
+    def _tool_points(self) -> np.ndarray:
+        return self.platform_points - self.tool_offset
+
+    def _level_joints(self) -> np.ndarray:
+        return self._tool_points()  # level, centred: horizontal positions are the points' own
+
+    def _gparams(self) -> np.ndarray:
+        return np.concatenate([self.base_points.ravel(), self._tool_points().ravel(),
+                               self.link_length])
+
+    def _jacobian(self, p, R):
+        r = np.einsum("nij,kj->nki", R, self._tool_points())          # (N, 6, 3)
+        a = p[:, None, :] + r - self.base_points
+        with np.errstate(invalid="ignore"):
+            a[..., 2] = np.sqrt(self.link_length**2 - a[..., 0] ** 2 - a[..., 1] ** 2)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.concatenate([a, np.cross(r, a)], axis=-1) / a[..., 2:3]
+
+    def _closure(self, p, R, q):
+        r = np.einsum("nij,kj->nki", R, self._tool_points())
+        a = p[:, None, :] + r - self.base_points
+        a[..., 2] -= q
+        norm = np.linalg.norm(a, axis=-1)
+        u = a / norm[..., None]
+        return norm - self.link_length, np.concatenate([u, np.cross(r, u)], axis=-1)
+
+    def describe(self) -> dict:
+        d = super().describe()
+        d.update(link_length_mm=self.link_length.tolist(), stroke_mm=list(self.stroke),
+                 tool_offset_mm=self.tool_offset.tolist(),
+                 base_points_mm=self.base_points.tolist(),
+                 platform_points_mm=self.platform_points.tolist())
+        return d
+
+
+def _radii(value, field: str) -> tuple[float, float]:
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (2,) or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise ParameterError(field, "[inner, outer], two radii > 0 mm", value)
+    if arr[0] > arr[1]:
+        raise ParameterError(field, "[inner, outer] with inner <= outer", arr.tolist())
+    return float(arr[0]), float(arr[1])

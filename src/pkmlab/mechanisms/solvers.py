@@ -1,0 +1,145 @@
+"""Generic forward-kinematics solvers shared by every family.
+
+Newton's method runs on the family's loop-closure residuals ``f(p, R; q)`` (mm) with their
+analytic derivative ``G = ∂f/∂ξ`` with respect to a base-frame twist displacement ξ = (δp, δφ);
+a step updates ``p ← p + δp`` and ``R ← exp(δφ)·R``, so no Euler-angle singularity is involved.
+Everything is batched over starting points; converged entries drop out of the active set.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..poses import as_frames, frames_to_poses, log_so3
+from .base import AssemblyModes, FKResult, step_frames
+
+
+def _solve(G: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """Batched ``G⁻¹ f`` with a pseudo-inverse fallback when a matrix is singular."""
+    try:
+        return np.linalg.solve(G, f[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        return np.einsum("nij,nj->ni", np.linalg.pinv(G, rcond=1e-13), f)
+
+
+def newton(mech, p, R, q, *, tol: float, max_iter: int, polish: int = 2):
+    """Damped Newton from frames ``p (N,3)``, ``R (N,3,3)`` towards actuator values ``q (N,6)``.
+
+    Returns ``(p, R, residual (N,), iterations (N,), finite (N,))``: ``finite`` is False where
+    the residual or its derivative became undefined (e.g. a leg with no real solution).
+    """
+    p, R, q = p.copy(), R.copy(), np.asarray(q, dtype=float)
+    n = p.shape[0]
+    residual = np.full(n, np.inf)
+    iters = np.zeros(n, dtype=int)
+    polished = np.zeros(n, dtype=int)
+    finite = np.ones(n, dtype=bool)
+    active = np.arange(n)
+    max_lin, max_ang = 0.25 * mech.scale, 0.5
+    for _ in range(max_iter + polish + 1):
+        if active.size == 0:
+            break
+        f, G = mech._closure(p[active], R[active], q[active])
+        good = np.all(np.isfinite(f), axis=1) & np.all(np.isfinite(G), axis=(1, 2))
+        res = np.where(good, np.max(np.abs(np.where(np.isfinite(f), f, 0.0)), axis=1), np.inf)
+        residual[active] = res
+        finite[active[~good]] = False
+        polished[active] += res < tol
+        keep = good & (polished[active] <= polish) & (iters[active] < max_iter + polish)
+        active, f, G = active[keep], f[keep], G[keep]
+        if active.size == 0:
+            break
+        step = -_solve(G, f)
+        lin = np.linalg.norm(step[:, :3], axis=1)
+        ang = np.linalg.norm(step[:, 3:], axis=1)
+        scale = np.minimum(1.0, np.minimum(max_lin / np.maximum(lin, 1e-300),
+                                           max_ang / np.maximum(ang, 1e-300)))
+        step *= scale[:, None]
+        p[active], R[active] = step_frames(p[active], R[active], step)
+        iters[active] += 1
+    return p, R, residual, iters, finite
+
+
+def _working_mode(mech, p, R, q, tol_mode: float) -> np.ndarray:
+    """True where the family's inverse kinematics at (p, R) reproduces q."""
+    ik = mech._ik_frames_raw(p, R)
+    with np.errstate(invalid="ignore"):
+        err = np.max(np.abs(ik.q - q), axis=1)
+    return np.isfinite(err) & (err <= tol_mode)
+
+
+def forward_newton(mech, q, guess=None, *, tol: float = 1e-9, max_iter: int = 50,
+                   continuation_steps: int = 12) -> FKResult:
+    """Batched forward kinematics; see :meth:`Mechanism.forward`."""
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    if q.shape[1:] != (6,):
+        from ..errors import ParameterError
+
+        raise ParameterError("q", "an array of shape (6,) or (N, 6) in mm", q.shape)
+    n = q.shape[0]
+    p0, R0 = as_frames(mech.nominal_pose if guess is None else guess, field="guess")
+    if p0.shape[0] == 1 and n > 1:
+        p0, R0 = np.repeat(p0, n, axis=0), np.repeat(R0, n, axis=0)
+    tol_mode = max(1e3 * tol, 1e-6)
+    p, R, res, it, _ = newton(mech, p0, R0, q, tol=tol, max_iter=max_iter)
+    ok = (res < tol) & _working_mode(mech, p, R, q, tol_mode)
+
+    bad = np.flatnonzero(~ok & np.all(np.isfinite(q), axis=1))
+    if bad.size:
+        # Continuation from the nominal pose keeps the nominal assembly mode.
+        pn, Rn = as_frames(mech.nominal_pose)
+        qn = mech._ik_frames_raw(pn, Rn).q[0]
+        pc, Rc = np.repeat(pn, bad.size, axis=0), np.repeat(Rn, bad.size, axis=0)
+        itc = np.zeros(bad.size, dtype=int)
+        for k in range(1, continuation_steps + 1):
+            qk = qn + (k / continuation_steps) * (q[bad] - qn)
+            last = k == continuation_steps
+            pc, Rc, resc, itk, _ = newton(mech, pc, Rc, qk, tol=tol if last else 1e3 * tol,
+                                          max_iter=max_iter if last else 15)
+            itc += itk
+        okc = (resc < tol) & _working_mode(mech, pc, Rc, q[bad], tol_mode)
+        take = okc
+        idx = bad[take]
+        p[idx], R[idx], res[idx] = pc[take], Rc[take], resc[take]
+        it[bad] += itc
+        ok[idx] = True
+
+    pose = frames_to_poses(p, R)
+    pose[~ok] = np.nan
+    status = np.where(ok, "ok", np.where(np.isfinite(res), "not converged", "singular"))
+    return FKResult(pose=pose, converged=ok, residual=res, iterations=it,
+                    status=status.astype(object))
+
+
+def multistart_modes(mech, q, *, starts: int, seed: int, tol: float) -> AssemblyModes:
+    """Multi-start assembly-mode search; see :meth:`Mechanism.assembly_modes`."""
+    q = np.asarray(q, dtype=float).reshape(6)
+    pr, Rr = mech._random_starts(starts, seed)
+    pn, Rn = as_frames(mech.nominal_pose)
+    p0 = np.concatenate([pn, pr])
+    R0 = np.concatenate([Rn, Rr])
+    qq = np.repeat(q[None], p0.shape[0], axis=0)
+    p, R, res, _, _ = newton(mech, p0, R0, qq, tol=tol, max_iter=100)
+    conv = res < tol
+    p, R, res = p[conv], R[conv], res[conv]
+    # De-duplicate: greedy clustering in (position, rotation) space.
+    lin_tol, ang_tol = 1e-6 * mech.scale, 1e-6
+    keep: list[int] = []
+    for i in np.argsort(res):
+        if keep:
+            k = np.array(keep)
+            dp = np.linalg.norm(p[k] - p[i], axis=1)
+            da = np.linalg.norm(log_so3(np.einsum("nji,jk->nik", R[k], R[i])), axis=1)
+            if np.any((dp < lin_tol) & (da < ang_tol)):
+                continue
+        keep.append(int(i))
+    k = np.array(keep, dtype=int)
+    p, R, res = p[k], R[k], res[k]
+    dist = mech._pose_distance(p, R) if k.size else np.zeros(0)
+    order = np.argsort(dist)
+    p, R, res, dist = p[order], R[order], res[order], dist[order]
+    working = _working_mode(mech, p, R, qq[: p.shape[0]], max(1e3 * tol, 1e-6)) \
+        if k.size else np.zeros(0, dtype=bool)
+    return AssemblyModes(pose=frames_to_poses(p, R) if k.size else np.zeros((0, 6)),
+                         residual=res, working_mode=working, distance=dist,
+                         starts=int(p0.shape[0]))

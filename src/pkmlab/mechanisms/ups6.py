@@ -1,0 +1,138 @@
+"""6-UPS Gough–Stewart platform: six extensible legs between base U joints and platform S joints.
+
+Leg i joins the base joint ``B_i`` to the platform joint ``W_i = p + R·(P_i - O)``; the actuator
+value is the leg length ``q_i = |W_i - B_i|``. With ``n_i = (W_i - B_i)/q_i`` and
+``r_i = R·(P_i - O)`` the velocity Jacobian row is ``J_i = [n_iᵀ, (r_i × n_i)ᵀ]``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from . import _kernels
+from .base import Mechanism, as_points, as_stroke, as_vector3
+from .layout import equal_leg_base_angle, paired_layout
+from .psu6 import _radii
+
+__all__ = ["UPS6"]
+
+
+@njit(cache=True)
+def _ups_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st):
+    for i in range(6):
+        bx, by, bz = g[3 * i], g[3 * i + 1], g[3 * i + 2]
+        ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
+        sx = px + r00 * ux + r01 * uy + r02 * uz - bx
+        sy = py + r10 * ux + r11 * uy + r12 * uz - by
+        sz = pz + r20 * ux + r21 * uy + r22 * uz - bz
+        v = math.sqrt(sx * sx + sy * sy + sz * sz)
+        q[i] = v
+        if v < 1e-12:
+            st[i] = _kernels.DEGENERATE
+        else:
+            st[i] = _kernels.stroke_status(v, qmin, qmax)
+
+
+@dataclass(frozen=True)
+class UPS6(Mechanism):
+    """6-UPS geometry.
+
+    Attributes:
+        base_points: ``(6, 3)`` base U-joint centres (mm, base frame).
+        platform_points: ``(6, 3)`` platform S-joint centres (mm, platform frame).
+        stroke_window: leg-length window (min, max) in mm, 0 < min < max.
+        tool_offset: ``(3,)`` tool-frame origin in the platform frame (mm).
+    """
+
+    family = "ups6"
+
+    base_points: np.ndarray
+    platform_points: np.ndarray
+    stroke_window: tuple[float, float]
+    tool_offset: np.ndarray = (0.0, 0.0, 0.0)  # type: ignore[assignment]
+
+    _ik_one = _ups_one
+
+    def __post_init__(self):
+        set_ = object.__setattr__
+        set_(self, "base_points", as_points(self.base_points, "base_points", 6))
+        set_(self, "platform_points", as_points(self.platform_points, "platform_points", 6))
+        set_(self, "stroke_window", as_stroke(self.stroke_window, "stroke", positive=True))
+        set_(self, "tool_offset", as_vector3(self.tool_offset, "tool_offset"))
+
+    @classmethod
+    def from_circles(cls, *, base_radii=(300.0, 300.0), platform_radii=(150.0, 150.0),
+                     base_pair_angle: float | None = None,
+                     platform_rotation: float = math.radians(30.0),
+                     base_pair_separation: float = math.radians(20.0),
+                     platform_pair_separation: float = math.radians(20.0),
+                     pairing: str = "same", stroke=(400.0, 700.0), tool_offset=(0.0, 0.0, 0.0),
+                     name: str = "", nominal=None) -> UPS6:
+        """Paired layout on circles (see :mod:`pkmlab.mechanisms.layout`).
+
+        Equal inner and outer radii with pair separations give the usual "two circles with pair
+        separation angles" Gough–Stewart; ``base_pair_angle=None`` solves it for equal legs; distinct inner/outer radii with zero separations give
+        the Stoughton–Arai (1993) concentric-circle variant. Angles in rad, lengths in mm.
+        """
+        base_radii = _radii(base_radii, "base_radii")
+        platform_radii = _radii(platform_radii, "platform_radii")
+        auto = base_pair_angle is None
+        if auto:
+            base_pair_angle = equal_leg_base_angle(base_radii, platform_radii, platform_rotation,
+                                                   base_pair_separation,
+                                                   platform_pair_separation, pairing)
+        B, P = paired_layout(base_radii, platform_radii, base_pair_angle, platform_rotation,
+                             base_pair_separation, platform_pair_separation, pairing)
+        desc = {
+            "generator": "paired circles",
+            "base_radii_mm": list(base_radii), "platform_radii_mm": list(platform_radii),
+            "base_pair_angle_deg": math.degrees(base_pair_angle),
+            "base_pair_angle_source": "solved for equal legs" if auto else "given",
+            "platform_rotation_deg": math.degrees(platform_rotation),
+            "base_pair_separation_deg": math.degrees(base_pair_separation),
+            "platform_pair_separation_deg": math.degrees(platform_pair_separation),
+            "pairing": pairing,
+        }
+        return cls(B, P, stroke, tool_offset, name=name, nominal=nominal, description=desc)
+
+    @property
+    def stroke(self) -> tuple[float, float]:
+        return self.stroke_window
+
+    @property
+    def scale(self) -> float:
+        return float(np.max(np.linalg.norm(self.base_points, axis=1))
+                     + np.max(np.linalg.norm(self.platform_points, axis=1)) + self.stroke[1])
+
+    def _tool_points(self) -> np.ndarray:
+        return self.platform_points - self.tool_offset
+
+    def _gparams(self) -> np.ndarray:
+        return np.concatenate([self.base_points.ravel(), self._tool_points().ravel()])
+
+    def _legs(self, p, R):
+        r = np.einsum("nij,kj->nki", R, self._tool_points())
+        s = p[:, None, :] + r - self.base_points
+        length = np.linalg.norm(s, axis=-1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            n = s / length[..., None]
+        return r, n, length
+
+    def _jacobian(self, p, R):
+        r, n, _ = self._legs(p, R)
+        return np.concatenate([n, np.cross(r, n)], axis=-1)
+
+    def _closure(self, p, R, q):
+        r, n, length = self._legs(p, R)
+        return length - q, np.concatenate([n, np.cross(r, n)], axis=-1)
+
+    def describe(self) -> dict:
+        d = super().describe()
+        d.update(stroke_mm=list(self.stroke), tool_offset_mm=self.tool_offset.tolist(),
+                 base_points_mm=self.base_points.tolist(),
+                 platform_points_mm=self.platform_points.tolist())
+        return d

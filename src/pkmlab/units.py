@@ -1,0 +1,55 @@
+"""Unit parsing. Internal units are millimetres and radians; conversion happens once, at load.
+
+A quantity is either a bare number, read in the field's documented unit, or a string with a unit
+such as ``"225 mm"``, ``"4 in"``, ``"33.7 deg"`` or ``"0.5 rad"``.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import Any
+
+from .errors import ParameterError
+
+__all__ = ["LENGTH_UNITS", "ANGLE_UNITS", "parse_length", "parse_angle", "parse_quantity"]
+
+LENGTH_UNITS = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "inch": 25.4, "ft": 304.8}
+ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180.0, "°": math.pi / 180.0}
+
+_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z°]*)\s*$")
+
+
+def parse_quantity(value: Any, field: str, units: dict[str, float], default_unit: str) -> float:
+    """Convert ``value`` to the internal unit of ``units`` (factor 1.0).
+
+    Bare numbers are taken in ``default_unit``. Raises :class:`ParameterError` naming ``field``.
+    """
+    allowed = f"a number (in {default_unit}) or a string with a unit from {sorted(units)}"
+    if isinstance(value, bool):
+        raise ParameterError(field, allowed, value)
+    if isinstance(value, int | float):
+        number, unit = float(value), default_unit
+    elif isinstance(value, str):
+        match = _QUANTITY.match(value)
+        if match is None:
+            raise ParameterError(field, allowed, value)
+        number = float(match.group(1))
+        unit = match.group(2) or default_unit
+        if unit not in units:
+            raise ParameterError(field, allowed, value)
+    else:
+        raise ParameterError(field, allowed, value)
+    if not math.isfinite(number):
+        raise ParameterError(field, "a finite " + allowed, value)
+    return number * units[unit]
+
+
+def parse_length(value: Any, field: str, default_unit: str = "mm") -> float:
+    """Length in mm from a bare number (``default_unit``) or a string such as ``"4 in"``."""
+    return parse_quantity(value, field, LENGTH_UNITS, default_unit) / LENGTH_UNITS["mm"]
+
+
+def parse_angle(value: Any, field: str, default_unit: str = "deg") -> float:
+    """Angle in rad from a bare number (``default_unit``) or a string such as ``"30 deg"``."""
+    return parse_quantity(value, field, ANGLE_UNITS, default_unit)
