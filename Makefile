@@ -15,7 +15,7 @@ $(STAMP): pyproject.toml | $(PY)
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(PY) -m pkmlab.demo
+	$(VENV)/bin/pkmlab demo studies/mechanisms
 
 test: $(STAMP)
 	$(PY) -m pytest

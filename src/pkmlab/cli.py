@@ -1,0 +1,254 @@
+"""Command-line interface (typer). Speaks mm and degrees; the library speaks mm and radians.
+
+JSON output (``--json``) uses these keys throughout:
+
+* a pose is ``{"x": mm, "y": mm, "z": mm, "theta_x": deg, "theta_y": deg, "theta_z": deg}``
+  (Z-Y-X Euler angles, R = Rz·Ry·Rx, of the tool frame in the base frame);
+* actuator values are ``{"<name>": mm, ...}`` keyed by the family's actuator names
+  (``q1``..``q6``, or ``l11``..``l32`` for ``luzi3``).
+
+Errors in the input print one line naming the field, the allowed values and the value given,
+and exit with status 2.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.markup import escape
+from rich.table import Table
+
+from .config import load_mechanism
+from .errors import ParameterError
+from .mechanisms import Mechanism
+from .units import parse_angle, parse_length
+
+app = typer.Typer(add_completion=False, no_args_is_help=True,
+                  help="pkmlab: design-optimisation workbench for parallel manipulators.")
+out = Console()
+err = Console(stderr=True)
+
+POSE_KEYS = ("x", "y", "z", "theta_x", "theta_y", "theta_z")
+JSON_HELP = ("Print JSON. Pose keys: x, y, z (mm), theta_x, theta_y, theta_z (deg, Z-Y-X Euler); "
+             "actuators: {name: mm} with the family's actuator names.")
+
+
+def _fail(exc: Exception) -> None:
+    err.print(f"[bold red]error[/]: {exc}", highlight=False)
+    raise typer.Exit(code=2)
+
+
+def _load(path: Path) -> Mechanism:
+    try:
+        return load_mechanism(path)
+    except ParameterError as exc:
+        _fail(exc)
+        raise  # unreachable
+
+
+def _parse_csv(text: str, field: str, n: int) -> list[str]:
+    parts = [p.strip() for p in text.split(",")]
+    if len(parts) != n or any(p == "" for p in parts):
+        _fail(ParameterError(field, f"{n} comma-separated values", text))
+    return parts
+
+
+def _parse_pose(text: str, field: str = "--pose") -> np.ndarray:
+    parts = _parse_csv(text, field, 6)
+    try:
+        lin = [parse_length(p, f"{field}[{i}]") for i, p in enumerate(parts[:3])]
+        ang = [parse_angle(p, f"{field}[{i + 3}]") for i, p in enumerate(parts[3:])]
+    except ParameterError as exc:
+        _fail(exc)
+    return np.array(lin + ang)
+
+
+def _pose_json(pose: np.ndarray) -> dict:
+    vals = list(pose[:3]) + [math.degrees(a) for a in pose[3:]]
+    return {k: (None if not np.isfinite(v) else float(v)) for k, v in zip(POSE_KEYS, vals)}
+
+
+def _act_json(mech: Mechanism, q: np.ndarray) -> dict:
+    return {n: (None if not np.isfinite(v) else float(v)) for n, v in zip(mech.actuator_names, q)}
+
+
+def _pose_str(pose: np.ndarray) -> str:
+    p = _pose_json(pose)
+    return (f"x={p['x']:.4f} y={p['y']:.4f} z={p['z']:.4f} mm, θx={p['theta_x']:.4f} "
+            f"θy={p['theta_y']:.4f} θz={p['theta_z']:.4f} deg") if None not in p.values() \
+        else "undefined"
+
+
+def _emit(data: dict) -> None:
+    sys.stdout.write(json.dumps(data, indent=2) + "\n")
+
+
+MechArg = Annotated[Path, typer.Argument(help="Mechanism YAML file.")]
+JsonOpt = Annotated[bool, typer.Option("--json", help=JSON_HELP)]
+
+
+@app.command()
+def inspect(mech_file: MechArg, as_json: JsonOpt = False) -> None:
+    """Geometry, nominal pose, its actuator values and the Jacobian condition number."""
+    mech = _load(mech_file)
+    nominal = mech.nominal_pose
+    ik = mech.inverse(nominal)
+    J = mech.jacobian(nominal)[0]
+    cond = float(np.linalg.cond(J)) if np.all(np.isfinite(J)) else None
+    data = {
+        "geometry": mech.describe(),
+        "nominal_pose": _pose_json(nominal),
+        "nominal_actuators": _act_json(mech, ik.q[0]),
+        "nominal_valid": bool(ik.valid[0]),
+        "nominal_reason": str(ik.reason_text[0]),
+        "actuator_limits": {n: list(map(float, lim))
+                            for n, lim in zip(mech.actuator_names, mech.actuator_limits)},
+        "jacobian_condition_number": cond,
+    }
+    if as_json:
+        _emit(data)
+        return
+    out.print(f"[bold]{mech.name or mech_file.stem}[/] — family [cyan]{mech.family}[/]")
+    g = mech.describe()
+    for key, val in g.items():
+        if key.endswith("points_mm") or key in ("family", "name"):
+            continue
+        out.print(f"  {key}: {val}")
+    pts = [k for k in g if k.endswith("points_mm")]
+    table = Table("joint", *[k.removesuffix("_mm") + " (mm)" for k in pts])
+    for i in range(max(len(g[k]) for k in pts)):
+        table.add_row(str(i + 1), *[(" ".join(f"{c:9.3f}" for c in g[k][i])
+                                     if i < len(g[k]) else "") for k in pts])
+    out.print(table)
+    out.print(f"nominal pose: {_pose_str(nominal)}")
+    out.print("nominal actuators (mm): " + ", ".join(
+        f"{n}={v:.4f}" for n, v in zip(mech.actuator_names, ik.q[0]))
+        + escape(f"  [{ik.reason_text[0]}]"))
+    out.print(f"Jacobian condition number at nominal (unscaled, mm and rad): {cond:.4g}"
+              if cond is not None else "Jacobian undefined at nominal")
+
+
+@app.command()
+def ik(mech_file: MechArg,
+       pose: Annotated[str, typer.Option(help='Tool pose "x,y,z,θx,θy,θz" in mm and deg '
+                                              '(units may be given, e.g. "2 in").')],
+       as_json: JsonOpt = False) -> None:
+    """Inverse kinematics: actuator values of one pose, with validity and reason."""
+    mech = _load(mech_file)
+    X = _parse_pose(pose)
+    res = mech.inverse(X)
+    J = mech.jacobian(X)[0]
+    cond = float(np.linalg.cond(J)) if np.all(np.isfinite(J)) else None
+    legs = [str(res.reason_text[0])] if res.valid[0] else [
+        f"{n}: {s}" for n, s in zip(mech.actuator_names,
+                                    [mech_status(c) for c in res.leg_status[0]]) if s != "ok"]
+    data = {"pose": _pose_json(X), "actuators": _act_json(mech, res.q[0]),
+            "valid": bool(res.valid[0]), "reason": str(res.reason_text[0]),
+            "leg_status": {n: mech_status(c) for n, c in zip(mech.actuator_names,
+                                                              res.leg_status[0])},
+            "jacobian_condition_number": cond}
+    if as_json:
+        _emit(data)
+        return
+    out.print(f"pose: {_pose_str(X)}")
+    out.print("actuators (mm): " + ", ".join(f"{n}={v:.6f}" for n, v in
+                                            zip(mech.actuator_names, res.q[0])))
+    out.print(("[green]valid[/]" if res.valid[0] else "[red]invalid[/]") + ": "
+              + escape("; ".join(legs)))
+
+
+def mech_status(code: int) -> str:
+    from .mechanisms import LEG_STATUS
+
+    return LEG_STATUS[int(code)]
+
+
+@app.command()
+def fk(mech_file: MechArg,
+       actuators: Annotated[str, typer.Option(help='Actuator values "q1,…,q6" in mm.')],
+       all_modes: Annotated[bool, typer.Option("--all", help="List every assembly mode found "
+                                               "by the multi-start search.")] = False,
+       guess: Annotated[str | None, typer.Option(help='Start pose "x,y,z,θx,θy,θz" (mm, deg); '
+                                                 'default the nominal pose.')] = None,
+       starts: Annotated[int, typer.Option(help="Random starts for --all.", min=1)] = 1500,
+       seed: Annotated[int, typer.Option(help="Seed of the --all starts.")] = 0,
+       as_json: JsonOpt = False) -> None:
+    """Forward kinematics (Newton from the nominal pose or --guess); --all for every mode."""
+    mech = _load(mech_file)
+    parts = _parse_csv(actuators, "--actuators", 6)
+    try:
+        q = np.array([parse_length(p, f"--actuators[{i}]") for i, p in enumerate(parts)])
+    except ParameterError as exc:
+        _fail(exc)
+    g = None if guess is None else _parse_pose(guess, "--guess")
+    res = mech.forward(q, g)
+    data = {"actuators": _act_json(mech, q), "pose": _pose_json(res.pose[0]),
+            "converged": bool(res.converged[0]), "residual_mm": float(res.residual[0]),
+            "iterations": int(res.iterations[0]), "status": str(res.status[0])}
+    if all_modes:
+        modes = mech.assembly_modes(q, starts=starts, seed=seed)
+        data["assembly_modes"] = [
+            {"pose": _pose_json(p), "residual_mm": float(r), "working_mode": bool(w),
+             "distance_to_nominal": float(d)}
+            for p, r, w, d in zip(modes.pose, modes.residual, modes.working_mode, modes.distance)]
+        data["starts"] = modes.starts
+    if as_json:
+        _emit(data)
+        return
+    out.print(f"forward kinematics: [{'green' if res.converged[0] else 'red'}]"
+              f"{res.status[0]}[/] after {res.iterations[0]} iterations, "
+              f"residual {res.residual[0]:.3g} mm")
+    out.print(f"pose: {_pose_str(res.pose[0])}")
+    if all_modes:
+        table = Table("#", "x (mm)", "y (mm)", "z (mm)", "θx (deg)", "θy (deg)", "θz (deg)",
+                      "residual (mm)", "working mode",
+                      title=f"{len(modes.residual)} assembly modes from {modes.starts} starts")
+        for i, (p, r, w) in enumerate(zip(modes.pose, modes.residual, modes.working_mode)):
+            pj = _pose_json(p)
+            table.add_row(str(i + 1), *[f"{pj[k]:.4f}" for k in POSE_KEYS], f"{r:.2e}",
+                          "yes" if w else "no")
+        out.print(table)
+
+
+@app.command()
+def demo(folder: Annotated[Path, typer.Argument(help="Folder of mechanism YAML files.")]
+         = Path("studies/mechanisms")) -> None:
+    """Kinematics demo on the shipped paper geometries: inspect, IK, FK round trip, modes."""
+    files = sorted(folder.glob("*.yaml"))
+    if not files:
+        _fail(ParameterError("folder", "a folder containing mechanism YAML files", str(folder)))
+    for f in files:
+        out.rule(f"[bold]{f.name}")
+        inspect(f)
+        mech = _load(f)
+        X = mech.nominal_pose + np.array([10.0, -5.0, 8.0, *np.radians([5.0, -4.0, 10.0])])
+        res = mech.inverse(X)
+        out.print(f"IK of a displaced pose {_pose_str(X)}:")
+        out.print("  " + ", ".join(f"{n}={v:.4f}" for n, v in zip(mech.actuator_names,
+                                                                   res.q[0]))
+                  + escape(f" mm [{res.reason_text[0]}]"))
+        back = mech.forward(res.q[0])
+        errp = np.abs(back.pose[0] - X)
+        out.print(f"FK back from the nominal pose: {back.status[0]} in {back.iterations[0]} "
+                  f"iterations; error {errp[:3].max():.2e} mm, {errp[3:].max():.2e} rad")
+        modes = mech.assembly_modes(res.q[0], starts=800)
+        out.print(f"assembly modes for these actuator values: {len(modes.residual)} found from "
+                  f"{modes.starts} starts ({int(modes.working_mode.sum())} in the working mode)")
+    out.rule()
+    out.print("Demo done. Try: pkmlab ik studies/mechanisms/hopkins-williams-6psu.yaml "
+              '--pose "0,0,300,10,0,0"')
+
+
+def main() -> None:
+    app()
+
+
+if __name__ == "__main__":
+    main()

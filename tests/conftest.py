@@ -1,0 +1,45 @@
+"""Shared fixtures: one instance of every registered family (the contract suite runs on each)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import pkmlab
+from pkmlab.mechanisms import REGISTRY, Luzi3
+
+ROOT = Path(__file__).resolve().parents[1]
+MECH_DIR = ROOT / "studies" / "mechanisms"
+
+# Every shipped mechanism file, plus the Luzi geometry that matches the paper's Table 1.
+SHIPPED = sorted(MECH_DIR.glob("*.yaml"))
+
+
+def _instances() -> dict[str, pkmlab.Mechanism]:
+    mechs = {f.stem: pkmlab.load_mechanism(f) for f in SHIPPED}
+    mechs["luzi-3chain-l200"] = Luzi3.from_paper(upper_link=200.0, stroke=(750.0, 1150.0))
+    return mechs
+
+
+MECHANISMS = _instances()
+# The contract must cover every registered family.
+assert {m.family for m in MECHANISMS.values()} == set(REGISTRY), "a family has no test instance"
+
+
+@pytest.fixture(params=sorted(MECHANISMS), ids=sorted(MECHANISMS))
+def mech(request):
+    return MECHANISMS[request.param]
+
+
+def random_valid_poses(mech, n: int, seed: int, lin: float = 25.0, ang_deg: float = 10.0):
+    """``n`` poses near the nominal pose whose inverse kinematics is valid."""
+    rng = np.random.default_rng(seed)
+    out = []
+    while sum(len(o) for o in out) < n:
+        X = mech.nominal_pose + np.concatenate(
+            [rng.uniform(-lin, lin, (4 * n, 3)),
+             np.radians(rng.uniform(-ang_deg, ang_deg, (4 * n, 3)))], axis=1)
+        out.append(X[mech.inverse(X).valid])
+    return np.concatenate(out)[:n]
