@@ -217,22 +217,22 @@ class Mechanism:
     def inverse(self, poses: np.ndarray) -> IKResult:
         """Actuator values of poses ``(N, 6)`` / ``(N, 4, 4)`` → :class:`IKResult`."""
         X = np.asarray(poses, dtype=float)
-        lo, hi = self.stroke
-        g = self._gparams()
         if X.ndim <= 2 and X.shape[-1] == 6:
-            X2 = np.ascontiguousarray(X.reshape(-1, 6))
-            n = X2.shape[0]
-            q = np.empty((n, 6))
-            st = np.empty((n, 6), dtype=np.int8)
-            _kernels.drive_euler(type(self)._ik_one, X2, g, lo, hi, q, st)
+            return self._run_ik(np.ascontiguousarray(X.reshape(-1, 6)), None, *self.stroke)
+        p, R = as_frames(X)
+        return self._run_ik(p, R, *self.stroke)
+
+    def _run_ik(self, X_or_p, R, lo: float, hi: float) -> IKResult:
+        euler, frames = _kernels.make_drivers(type(self)._ik_one)
+        n = X_or_p.shape[0]
+        q = np.empty((n, 6))
+        st = np.empty((n, 6), dtype=np.int8)
+        reason = np.empty(n, dtype=np.int8)
+        if R is None:
+            euler(X_or_p, self._gparams(), lo, hi, q, st, reason)
         else:
-            p, R = as_frames(X)
-            n = p.shape[0]
-            q = np.empty((n, 6))
-            st = np.empty((n, 6), dtype=np.int8)
-            _kernels.drive_frames(type(self)._ik_one, np.ascontiguousarray(p),
-                                  np.ascontiguousarray(R), g, lo, hi, q, st)
-        reason = st.max(axis=1)
+            frames(np.ascontiguousarray(X_or_p), np.ascontiguousarray(R), self._gparams(),
+                   lo, hi, q, st, reason)
         return IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st)
 
     def jacobian(self, poses: np.ndarray) -> np.ndarray:
@@ -280,14 +280,7 @@ class Mechanism:
     # ---- helpers -----------------------------------------------------------------------------
     def _ik_frames_raw(self, p: np.ndarray, R: np.ndarray) -> IKResult:
         """Inverse kinematics ignoring the stroke window (geometry only)."""
-        g = self._gparams()
-        n = p.shape[0]
-        q = np.empty((n, 6))
-        st = np.empty((n, 6), dtype=np.int8)
-        _kernels.drive_frames(type(self)._ik_one, np.ascontiguousarray(p),
-                              np.ascontiguousarray(R), g, -np.inf, np.inf, q, st)
-        reason = st.max(axis=1)
-        return IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st)
+        return self._run_ik(p, R, -np.inf, np.inf)
 
     def _level_yaw(self) -> float:
         """Rotation about z (rad) of the platform frame at the symmetric, level pose."""

@@ -35,10 +35,11 @@ from .base import Mechanism, as_points, as_positive, as_stroke, as_vector3
 __all__ = ["Luzi3", "pose_to_psi", "psi_to_pose", "reduced_dpa", "ReducedDPAResult"]
 
 
-@njit(cache=True)
-def _luzi_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st):
+@njit(cache=True, inline="always")
+def _luzi_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st, k):
     half = 0.5 * g[27]
     kx, ky, kz = r02, r12, r22
+    worst = _kernels.OK
     for i in range(3):
         a1x, a1y, a1z = g[6 * i], g[6 * i + 1], g[6 * i + 2]
         a2x, a2y, a2z = g[6 * i + 3], g[6 * i + 4], g[6 * i + 5]
@@ -53,19 +54,23 @@ def _luzi_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, 
         nn = math.sqrt(nx * nx + ny * ny + nz * nz)
         scale = math.sqrt(rx * rx + ry * ry + rz * rz) * math.sqrt(dx * dx + dy * dy + dz * dz)
         if not nn > 1e-12 * scale:
-            q[2 * i] = np.nan
-            q[2 * i + 1] = np.nan
-            st[2 * i] = _kernels.DEGENERATE
-            st[2 * i + 1] = _kernels.DEGENERATE
+            q[k, 2 * i] = np.nan
+            q[k, 2 * i + 1] = np.nan
+            st[k, 2 * i] = _kernels.DEGENERATE
+            st[k, 2 * i + 1] = _kernels.DEGENERATE
+            worst = _kernels.DEGENERATE if worst < _kernels.DEGENERATE else worst
             continue
         s = half / nn if nx * rx + ny * ry + nz * rz >= 0.0 else -half / nn
         ex, ey, ez = cx - s * nx - a1x, cy - s * ny - a1y, cz - s * nz - a1z
         v1 = math.sqrt(ex * ex + ey * ey + ez * ez)
         ex, ey, ez = cx + s * nx - a2x, cy + s * ny - a2y, cz + s * nz - a2z
         v2 = math.sqrt(ex * ex + ey * ey + ez * ez)
-        q[2 * i], q[2 * i + 1] = v1, v2
-        st[2 * i] = _kernels.stroke_status(v1, qmin, qmax)
-        st[2 * i + 1] = _kernels.stroke_status(v2, qmin, qmax)
+        q[k, 2 * i], q[k, 2 * i + 1] = v1, v2
+        s1 = _kernels.stroke_status(v1, qmin, qmax)
+        s2 = _kernels.stroke_status(v2, qmin, qmax)
+        st[k, 2 * i], st[k, 2 * i + 1] = s1, s2
+        worst = max(worst, max(s1, s2))
+    return worst
 
 
 @dataclass(frozen=True)
@@ -308,8 +313,13 @@ def pose_to_psi(mech: Luzi3, poses) -> np.ndarray:
     return np.stack([psi1, psi2, psi3, psi4], axis=1)
 
 
-def _reduced_residual(mech: Luzi3, psi, q, branch: int) -> np.ndarray:
-    """Eq. (13): the four closure residuals (mm) of chains 2 and 3, t_i from eq. (10)."""
+def _reduced_residual(mech: Luzi3, psi, q, branch: int, literal: bool = False) -> np.ndarray:
+    """Eq. (13): the four closure residuals (mm) of chains 2 and 3, t_i from eq. (10).
+
+    Eq. (10) fixes t_i's sign by the order of the cross products alone; unless ``literal``,
+    t_i is oriented with t_i · r_i ≥ 0 (the inverse kinematics' convention), without which the
+    reduced system cannot reach the modes where the printed sign points against r_i.
+    """
     pose = psi_to_pose(mech, psi, q[0], q[1], branch)
     p, R = as_frames(pose)
     rho = np.einsum("nij,kj->nki", R, mech.platform_points - mech.tool_offset)
@@ -317,6 +327,8 @@ def _reduced_residual(mech: Luzi3, psi, q, branch: int) -> np.ndarray:
     k = R[:, None, :, 2]
     A1, A2 = mech.base_points[0::2], mech.base_points[1::2]
     m = np.cross(k, np.cross(A2 - A1, C - A1))
+    if not literal:
+        m *= np.where(np.einsum("nki,ki->nk", m, A2 - A1) >= 0, 1.0, -1.0)[..., None]
     with np.errstate(invalid="ignore", divide="ignore"):
         t = m / np.linalg.norm(m, axis=-1, keepdims=True)
     half = 0.5 * mech.upper_link
@@ -348,25 +360,26 @@ class ReducedDPAResult:
     ik_error: np.ndarray
 
 
-def reduced_dpa(mech: Luzi3, q, *, grid: int = 6, tol: float = 1e-9,
-                max_iter: int = 60) -> ReducedDPAResult:
+def reduced_dpa(mech: Luzi3, q, *, grid: int = 9, tol: float = 1e-9, max_iter: int = 60,
+                literal_eq10: bool = False) -> ReducedDPAResult:
     """Solve the paper's 4-equation system (13) in ψ1..ψ4 by multi-start Newton.
 
-    Starts: a ``grid × grid`` lattice in (ψ1, ψ2) over (0, π) times a ``(grid+2)²`` lattice in
-    (ψ3, ψ4) over (-π, π], for both four-bar branches. The Jacobian of (13) is taken by central
+    Starts: a ``grid⁴`` lattice over (-π, π]⁴, for both four-bar branches (configurations
+    below the base plane have ψ1 or ψ2 outside (0, π), so the whole circle is searched). The Jacobian of (13) is taken by central
     differences (step 1e-7 rad); this solver is a cross-check of :meth:`Luzi3.forward`, which
-    uses the analytic Jacobian of the full closure.
+    uses the analytic Jacobian of the full closure. Roots are de-duplicated by pose (distinct ψ
+    can describe one pose, e.g. (ψ1, ψ2) and (-ψ1, ψ2 + π)). ``literal_eq10`` keeps eq. (10)'s
+    printed sign of t_i (see :func:`_reduced_residual`).
     """
     q = np.asarray(q, dtype=float).reshape(6)
-    a12 = np.linspace(0.1, math.pi - 0.1, grid)
-    a34 = np.linspace(-math.pi, math.pi, grid + 2, endpoint=False)
-    starts = np.stack(np.meshgrid(a12, a12, a34, a34, indexing="ij"), -1).reshape(-1, 4)
+    a = np.linspace(-math.pi, math.pi, grid, endpoint=False) + math.pi / (2 * grid)
+    starts = np.stack(np.meshgrid(a, a, a, a, indexing="ij"), -1).reshape(-1, 4)
     out_psi, out_branch, out_res = [], [], []
     h = 1e-7
     for branch in (-1, 1):
         x = starts.copy()
         for _ in range(max_iter):
-            f = _reduced_residual(mech, x, q, branch)
+            f = _reduced_residual(mech, x, q, branch, literal_eq10)
             ok = np.all(np.isfinite(f), axis=1)
             x, f = x[ok], f[ok]
             if x.shape[0] == 0:
@@ -375,15 +388,15 @@ def reduced_dpa(mech: Luzi3, q, *, grid: int = 6, tol: float = 1e-9,
             for j in range(4):
                 dx = np.zeros(4)
                 dx[j] = h
-                Jm[:, :, j] = (_reduced_residual(mech, x + dx, q, branch)
-                               - _reduced_residual(mech, x - dx, q, branch)) / (2 * h)
+                Jm[:, :, j] = (_reduced_residual(mech, x + dx, q, branch, literal_eq10)
+                               - _reduced_residual(mech, x - dx, q, branch, literal_eq10)) / (2 * h)
             good = np.all(np.isfinite(Jm), axis=(1, 2)) & (np.abs(np.linalg.det(Jm)) > 1e-300)
             x, f, Jm = x[good], f[good], Jm[good]
             step = -np.linalg.solve(Jm, f[..., None])[..., 0]
             big = np.max(np.abs(step), axis=1)
             step *= np.minimum(1.0, 0.3 / np.maximum(big, 1e-300))[:, None]
             x = x + step
-        f = _reduced_residual(mech, x, q, branch)
+        f = _reduced_residual(mech, x, q, branch, literal_eq10)
         res = np.max(np.abs(f), axis=1)
         conv = res < tol
         out_psi.append(x[conv])
@@ -392,18 +405,21 @@ def reduced_dpa(mech: Luzi3, q, *, grid: int = 6, tol: float = 1e-9,
     psi = (np.concatenate(out_psi) + np.pi) % (2 * np.pi) - np.pi
     res = np.concatenate(out_res)
     branch = np.concatenate(out_branch)
-    keep: list[int] = []
-    for i in np.argsort(res):
-        if keep and np.any((np.max(np.abs(psi[keep] - psi[i]), axis=1) < 1e-6)
-                           & (branch[keep] == branch[i])):
-            continue
-        keep.append(int(i))
-    psi, res, branch = psi[keep], res[keep], branch[keep]
     pose = np.concatenate([psi_to_pose(mech, psi[branch == b], q[0], q[1], b)
                            for b in (-1, 1)]) if psi.size else np.zeros((0, 6))
     order = np.concatenate([np.flatnonzero(branch == b) for b in (-1, 1)])
     psi, res, branch = psi[order], res[order], branch[order]
     p, R = as_frames(pose) if pose.size else (np.zeros((0, 3)), np.zeros((0, 3, 3)))
+    keep: list[int] = []
+    for i in np.argsort(res):
+        if keep:
+            k = np.array(keep)
+            dp = np.max(np.abs(p[k] - p[i]), axis=1)
+            dr = np.max(np.abs(R[k] - R[i]), axis=(1, 2))
+            if np.any((dp < 1e-6 * mech.scale) & (dr < 1e-6)):
+                continue
+        keep.append(int(i))
+    psi, res, branch, pose, p, R = (a[keep] for a in (psi, res, branch, pose, p, R))
     ik = mech._ik_frames_raw(p, R)
     with np.errstate(invalid="ignore"):
         err = np.max(np.abs(ik.q - q), axis=1) if pose.size else np.zeros(0)

@@ -21,8 +21,9 @@ from .psu6 import _radii
 __all__ = ["UPS6"]
 
 
-@njit(cache=True)
-def _ups_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st):
+@njit(cache=True, inline="always")
+def _ups_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st, k):
+    worst = _kernels.OK
     for i in range(6):
         bx, by, bz = g[3 * i], g[3 * i + 1], g[3 * i + 2]
         ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
@@ -30,11 +31,11 @@ def _ups_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, q
         sy = py + r10 * ux + r11 * uy + r12 * uz - by
         sz = pz + r20 * ux + r21 * uy + r22 * uz - bz
         v = math.sqrt(sx * sx + sy * sy + sz * sz)
-        q[i] = v
-        if v < 1e-12:
-            st[i] = _kernels.DEGENERATE
-        else:
-            st[i] = _kernels.stroke_status(v, qmin, qmax)
+        q[k, i] = v
+        s = _kernels.DEGENERATE if v < 1e-12 else _kernels.stroke_status(v, qmin, qmax)
+        st[k, i] = s
+        worst = max(worst, s)
+    return worst
 
 
 @dataclass(frozen=True)
