@@ -40,7 +40,7 @@ def hopkins_jnr_printed(X, B, P, L):
     """Eq. (11) exactly as printed (columns 1..6)."""
     x, y, z, tx, ty, tz = X
     r = euler_to_matrix(X[3:])
-    cx, sx, cy, sy, cz, sz = (math.cos(tx), math.sin(tx), math.cos(ty), math.sin(ty),
+    sx, cy, sy, cz, sz = (math.sin(tx), math.cos(ty), math.sin(ty),
                               math.cos(tz), math.sin(tz))
     Px, Py = P[0], P[1]
     return np.array([

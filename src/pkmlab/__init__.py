@@ -2,7 +2,7 @@
 
 from .config import load_mechanism
 from .errors import ParameterError
-from .mechanisms import REGISTRY, Luzi3, Mechanism, PSU6, UPS6
+from .mechanisms import PSU6, REGISTRY, UPS6, Luzi3, Mechanism
 
 __version__ = "0.1.0"
 

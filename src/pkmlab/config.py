@@ -16,7 +16,7 @@ import yaml
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, TypeAdapter, ValidationError
 
 from .errors import ParameterError, format_value
-from .mechanisms import Luzi3, Mechanism, PSU6, UPS6
+from .mechanisms import PSU6, UPS6, Luzi3, Mechanism
 from .units import ANGLE_UNITS, LENGTH_UNITS, parse_angle, parse_length
 
 __all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec"]

@@ -105,7 +105,8 @@ def log_so3(R: np.ndarray) -> np.ndarray:
                   R[..., 1, 0] - R[..., 0, 1]], axis=-1)
     s = np.sin(theta)
     small = s < 1e-6
-    out = np.where(small[..., None], 0.5 * v, v * (theta / (2 * np.where(small, 1.0, s)))[..., None])
+    ratio = theta / (2 * np.where(small, 1.0, s))
+    out = np.where(small[..., None], 0.5 * v, v * ratio[..., None])
     # Near θ = π the antisymmetric part vanishes: use the symmetric part instead.
     near_pi = (theta > np.pi - 1e-3)
     if np.any(near_pi):

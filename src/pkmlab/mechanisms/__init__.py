@@ -6,7 +6,7 @@ one entry in :data:`REGISTRY` (plus its YAML model in :mod:`pkmlab.config`).
 
 from __future__ import annotations
 
-from .base import AssemblyModes, FKResult, IKResult, LEG_STATUS, Mechanism
+from .base import LEG_STATUS, AssemblyModes, FKResult, IKResult, Mechanism
 from .luzi3 import Luzi3
 from .psu6 import PSU6
 from .ups6 import UPS6

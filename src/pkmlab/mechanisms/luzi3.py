@@ -365,7 +365,8 @@ def reduced_dpa(mech: Luzi3, q, *, grid: int = 9, tol: float = 1e-9, max_iter: i
     """Solve the paper's 4-equation system (13) in ψ1..ψ4 by multi-start Newton.
 
     Starts: a ``grid⁴`` lattice over (-π, π]⁴, for both four-bar branches (configurations
-    below the base plane have ψ1 or ψ2 outside (0, π), so the whole circle is searched). The Jacobian of (13) is taken by central
+    below the base plane have ψ1 or ψ2 outside (0, π), so the whole circle is searched).
+    The Jacobian of (13) is taken by central
     differences (step 1e-7 rad); this solver is a cross-check of :meth:`Luzi3.forward`, which
     uses the analytic Jacobian of the full closure. Roots are de-duplicated by pose (distinct ψ
     can describe one pose, e.g. (ψ1, ψ2) and (-ψ1, ψ2 + π)). ``literal_eq10`` keeps eq. (10)'s

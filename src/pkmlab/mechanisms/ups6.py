@@ -76,7 +76,8 @@ class UPS6(Mechanism):
         """Paired layout on circles (see :mod:`pkmlab.mechanisms.layout`).
 
         Equal inner and outer radii with pair separations give the usual "two circles with pair
-        separation angles" Gough–Stewart; ``base_pair_angle=None`` solves it for equal legs; distinct inner/outer radii with zero separations give
+        separation angles" Gough–Stewart (``base_pair_angle=None`` solves it for equal
+        legs); distinct inner/outer radii with zero separations give
         the Stoughton–Arai (1993) concentric-circle variant. Angles in rad, lengths in mm.
         """
         base_radii = _radii(base_radii, "base_radii")
