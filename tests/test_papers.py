@@ -97,11 +97,12 @@ def test_luzi_psi_round_trip_and_four_bar_equation():
     assert np.max(np.abs(back[:, :3] - X[:, :3])) < 1e-8
     R1, R2 = euler_to_matrix(back[:, 3:]), euler_to_matrix(X[:, 3:])
     assert np.max(np.linalg.norm(log_so3(np.einsum("nji,njk->nik", R1, R2)), axis=1)) < 1e-10
-    # Eq. (1) gives the same θ as the pose (chain 1's upper-link angle in its plane).
+    # psi_to_pose rebuilds the pose with θ from eq. (1), so the round trip above validates
+    # eq. (1) and its "−√" branch; the other branch must give a different (wrong) pose.
     theta = four_bar_theta(mech, psi[:, 0], q[:, 0], q[:, 1])
-    p, R = as_frames(X)
     assert np.all(np.isfinite(theta))
-    assert np.allclose(psi_to_pose(mech, psi, q[:, 0], q[:, 1]), back)  # consistent branch
+    other = psi_to_pose(mech, psi, q[:, 0], q[:, 1], branch=1)
+    assert np.min(np.max(np.abs(other[:, :3] - X[:, :3]), axis=1)) > 1.0
 
 
 def test_reduced_dpa_equals_full_closure_modes():

@@ -24,7 +24,7 @@ from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
 from ..errors import ParameterError
-from ..poses import as_frames, exp_so3, frames_to_poses, log_so3
+from ..poses import as_frames, exp_so3, log_so3
 from . import _kernels
 
 log = logging.getLogger(__name__)
@@ -313,8 +313,7 @@ class Mechanism:
     def _random_starts(self, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
         rng = np.random.default_rng(seed)
         S = self.scale
-        centre = np.array([0.0, 0.0, self.nominal_pose[2] * 0.0])
-        p = centre + rng.uniform(-2 * S, 2 * S, size=(n, 3))
+        p = rng.uniform(-2 * S, 2 * S, size=(n, 3))         # box about the base centre
         R = Rotation.random(n, random_state=rng).as_matrix()
         return p, R
 
@@ -324,14 +323,9 @@ class Mechanism:
         return np.linalg.norm(p - pn, axis=-1) + self.scale * rot
 
 
-def frames_from(poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Alias of :func:`pkmlab.poses.as_frames` for family modules."""
-    return as_frames(poses)
-
-
 def step_frames(p: np.ndarray, R: np.ndarray, twist: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Apply a base-frame twist displacement ``(N, 6)`` to frames: p += v, R ← exp(ω)·R."""
     return p + twist[:, :3], exp_so3(twist[:, 3:]) @ R
 
 
-__all__ += ["frames_from", "step_frames", "frames_to_poses"]
+__all__ += ["step_frames"]
