@@ -192,8 +192,13 @@ class Mechanism:
         raise NotImplementedError
 
     @property
-    def stroke(self) -> tuple[float, float]:  # pragma: no cover - abstract
-        raise NotImplementedError
+    def stroke(self) -> tuple[float, float]:
+        """Actuator window (min, max) in mm (every family stores it as ``stroke_window``)."""
+        return self.stroke_window
+
+    def _tool_points(self) -> np.ndarray:
+        """Platform joint centres in the tool frame (same orientation, origin at the offset)."""
+        return self.platform_points - self.tool_offset
 
     @property
     def scale(self) -> float:
@@ -275,7 +280,11 @@ class Mechanism:
 
     def describe(self) -> dict:
         """Plain-dict summary of the geometry for display and JSON."""
-        return {"family": self.family, "name": self.name, **self.description}
+        return {"family": self.family, "name": self.name, **self.description,
+                "stroke_mm": list(self.stroke),
+                "tool_offset_mm": np.asarray(self.tool_offset).tolist(),
+                "base_points_mm": np.asarray(self.base_points).tolist(),
+                "platform_points_mm": np.asarray(self.platform_points).tolist()}
 
     # ---- helpers -----------------------------------------------------------------------------
     def _ik_frames_raw(self, p: np.ndarray, R: np.ndarray) -> IKResult:

@@ -22,7 +22,7 @@ from scipy.optimize import brentq
 
 from ..errors import ParameterError
 
-__all__ = ["paired_layout", "equal_leg_base_angle"]
+__all__ = ["paired_layout", "equal_leg_base_angle", "build_paired"]
 
 
 def _ring(radii: np.ndarray, angles: np.ndarray, z: float = 0.0) -> np.ndarray:
@@ -83,3 +83,32 @@ def equal_leg_base_angle(base_radii, platform_radii, platform_rotation, base_pai
     target = 5 * np.pi / 6 - platform_rotation
     wrap = lambda a: (a + np.pi) % (2 * np.pi) - np.pi  # noqa: E731
     return float(min(roots, key=lambda r: abs(wrap(r - target))))
+
+
+def build_paired(base_radii, platform_radii, base_pair_angle, platform_rotation,
+                 base_pair_separation=0.0, platform_pair_separation=0.0, pairing="same"):
+    """:func:`paired_layout` with ``base_pair_angle=None`` solved for equal legs.
+
+    Returns ``(base_points, platform_points, description)``; the description records the
+    generator parameters in mm and deg for display.
+    """
+    import math
+
+    auto = base_pair_angle is None
+    if auto:
+        base_pair_angle = equal_leg_base_angle(base_radii, platform_radii, platform_rotation,
+                                               base_pair_separation, platform_pair_separation,
+                                               pairing)
+    B, P = paired_layout(base_radii, platform_radii, base_pair_angle, platform_rotation,
+                         base_pair_separation, platform_pair_separation, pairing)
+    desc = {
+        "generator": "paired concentric circles",
+        "base_radii_mm": list(base_radii), "platform_radii_mm": list(platform_radii),
+        "base_pair_angle_deg": math.degrees(base_pair_angle),
+        "base_pair_angle_source": "solved for equal legs" if auto else "given",
+        "platform_rotation_deg": math.degrees(platform_rotation),
+        "base_pair_separation_deg": math.degrees(base_pair_separation),
+        "platform_pair_separation_deg": math.degrees(platform_pair_separation),
+        "pairing": pairing,
+    }
+    return B, P, desc

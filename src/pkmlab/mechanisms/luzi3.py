@@ -146,17 +146,10 @@ class Luzi3(Mechanism):
 
     # ---- family hooks ----------------------------------------------------------------------
     @property
-    def stroke(self) -> tuple[float, float]:
-        return self.stroke_window
-
-    @property
     def scale(self) -> float:
         return float(np.max(np.linalg.norm(self.base_points, axis=1))
                      + np.max(np.linalg.norm(self.platform_points - self.tool_offset, axis=1))
                      + self.stroke[1])
-
-    def _tool_points(self) -> np.ndarray:
-        return self.platform_points - self.tool_offset
 
     def _gparams(self) -> np.ndarray:
         return np.concatenate([self.base_points.ravel(), self._tool_points().ravel(),
@@ -209,10 +202,7 @@ class Luzi3(Mechanism):
 
     def describe(self) -> dict:
         d = super().describe()
-        d.update(upper_link_mm=self.upper_link, stroke_mm=list(self.stroke),
-                 tool_offset_mm=self.tool_offset.tolist(),
-                 base_points_mm=self.base_points.tolist(),
-                 platform_points_mm=self.platform_points.tolist())
+        d.update(upper_link_mm=self.upper_link)
         return d
 
     # ---- ψ parametrisation ---------------------------------------------------------------

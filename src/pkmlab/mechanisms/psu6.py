@@ -24,7 +24,7 @@ from numba import njit
 from ..errors import ParameterError
 from . import _kernels
 from .base import Mechanism, as_points, as_positive, as_stroke, as_vector3
-from .layout import equal_leg_base_angle, paired_layout
+from .layout import build_paired
 
 __all__ = ["PSU6"]
 
@@ -107,39 +107,18 @@ class PSU6(Mechanism):
         """
         base_radii, platform_radii = _radii(base_radii, "base_radii"), \
             _radii(platform_radii, "platform_radii")
-        auto = base_pair_angle is None
-        if auto:
-            base_pair_angle = equal_leg_base_angle(base_radii, platform_radii, platform_rotation,
-                                                   base_pair_separation,
-                                                   platform_pair_separation, pairing)
-        B, P = paired_layout(base_radii, platform_radii, base_pair_angle, platform_rotation,
-                             base_pair_separation, platform_pair_separation, pairing)
-        desc = {
-            "generator": "paired concentric circles",
-            "base_radii_mm": list(base_radii), "platform_radii_mm": list(platform_radii),
-            "base_pair_angle_deg": math.degrees(base_pair_angle),
-            "base_pair_angle_source": "solved for equal legs" if auto else "given",
-            "platform_rotation_deg": math.degrees(platform_rotation),
-            "base_pair_separation_deg": math.degrees(base_pair_separation),
-            "platform_pair_separation_deg": math.degrees(platform_pair_separation),
-            "pairing": pairing,
-        }
+        B, P, desc = build_paired(base_radii, platform_radii, base_pair_angle,
+                                  platform_rotation, base_pair_separation,
+                                  platform_pair_separation, pairing)
         return cls(B, P, link_length, stroke, tool_offset, name=name, nominal=nominal,
                    description=desc)
 
     # ---- family hooks ----------------------------------------------------------------------
     @property
-    def stroke(self) -> tuple[float, float]:
-        return self.stroke_window
-
-    @property
     def scale(self) -> float:
         return float(np.max(np.linalg.norm(self.base_points, axis=1))
                      + np.max(np.linalg.norm(self.platform_points, axis=1))
                      + np.max(self.link_length) + (self.stroke[1] - self.stroke[0]))
-
-    def _tool_points(self) -> np.ndarray:
-        return self.platform_points - self.tool_offset
 
     def _level_joints(self) -> np.ndarray:
         return self._tool_points()  # level, centred: horizontal positions are the points' own
@@ -166,10 +145,7 @@ class PSU6(Mechanism):
 
     def describe(self) -> dict:
         d = super().describe()
-        d.update(link_length_mm=self.link_length.tolist(), stroke_mm=list(self.stroke),
-                 tool_offset_mm=self.tool_offset.tolist(),
-                 base_points_mm=self.base_points.tolist(),
-                 platform_points_mm=self.platform_points.tolist())
+        d.update(link_length_mm=self.link_length.tolist())
         return d
 
 

@@ -15,7 +15,7 @@ from numba import njit
 
 from . import _kernels
 from .base import Mechanism, as_points, as_stroke, as_vector3
-from .layout import equal_leg_base_angle, paired_layout
+from .layout import build_paired
 from .psu6 import _radii
 
 __all__ = ["UPS6"]
@@ -82,36 +82,15 @@ class UPS6(Mechanism):
         """
         base_radii = _radii(base_radii, "base_radii")
         platform_radii = _radii(platform_radii, "platform_radii")
-        auto = base_pair_angle is None
-        if auto:
-            base_pair_angle = equal_leg_base_angle(base_radii, platform_radii, platform_rotation,
-                                                   base_pair_separation,
-                                                   platform_pair_separation, pairing)
-        B, P = paired_layout(base_radii, platform_radii, base_pair_angle, platform_rotation,
-                             base_pair_separation, platform_pair_separation, pairing)
-        desc = {
-            "generator": "paired circles",
-            "base_radii_mm": list(base_radii), "platform_radii_mm": list(platform_radii),
-            "base_pair_angle_deg": math.degrees(base_pair_angle),
-            "base_pair_angle_source": "solved for equal legs" if auto else "given",
-            "platform_rotation_deg": math.degrees(platform_rotation),
-            "base_pair_separation_deg": math.degrees(base_pair_separation),
-            "platform_pair_separation_deg": math.degrees(platform_pair_separation),
-            "pairing": pairing,
-        }
+        B, P, desc = build_paired(base_radii, platform_radii, base_pair_angle,
+                                  platform_rotation, base_pair_separation,
+                                  platform_pair_separation, pairing)
         return cls(B, P, stroke, tool_offset, name=name, nominal=nominal, description=desc)
-
-    @property
-    def stroke(self) -> tuple[float, float]:
-        return self.stroke_window
 
     @property
     def scale(self) -> float:
         return float(np.max(np.linalg.norm(self.base_points, axis=1))
                      + np.max(np.linalg.norm(self.platform_points, axis=1)) + self.stroke[1])
-
-    def _tool_points(self) -> np.ndarray:
-        return self.platform_points - self.tool_offset
 
     def _gparams(self) -> np.ndarray:
         return np.concatenate([self.base_points.ravel(), self._tool_points().ravel()])
@@ -131,10 +110,3 @@ class UPS6(Mechanism):
     def _closure(self, p, R, q):
         r, n, length = self._legs(p, R)
         return length - q, np.concatenate([n, np.cross(r, n)], axis=-1)
-
-    def describe(self) -> dict:
-        d = super().describe()
-        d.update(stroke_mm=list(self.stroke), tool_offset_mm=self.tool_offset.tolist(),
-                 base_points_mm=self.base_points.tolist(),
-                 platform_points_mm=self.platform_points.tolist())
-        return d
