@@ -246,6 +246,141 @@ def demo(folder: Annotated[Path, typer.Argument(help="Folder of mechanism YAML f
               '--pose "0,0,300,10,0,0"')
 
 
+# ---- workspace ----------------------------------------------------------------------------------
+
+
+def _csv_list(text: str | None, field: str, n: int) -> list[str] | None:
+    return None if text is None else _parse_csv(text, field, n)
+
+
+def _write_workspace(res, out_dir: Path, mesh_formats: list[str], window: float,
+                     spacing: float) -> list[Path]:
+    """Write every output into a scratch folder first, then move it into ``out_dir``."""
+    import shutil
+    import tempfile
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    with tempfile.TemporaryDirectory(dir=out_dir, prefix=".partial-") as tmp:
+        tmp = Path(tmp)
+        files = [res.save_npz(tmp / "workspace.npz"), res.save_json(tmp / "workspace.json"),
+                 res.plot_slices(tmp / "slices.png", window=window, spacing=spacing)]
+        if not res.empty:
+            files += [res.save_mesh(tmp / f"workspace.{fmt}") for fmt in mesh_formats]
+        for stale in ("workspace.stl", "workspace.ply", "workspace.glb"):
+            (out_dir / stale).unlink(missing_ok=True)
+        for f in files:
+            shutil.move(str(f), out_dir / f.name)
+            written.append(out_dir / f.name)
+    return written
+
+
+def _workspace_summary(res, written, as_json: bool, extra: dict | None = None) -> None:
+    m = res.metrics()
+    m["files"] = [str(p) for p in written]
+    if extra:
+        m.update(extra)
+    if as_json:
+        _emit(m)
+        return
+    title = f"{m['mechanism'] or m['family']}: {m['kind']} workspace"
+    if res.empty:
+        out.print(f"{escape(title)}: [bold]empty[/] — no position satisfies the constraints "
+                  "for this orientation set (no mesh written).")
+    else:
+        out.print(f"{escape(title)}: volume {m['volume_cm3']:.3f} ± "
+                  f"{m['volume_error_cm3']:.3f} cm³ ({escape(m['method'])})")
+        z0, z1 = m["z_range_mm"]
+        c = m["centroid_mm"]
+        out.print(f"  z range {z0:.2f} … {z1:.2f} mm, centroid ({c[0]:.2f}, {c[1]:.2f}, "
+                  f"{c[2]:.2f}) mm, {m['components']} component(s)")
+        for key in ("inscribed_box", "inscribed_cylinder"):
+            if extra and extra.get(key):
+                out.print(f"  {key.replace('_', ' ')}: {escape(json.dumps(extra[key]))}")
+    for note in m["notes"]:
+        out.print(f"  note: {escape(note)}")
+    out.print(f"  orientations: {m['orientations']['count']}, grid {m['grid']}, "
+              f"{m['timings_s']['total_s'] * 1e3:.1f} ms")
+    for p in written:
+        out.print(f"  wrote {escape(str(p))}")
+
+
+@app.command()
+def workspace(
+    mech_file: MechArg,
+    kind: Annotated[str, typer.Option(help="constant | reachable | dexterous")] = "constant",
+    orientation: Annotated[str | None, typer.Option(
+        help='constant kind: "θx,θy,θz" relative to nominal (deg or with units)')] = None,
+    box: Annotated[str | None, typer.Option(help='Euler half-ranges "a,b,c" (deg)')] = None,
+    semantics: Annotated[str, typer.Option(help="simultaneous | single-axis")]
+    = "simultaneous",
+    tilt: Annotated[str | None, typer.Option(help="tilt-and-torsion set: largest tilt")] = None,
+    torsion: Annotated[str, typer.Option(help="tilt-and-torsion set: torsion half-range")]
+    = "0",
+    samples: Annotated[int, typer.Option(help="orientation samples per angle")] = 7,
+    resolution: Annotated[str, typer.Option(help="grid spacing (mm or with units)")] = "2.5",
+    link_diameter: Annotated[str | None, typer.Option(help="leg interference diameter")]
+    = None,
+    joint_limit: Annotated[str | None, typer.Option(
+        help='passive joint cone half-angles "base,platform" (deg)')] = None,
+    kappa_max: Annotated[float | None, typer.Option(help="largest condition number")] = None,
+    all_components: Annotated[bool, typer.Option(
+        "--all-components", help="keep regions not connected to the nominal pose")] = False,
+    inscribed: Annotated[bool, typer.Option(
+        "--inscribed", help="also find the largest inscribed box and vertical cylinder")]
+    = False,
+    mesh: Annotated[str, typer.Option(help="mesh formats, comma-separated: stl,ply,glb")]
+    = "stl",
+    out_dir: Annotated[Path, typer.Option("--out", help="output folder")]
+    = Path("results/workspace"),
+    as_json: JsonOpt = False,
+) -> None:
+    """Workspace volume, slices (PNG), boundary mesh (STL) and arrays (npz) of a mechanism.
+
+    Writes workspace.npz, workspace.json, slices.png and workspace.stl into --out.
+    """
+    from .config import workspace_spec
+    from .workspace import workspace as compute
+
+    mech = _load(mech_file)
+    data: dict = {"kind": kind, "semantics": semantics, "samples": samples,
+                  "resolution": resolution, "torsion": torsion,
+                  "constraints": {"connected": not all_components}}
+    for key, text in (("orientation", orientation), ("box", box)):
+        vals = _csv_list(text, f"--{key}", 3)
+        if vals is not None:
+            data[key] = vals
+    if tilt is not None:
+        data["tilt"] = tilt
+    if link_diameter is not None:
+        data["constraints"]["link_diameter"] = link_diameter
+    if kappa_max is not None:
+        data["constraints"]["kappa_max"] = kappa_max
+    jl = _csv_list(joint_limit, "--joint-limit", 2)
+    if jl is not None:
+        data["constraints"]["joint_limits"] = {"base": jl[0], "platform": jl[1]}
+    formats = [f.strip().lower() for f in mesh.split(",") if f.strip()]
+    bad = [f for f in formats if f not in ("stl", "ply", "glb")]
+    if bad or not formats:
+        _fail(ParameterError("--mesh", "comma-separated formats from ['stl', 'ply', 'glb']",
+                             mesh))
+    try:
+        spec = workspace_spec(data, prefix="--")
+        req = spec.build()
+        res = compute(mech, **req)
+        extra = {}
+        if inscribed and not res.empty:
+            extra = {"inscribed_box": res.inscribed_box().as_dict(),
+                     "inscribed_cylinder": res.inscribed_cylinder().as_dict()}
+    except ParameterError as exc:
+        _fail(exc)
+    written = _write_workspace(res, out_dir, formats, spec.slice_window, spec.slice_spacing)
+    if extra:
+        (out_dir / "workspace.json").write_text(
+            json.dumps({**res.metrics(), **extra}, indent=2) + "\n")
+    _workspace_summary(res, written, as_json, extra)
+
+
 def main() -> None:
     app()
 

@@ -19,7 +19,14 @@ from .errors import ParameterError, format_value
 from .mechanisms import PSU6, UPS6, Luzi3, Mechanism
 from .units import ANGLE_UNITS, LENGTH_UNITS, parse_angle, parse_length
 
-__all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec"]
+__all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec", "workspace_spec", "WorkspaceSpec"]
+
+
+class _Shown(str):
+    """A value already rendered for an error message (not quoted again)."""
+
+    def __repr__(self) -> str:
+        return str(self)
 
 
 class _Invalid(ValueError):
@@ -220,7 +227,7 @@ def _translate(exc: ValidationError, prefix: str = "") -> ParameterError:
     if kind == "value_error":
         text = msg.removeprefix("Value error, ")
         allowed, _, given = text.removeprefix("must be ").partition("; got ")
-        return ParameterError(field, allowed, given or got)
+        return ParameterError(field, allowed, _Shown(given) if given else got)
     if kind == "missing":
         return ParameterError(field, "given (required)", None)
     if kind == "extra_forbidden":
@@ -232,6 +239,106 @@ def _translate(exc: ValidationError, prefix: str = "") -> ParameterError:
     if kind == "literal_error":
         return ParameterError(field, msg.removeprefix("Input should be "), got)
     return ParameterError(field, msg, got)
+
+
+# ---- workspace requests ------------------------------------------------------------------------
+
+
+def _angle_triple(v: Any) -> list[float]:
+    if not isinstance(v, list | tuple) or len(v) != 3:
+        raise _Invalid(f"must be three angles [θx, θy, θz] (deg or with units); got "
+                       f"{format_value(v)}")
+    return [_angle(x) for x in v]
+
+
+AngleTriple = Annotated[list[float], BeforeValidator(_angle_triple)]
+
+
+class JointLimitsSpec(_Model):
+    """Passive joint cone half-angles; axes default to the link directions at nominal."""
+
+    base: Angle | None = Field(None, description="base-side joint cone half-angle (deg)")
+    platform: Angle | None = Field(None, description="platform-side joint cone half-angle")
+    base_axes: Points | None = Field(None, description="6 mounting axes, base frame")
+    platform_axes: Points | None = Field(None, description="6 mounting axes, platform frame")
+
+
+class ConstraintsSpec(_Model):
+    stroke: bool = True
+    joint_limits: JointLimitsSpec | None = None
+    link_diameter: PositiveLength | None = Field(None, description="leg diameter (mm)")
+    kappa_max: float | None = Field(None, ge=1, description="largest condition number")
+    characteristic_length: PositiveLength | None = None
+    connected: bool = True
+
+
+class WorkspaceSpec(_Model):
+    """One workspace request (YAML ``workspace:`` block or the CLI options)."""
+
+    kind: Literal["constant", "reachable", "dexterous"] = "constant"
+    orientation: AngleTriple | None = Field(
+        None, description="constant kind: [θx, θy, θz] relative to nominal (deg)")
+    box: AngleTriple | None = Field(None, description="Euler half-ranges [a, b, c] (deg)")
+    semantics: Literal["simultaneous", "single-axis"] = "simultaneous"
+    tilt: Angle | None = Field(None, description="tilt-and-torsion set: largest tilt (deg)")
+    torsion: Angle = Field(0.0, description="tilt-and-torsion set: torsion half-range (deg)")
+    samples: int = Field(7, ge=1, le=101, description="orientation samples per angle")
+    resolution: PositiveLength = Field(2.5, description="grid spacing (mm)")
+    constraints: ConstraintsSpec = ConstraintsSpec()
+    slice_window: PositiveLength = Field(152.4, description="slice plot window edge (mm)")
+    slice_spacing: PositiveLength = Field(12.7, description="slice plot spacing (mm)")
+
+    def build(self):
+        """→ ``dict(kind, orientations, resolution, constraints)`` for ``pkmlab.workspace``."""
+        from .workspace import Constraints, JointLimits, OrientationSet
+
+        if self.box is not None and self.tilt is not None:
+            raise ParameterError("box", "absent when tilt is given (choose one orientation "
+                                 "set)", "both given")
+        if self.kind == "constant" and (self.box is not None or self.tilt is not None):
+            raise ParameterError("kind", "'reachable' or 'dexterous' when an orientation set "
+                                 "(box or tilt) is given", self.kind)
+        if self.kind != "constant" and self.box is None and self.tilt is None:
+            raise ParameterError("box", "given (or tilt) for kind " + repr(self.kind),
+                                 None)
+        if self.orientation is not None and self.kind != "constant":
+            raise ParameterError("orientation", "only given for kind 'constant'",
+                                 self.orientation)
+        if self.box is not None:
+            if any(not 0 <= a <= np.pi for a in self.box):
+                raise ParameterError("box", "half-ranges in [0, 180] deg",
+                                     [float(np.degrees(a)) for a in self.box])
+            oset = OrientationSet.box(tuple(self.box), self.semantics, self.samples)
+        elif self.tilt is not None:
+            oset = OrientationSet.tilt_torsion(self.tilt, self.torsion, self.samples)
+        else:
+            oset = OrientationSet.fixed(tuple(self.orientation or (0.0, 0.0, 0.0)))
+        c = self.constraints
+        jl = None
+        if c.joint_limits is not None:
+            j = c.joint_limits
+            jl = JointLimits(j.base, j.platform, j.base_axes, j.platform_axes)
+        cons = Constraints(stroke=c.stroke, joint_limits=jl, link_diameter=c.link_diameter,
+                           kappa_max=c.kappa_max, characteristic_length=c.characteristic_length,
+                           connected=c.connected)
+        return {"kind": self.kind, "orientations": oset, "resolution": self.resolution,
+                "constraints": cons}
+
+
+def workspace_spec(data: dict, prefix: str = "") -> WorkspaceSpec:
+    """Validate a workspace request mapping (errors name ``prefix + field``)."""
+    if not isinstance(data, dict):
+        raise ParameterError(prefix.rstrip(".") or "(workspace)", "a mapping of workspace "
+                             "fields", type(data).__name__)
+    try:
+        spec = WorkspaceSpec.model_validate(data)
+    except ValidationError as exc:
+        raise _translate(exc, prefix) from None
+    try:
+        spec.build()
+    except ParameterError as exc:
+        raise ParameterError(prefix + exc.field, exc.allowed, exc.got) from None
+    return spec
 
 
 def mechanism_spec(data: dict, prefix: str = "") -> PSU6Spec | UPS6Spec | Luzi3Spec:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any, ClassVar
 
 import numpy as np
@@ -181,6 +182,35 @@ class Mechanism:
 
     # ---- family hooks ----------------------------------------------------------------------
     _ik_one: ClassVar[Any] = None
+    #: ``"linear"`` / ``"quadratic"`` when the family supplies exact column kernels
+    #: (:meth:`_columns`) for the workspace engine, ``None`` for sampled evaluation.
+    column_method: ClassVar[str | None] = None
+    #: True when, at fixed (x, y, orientation), the leg geometry (link vectors, joint angles,
+    #: Jacobian) does not depend on z, so non-stroke constraints act on whole columns.
+    column_invariant: ClassVar[bool] = False
+
+    def _columns(self, xs, ys, R, mode, allowed=None, K=8):  # pragma: no cover - optional
+        """Stroke-feasible z sets of the columns ``xs × ys``: ``(lo, hi, overflow)``.
+
+        ``lo, hi`` are ``(nx, ny, K)`` sorted disjoint intervals (empty slots ``inf, -inf``);
+        ``mode="all"`` intersects over the orientations ``R (M, 3, 3)``, ``"any"`` unites the
+        orientations that ``allowed (nx, ny, M)`` permits. ``overflow`` counts columns that
+        needed more than ``K`` pieces.
+        """
+        raise NotImplementedError
+
+    def _position_bounds(self, R: np.ndarray) -> np.ndarray:
+        """``(M, 2, 3)`` per-orientation box [min; max] that contains every feasible position."""
+        p = self.nominal_pose[:3]
+        S = 2.0 * self.scale
+        return np.broadcast_to(np.stack([p - S, p + S]), (len(R), 2, 3)).copy()
+
+    def leg_segments(self, p: np.ndarray, R: np.ndarray):  # pragma: no cover - abstract
+        """End points ``(start, end)``, each ``(N, 6, 3)``, of each leg's moving link.
+
+        ``start`` carries the base-side passive joint and ``end`` the platform-side one.
+        """
+        raise NotImplementedError
 
     def _gparams(self) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError
@@ -215,6 +245,10 @@ class Mechanism:
     @property
     def nominal_pose(self) -> np.ndarray:
         """``(6,)`` nominal tool pose (mm, rad): given, or level and centred at mid-stroke."""
+        return self._nominal.copy()
+
+    @cached_property
+    def _nominal(self) -> np.ndarray:
         if self.nominal is not None:
             return np.array(self.nominal, dtype=float)
         return self._mid_stroke_pose()
@@ -309,7 +343,9 @@ class Mechanism:
 
         S = self.scale
         zs = np.linspace(3.0 * S + hi, -S, 801)
-        vals = np.array([mean_q(z) for z in zs])
+        scan = self._ik_frames_raw(np.stack([np.zeros(801), np.zeros(801), zs], axis=1),
+                                   np.ascontiguousarray(np.broadcast_to(Rz, (801, 3, 3))))
+        vals = np.where(scan.valid, scan.q.mean(axis=1) - mid, np.nan)
         for k in range(len(zs) - 1):
             a, b = vals[k], vals[k + 1]
             if np.isfinite(a) and np.isfinite(b) and a * b <= 0:

@@ -205,6 +205,30 @@ class Luzi3(Mechanism):
         d.update(upper_link_mm=self.upper_link)
         return d
 
+    # ---- workspace hooks -------------------------------------------------------------------
+    def _position_bounds(self, R):
+        """Each C_i lies within qmax + l/2 of both its base points: ``(M, 2, 3)``."""
+        rho = np.einsum("mij,kj->mki", R, self._tool_points())             # (M, 3, 3)
+        A = self.base_points.reshape(3, 2, 3)
+        reach = self.stroke[1] + 0.5 * self.upper_link
+        centre = A[None, :, :, :] - rho[:, :, None, :]                      # (M, 3, 2, 3)
+        lo = (centre - reach).reshape(len(R), 6, 3).max(axis=1)
+        hi = (centre + reach).reshape(len(R), 6, 3).min(axis=1)
+        return np.stack([lo, hi], axis=1)
+
+    def leg_segments(self, p, R):
+        """Actuated legs ``A_ij → B_ij`` as end points ``(N, 6, 3)`` each."""
+        rho = np.einsum("nij,kj->nki", R, self._tool_points())
+        C = p[:, None, :] + rho
+        A1, A2 = self.base_points[0::2], self.base_points[1::2]
+        n = np.cross(R[:, None, :, 2], np.cross(A2 - A1, C - A1))
+        sgn = np.where(np.einsum("nki,ki->nk", n, A2 - A1) >= 0, 1.0, -1.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = n * (sgn / np.linalg.norm(n, axis=-1))[..., None]
+        half = 0.5 * self.upper_link
+        end = np.stack([C - half * t, C + half * t], axis=2).reshape(-1, 6, 3)
+        return np.broadcast_to(self.base_points, end.shape).copy(), end
+
     # ---- ψ parametrisation ---------------------------------------------------------------
     def chain1_frame(self) -> np.ndarray:
         """Columns: x ∥ A11→A12, y = ẑ × x (normalised), z = x × y. Identity for the paper."""

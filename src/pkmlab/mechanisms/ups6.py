@@ -11,8 +11,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
+from .._intervals import intersect_pair, union_merge
 from . import _kernels
 from .base import Mechanism, as_points, as_stroke, as_vector3
 from .layout import build_paired
@@ -36,6 +37,97 @@ def _ups_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, q
         st[k, i] = s
         worst = max(worst, s)
     return worst
+
+
+# ---- column kernels for the workspace engine ------------------------------------------------
+# Along a vertical column q_i² = d_i² + (z + w_iz)² with w_i = R·u_i - b_i and d_i the
+# horizontal leg length, so qmin <= q_i <= qmax is |z + w_iz| in [sqrt(qmin² - d²), sqrt(qmax² -
+# d²)]: two z intervals mirrored about the base joint's height (one when d >= qmin).
+
+
+@njit(inline="always")
+def _leg_pieces(x, y, wx, wy, wz, qmin2, qmax2):
+    sx = x + wx
+    sy = y + wy
+    d2 = sx * sx + sy * sy
+    A = qmax2 - d2
+    if A < 0.0:
+        return np.inf, -np.inf, np.inf, -np.inf
+    ro = math.sqrt(A)
+    B = qmin2 - d2
+    if B <= 0.0:
+        return -wz - ro, -wz + ro, np.inf, -np.inf
+    ri = math.sqrt(B)
+    return -wz - ro, -wz - ri, -wz + ri, -wz + ro
+
+
+@njit(parallel=True, cache=True)
+def _points_all(px, py, W, qmin, qmax, out_lo, out_hi, count):
+    """Exact intersection (all sign patterns) for the columns at ``(px[k], py[k])``."""
+    M, K = W.shape[0], out_lo.shape[1]
+    qmin2, qmax2 = qmin * qmin, qmax * qmax
+    for c in prange(px.shape[0]):
+        s_lo, s_hi = np.empty(K), np.empty(K)
+        t_lo, t_hi = np.empty(K), np.empty(K)
+        n = 1
+        s_lo[0], s_hi[0] = -np.inf, np.inf
+        count[c] = 0
+        for m in range(M):
+            for i in range(6):
+                a1, b1, a2, b2 = _leg_pieces(px[c], py[c], W[m, i, 0], W[m, i, 1],
+                                             W[m, i, 2], qmin2, qmax2)
+                n = intersect_pair(s_lo, s_hi, n, a1, b1, a2, b2, t_lo, t_hi, K)
+                if n > K:
+                    n = K
+                    count[c] = K + 1
+                for k in range(n):
+                    s_lo[k], s_hi[k] = t_lo[k], t_hi[k]
+                if n == 0:
+                    break
+            if n == 0:
+                break
+        if count[c] <= K:
+            count[c] = n
+        for k in range(K):
+            out_lo[c, k] = s_lo[k] if k < n else np.inf
+            out_hi[c, k] = s_hi[k] if k < n else -np.inf
+
+
+@njit(parallel=True, cache=True)
+def _columns_any(xs, ys, W, qmin, qmax, allowed, out_lo, out_hi, count):
+    nx, ny, M, K = xs.shape[0], ys.shape[0], W.shape[0], out_lo.shape[2]
+    qmin2, qmax2 = qmin * qmin, qmax * qmax
+    for ix in prange(nx):
+        s_lo, s_hi = np.empty(K), np.empty(K)
+        t_lo, t_hi = np.empty(K), np.empty(K)
+        b_lo, b_hi = np.empty(M * K), np.empty(M * K)
+        for iy in range(ny):
+            nb = 0
+            over = False
+            for m in range(M):
+                if not allowed[ix, iy, m]:
+                    continue
+                n = 1
+                s_lo[0], s_hi[0] = -np.inf, np.inf
+                for i in range(6):
+                    a1, b1, a2, b2 = _leg_pieces(xs[ix], ys[iy], W[m, i, 0], W[m, i, 1],
+                                                 W[m, i, 2], qmin2, qmax2)
+                    n = intersect_pair(s_lo, s_hi, n, a1, b1, a2, b2, t_lo, t_hi, K)
+                    if n > K:
+                        n = K
+                        over = True
+                    for k in range(n):
+                        s_lo[k], s_hi[k] = t_lo[k], t_hi[k]
+                    if n == 0:
+                        break
+                for k in range(n):
+                    b_lo[nb], b_hi[nb] = s_lo[k], s_hi[k]
+                    nb += 1
+            for k in range(K):
+                out_lo[ix, iy, k] = np.inf
+                out_hi[ix, iy, k] = -np.inf
+            c = union_merge(b_lo, b_hi, nb, out_lo[ix, iy], out_hi[ix, iy], K)
+            count[ix, iy] = K + 1 if over else c
 
 
 @dataclass(frozen=True)
@@ -110,3 +202,39 @@ class UPS6(Mechanism):
     def _closure(self, p, R, q):
         r, n, length = self._legs(p, R)
         return length - q, np.concatenate([n, np.cross(r, n)], axis=-1)
+
+    # ---- workspace hooks -------------------------------------------------------------------
+    column_method = "quadratic"
+
+    def _leg_offsets(self, R: np.ndarray) -> np.ndarray:
+        return np.ascontiguousarray(np.einsum("mij,kj->mki", R, self._tool_points())
+                                    - self.base_points)
+
+    def _columns(self, xs, ys, R, mode, allowed=None, K=8):
+        W = self._leg_offsets(R)
+        nx, ny = len(xs), len(ys)
+        lo = np.empty((nx, ny, K))
+        hi = np.empty((nx, ny, K))
+        count = np.zeros((nx, ny), dtype=np.int64)
+        if mode == "all":
+            if allowed is not None:
+                raise ValueError("mode 'all' takes no orientation mask; mask the columns")
+            X, Y = np.meshgrid(xs, ys, indexing="ij")
+            flat_lo, flat_hi = lo.reshape(-1, K), hi.reshape(-1, K)
+            _points_all(X.ravel(), Y.ravel(), W, *self.stroke, flat_lo, flat_hi,
+                        count.reshape(-1))
+        else:
+            if allowed is None:
+                allowed = np.ones((nx, ny, len(R)), dtype=np.bool_)
+            _columns_any(xs, ys, W, *self.stroke, allowed, lo, hi, count)
+        return lo, hi, int(np.sum(count > K))
+
+    def _position_bounds(self, R):
+        W = self._leg_offsets(R)
+        qmax = self.stroke[1]
+        return np.stack([(-W - qmax).max(axis=1), (-W + qmax).min(axis=1)], axis=1)
+
+    def leg_segments(self, p, R):
+        """Leg end points ``(N, 6, 3)`` each: base U joint → platform S joint."""
+        W = p[:, None, :] + np.einsum("nij,kj->nki", R, self._tool_points())
+        return np.broadcast_to(self.base_points, W.shape).copy(), W

@@ -1,0 +1,292 @@
+"""The workspace engine: exact column intervals where the kinematics allow, sampling elsewhere.
+
+Positions lie on a grid anchored at the origin with spacing ``h`` (``x = i·h``), so results
+of different runs and geometries share voxels. For families with column kernels
+(``Mechanism.column_method``) every (x, y) column gets its exact stroke-feasible z set as a
+few intervals; the volume is then integrated exactly in z and only the x-y footprint is
+discretised. Other families (and constraints that depend on z along a column) are sampled on
+the voxel grid. The voxel grid and a signed field (positive inside, zero on the boundary) are
+kept for display: slices, meshes.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+
+import numpy as np
+from scipy import ndimage
+
+from .._intervals import label_pieces
+from ..errors import ParameterError
+from ..poses import as_frames, matrix_to_euler
+from .constraints import Constraints, check
+from .orientations import OrientationSet
+from .result import WorkspaceResult
+
+log = logging.getLogger(__name__)
+
+__all__ = ["workspace", "KINDS"]
+
+KINDS = ("constant", "reachable", "dexterous")
+_CHUNK = 200_000
+
+
+def workspace(mech, kind: str = "constant", orientations: OrientationSet | None = None,
+              resolution: float = 2.5, constraints: Constraints | None = None,
+              method: str = "auto") -> WorkspaceResult:
+    """Compute a workspace of ``mech``.
+
+    Args:
+        mech: a registered mechanism.
+        kind: ``"constant"`` (one orientation), ``"reachable"`` (at least one orientation of
+            the set) or ``"dexterous"`` (every orientation of the set).
+        orientations: the orientation set, relative to the nominal orientation; default the
+            nominal orientation itself.
+        resolution: grid spacing h in mm (x, y and the display voxels in z).
+        constraints: which constraints apply (default: stroke, connected to nominal).
+        method: ``"auto"`` (exact columns where available), ``"columns"`` or ``"sampled"``.
+
+    Returns:
+        :class:`WorkspaceResult`; an empty workspace is a valid result (``result.empty``).
+    """
+    t0 = time.perf_counter()
+    if kind not in KINDS:
+        raise ParameterError("kind", f"one of {list(KINDS)}", kind)
+    if not (isinstance(resolution, int | float) and math.isfinite(resolution)
+            and 0.05 <= resolution <= 100):
+        raise ParameterError("resolution", "a grid spacing in [0.05, 100] mm", resolution)
+    if method not in ("auto", "columns", "sampled"):
+        raise ParameterError("method", "one of ['auto', 'columns', 'sampled']", method)
+    cons = constraints or Constraints()
+    oset = orientations or OrientationSet.fixed()
+    if kind == "constant" and oset.kind != "fixed":
+        raise ParameterError("orientations", "a single fixed orientation for kind 'constant'",
+                             oset.kind)
+    _, Rn = as_frames(mech.nominal_pose)
+    oset = oset.centred(tuple(matrix_to_euler(Rn[0])))
+    R = oset.rotations()
+    mode = "any" if kind == "reachable" else "all"
+    h = float(resolution)
+    use_columns = mech.column_method is not None and method != "sampled"
+    if method == "columns" and mech.column_method is None:
+        raise ParameterError("method", f"'auto' or 'sampled' for family {mech.family!r} "
+                             "(it has no column kernel)", method)
+
+    xs, ys, zb = _grid_xy(mech, R, mode, h)
+    timings = {}
+    notes: list[str] = []
+    lo = hi = field = None
+    p_nom = mech.nominal_pose[:3]
+    if use_columns and len(xs) and len(ys):
+        t = time.perf_counter()
+        lo, hi, overflow = mech._columns(xs, ys, R, mode)
+        timings["columns_s"] = time.perf_counter() - t
+        if cons.extra and mech.column_invariant:
+            t = time.perf_counter()
+            lo, hi, overflow = _column_extras(mech, xs, ys, R, mode, cons, lo, hi, overflow)
+            timings["column_constraints_s"] = time.perf_counter() - t
+        if overflow:
+            notes.append(f"{overflow} columns needed more interval pieces than stored; "
+                         "their sets are truncated")
+        zs = _z_axis(lo, hi, h)
+        if cons.extra and not mech.column_invariant:
+            t = time.perf_counter()
+            field = _voxel_extras(mech, xs, ys, zs, R, mode, cons,
+                                  interval_field(xs, ys, zs, lo, hi, h), h)
+            timings["voxel_constraints_s"] = time.perf_counter() - t
+            lo = hi = None
+    else:
+        t = time.perf_counter()
+        if use_columns:
+            zs = np.empty(0)
+        else:
+            zs = np.arange(math.ceil(zb[0] / h), math.floor(zb[1] / h) + 1) * h
+        field = _sampled_field(mech, xs, ys, zs, R, mode, cons, h)
+        timings["sampled_s"] = time.perf_counter() - t
+
+    if lo is not None:
+        n_comp, keep, nominal_inside = _piece_components(lo, hi, xs, ys, p_nom)
+        if cons.connected and n_comp > 1:
+            lo = np.where(keep, lo, np.inf)
+            hi = np.where(keep, hi, -np.inf)
+            zs = _z_axis(lo, hi, h)
+    else:
+        n_comp, keep, nominal_inside = _components(field >= 0, xs, ys, zs, p_nom, h)
+        if cons.connected and n_comp > 1:
+            field = np.where(keep, field, np.minimum(field, -h)).astype(np.float32)
+    if cons.connected and n_comp > 1:
+        notes.append(f"{n_comp} connected components; kept the one "
+                     f"{'containing' if nominal_inside else 'nearest to'} the nominal position")
+    if lo is not None:
+        method_used = f"columns ({mech.column_method}), exact in z"
+    elif use_columns:
+        method_used = "columns for the stroke, voxels for z-dependent constraints"
+    else:
+        method_used = "sampled voxels"
+    timings["total_s"] = time.perf_counter() - t0
+    return WorkspaceResult(
+        mechanism=mech, kind=kind, orientations=oset, constraints=cons, resolution=h,
+        xs=xs, ys=ys, zs=zs, lo=lo, hi=hi, voxel_field=field,
+        method=method_used, components=n_comp, nominal_inside=nominal_inside,
+        timings=timings, notes=notes)
+
+
+# ---------------------------------------------------------------------------------------------
+
+
+def _grid_xy(mech, R, mode, h):
+    b = mech._position_bounds(R)                           # (M, 2, 3)
+    if mode == "all":
+        lo, hi = b[:, 0].max(axis=0), b[:, 1].min(axis=0)
+    else:
+        lo, hi = b[:, 0].min(axis=0), b[:, 1].max(axis=0)
+    if np.any(lo > hi):
+        return np.empty(0), np.empty(0), (0.0, -1.0)
+    xs = np.arange(math.ceil(lo[0] / h), math.floor(hi[0] / h) + 1) * h
+    ys = np.arange(math.ceil(lo[1] / h), math.floor(hi[1] / h) + 1) * h
+    return xs, ys, (float(lo[2]), float(hi[2]))
+
+
+def _z_axis(lo, hi, h):
+    finite = np.isfinite(lo) & (lo <= hi)
+    if not np.any(finite):
+        return np.empty(0)
+    zmin, zmax = float(lo[finite].min()), float(hi[finite].max())
+    return np.arange(math.floor(zmin / h), math.ceil(zmax / h) + 1) * h
+
+
+def interval_field(xs, ys, zs, lo, hi, h):
+    """Signed z distance to the column sets, clipped to [-h, h] (positive inside)."""
+    f = np.full((len(xs), len(ys), len(zs)), -h, dtype=np.float32)
+    if f.size == 0:
+        return f
+    used = int(np.max(np.sum(lo <= hi, axis=-1), initial=0))
+    z = zs[None, None, :]
+    for k in range(used):
+        a = lo[..., k, None]
+        b = hi[..., k, None]
+        with np.errstate(invalid="ignore"):
+            piece = np.minimum(z - a, b - z)
+        piece = np.where(a <= b, piece, -np.inf)
+        np.maximum(f, np.clip(piece, -h, h), out=f)
+    return f
+
+
+def _column_extras(mech, xs, ys, R, mode, cons, lo, hi, overflow):
+    """Apply z-independent constraints to whole columns (per orientation)."""
+    alive = np.any(lo <= hi, axis=-1)
+    ix, iy = np.nonzero(alive)
+    if len(ix) == 0:
+        return lo, hi, overflow
+    z = np.where(lo[ix, iy, 0] <= hi[ix, iy, 0], lo[ix, iy, 0], 0.0)   # any z will do
+    p = np.stack([xs[ix], ys[iy], z], axis=1)
+    M = len(R)
+    if mode == "all":
+        ok = np.ones(len(ix), dtype=bool)
+        for m in range(M):
+            idx = np.nonzero(ok)[0]
+            if len(idx) == 0:
+                break
+            ok[idx] = check(mech, p[idx], np.broadcast_to(R[m], (len(idx), 3, 3)), cons)
+        lo, hi = lo.copy(), hi.copy()
+        lo[ix[~ok], iy[~ok]] = np.inf
+        hi[ix[~ok], iy[~ok]] = -np.inf
+        return lo, hi, overflow
+    allowed = np.zeros((len(xs), len(ys), M), dtype=np.bool_)
+    for m in range(M):
+        allowed[ix, iy, m] = check(mech, p, np.broadcast_to(R[m], (len(ix), 3, 3)), cons)
+    return mech._columns(xs, ys, R, "any", allowed)
+
+
+def _voxel_extras(mech, xs, ys, zs, R, mode, cons, field, h):
+    """Re-check occupied voxels with z-dependent constraints (families not column-invariant)."""
+    occ = field >= 0
+    idx = np.argwhere(occ)
+    if len(idx) == 0:
+        return field
+    p = np.stack([xs[idx[:, 0]], ys[idx[:, 1]], zs[idx[:, 2]]], axis=1)
+    lo_q, hi_q = mech.stroke
+    if mode == "all":      # stroke already holds for every orientation inside the sets
+        ok = np.ones(len(p), dtype=bool)
+        for m in range(len(R)):
+            live = np.nonzero(ok)[0]
+            ok[live] = check(mech, p[live], np.broadcast_to(R[m], (len(live), 3, 3)), cons)
+    else:
+        ok = np.zeros(len(p), dtype=bool)
+        for m in range(len(R)):
+            todo = np.nonzero(~ok)[0]
+            if len(todo) == 0:
+                break
+            Rm = np.broadcast_to(R[m], (len(todo), 3, 3))
+            ik = mech._run_ik(p[todo], np.ascontiguousarray(Rm), lo_q, hi_q)
+            sel = todo[ik.valid]
+            ok[sel] = check(mech, p[sel], np.broadcast_to(R[m], (len(sel), 3, 3)), cons)
+    out = field.copy()
+    bad = idx[~ok]
+    out[bad[:, 0], bad[:, 1], bad[:, 2]] = -h
+    return out
+
+
+def _sampled_field(mech, xs, ys, zs, R, mode, cons, h):
+    """Actuator-stroke margin (mm) over the voxel grid, min (all) or max (any) over R."""
+    shape = (len(xs), len(ys), len(zs))
+    if 0 in shape:
+        return np.full(shape, -h, dtype=np.float32)
+    X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
+    p = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)
+    lo_q, hi_q = mech.stroke
+    f = np.full(len(p), np.inf if mode == "all" else -np.inf)
+    live = np.arange(len(p))
+    for m in range(len(R)):
+        if mode == "all":
+            live = live[f[live] >= 0]
+            if len(live) == 0:
+                break
+        margin = np.empty(len(live))
+        for s in range(0, len(live), _CHUNK):
+            sl = live[s:s + _CHUNK]
+            Rm = np.ascontiguousarray(np.broadcast_to(R[m], (len(sl), 3, 3)))
+            ik = mech._ik_frames_raw(p[sl], Rm)
+            with np.errstate(invalid="ignore"):
+                mg = np.min(np.minimum(ik.q - lo_q, hi_q - ik.q), axis=1)
+            mg = np.where(np.isnan(mg), -np.inf, mg)
+            if cons.extra:
+                good = np.nonzero(mg >= 0)[0]
+                okx = check(mech, p[sl[good]], Rm[good], cons)
+                mg[good[~okx]] = -h
+            margin[s:s + len(sl)] = mg
+        f[live] = np.minimum(f[live], margin) if mode == "all" else np.maximum(f[live], margin)
+    return np.clip(f, -h, h).reshape(shape).astype(np.float32)
+
+
+def _piece_components(lo, hi, xs, ys, p_nom):
+    """Components of column pieces; keep mask ``(nx, ny, K)`` of the nominal one."""
+    labels, n = label_pieces(lo, hi)
+    if n == 0:
+        return 0, labels >= 0, False
+    ix, iy, k = np.nonzero(labels >= 0)
+    a, b = lo[ix, iy, k], hi[ix, iy, k]
+    dz = np.maximum(np.maximum(a - p_nom[2], p_nom[2] - b), 0.0)
+    d = np.hypot(np.hypot(xs[ix] - p_nom[0], ys[iy] - p_nom[1]), dz)
+    j = int(np.argmin(d))
+    h = xs[1] - xs[0] if len(xs) > 1 else np.inf
+    inside = bool(d[j] <= 0.5 * h * math.sqrt(2))
+    return n, labels == labels[ix[j], iy[j], k[j]], inside
+
+
+def _components(occ, xs, ys, zs, p_nom, h):
+    """Label 26-connected components; pick the nominal one (or the one nearest to it)."""
+    if not occ.any():
+        return 0, occ, False
+    labels, n = ndimage.label(occ, structure=np.ones((3, 3, 3), dtype=bool))
+    ijk = np.round((np.asarray(p_nom) - [xs[0], ys[0], zs[0]]) / h).astype(int)
+    inside = bool(np.all(ijk >= 0) and np.all(ijk < occ.shape) and occ[tuple(ijk)])
+    if inside:
+        lab = labels[tuple(ijk)]
+    else:
+        pts = np.argwhere(occ)
+        d = np.linalg.norm(pts - ijk, axis=1)
+        lab = labels[tuple(pts[np.argmin(d)])]
+    return n, labels == lab, inside
