@@ -1,8 +1,8 @@
 """Numba helpers for small sorted sets of disjoint closed intervals.
 
 A set is stored in two float arrays ``lo[:n], hi[:n]`` (sorted, disjoint, ``lo <= hi``) of
-capacity ``K``; the column workspace kernels keep one per (x, y) column. A function that
-would need more than ``K`` pieces returns ``K + 1`` (overflow) and leaves the first ``K``.
+capacity ``K``; the workspace engine keeps one per (x, y) column. A union that would need more
+than ``K`` pieces returns ``K + 1`` (overflow) and keeps the first ``K``.
 """
 
 from __future__ import annotations
@@ -10,34 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["intersect_pair", "union_merge", "label_pieces", "EMPTY_LO", "EMPTY_HI"]
-
-EMPTY_LO, EMPTY_HI = np.inf, -np.inf
-
-
-@njit(cache=True, inline="always")
-def intersect_pair(s_lo, s_hi, n, a1, b1, a2, b2, t_lo, t_hi, K):
-    """``t = s ∩ ([a1, b1] ∪ [a2, b2])`` with ``b1 < a2`` (either piece may be empty).
-
-    Returns the piece count written to ``t`` (``K + 1`` on overflow).
-    """
-    m = 0
-    for p in range(2):
-        a = a1 if p == 0 else a2
-        b = b1 if p == 0 else b2
-        if a > b:
-            continue
-        for j in range(n):
-            lo = s_lo[j] if s_lo[j] > a else a
-            hi = s_hi[j] if s_hi[j] < b else b
-            if lo <= hi:
-                if m == K:
-                    return K + 1
-                t_lo[m] = lo
-                t_hi[m] = hi
-                m += 1
-    return m
-
+__all__ = ["union_merge", "label_pieces"]
 
 @njit(cache=True)
 def union_merge(lo, hi, n, out_lo, out_hi, K):

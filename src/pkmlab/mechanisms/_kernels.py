@@ -15,10 +15,12 @@ from functools import cache
 import numpy as np
 from numba import njit, prange
 
-__all__ = ["make_drivers", "stroke_status"]
+__all__ = ["make_drivers", "make_column_kernels", "stroke_status"]
 
 # Leg status codes, ordered by severity: a pose's reason is its legs' maximum.
 OK, BELOW_STROKE, ABOVE_STROKE, DEGENERATE, NO_SOLUTION, INVALID_INPUT = 0, 1, 2, 3, 4, 5
+# A leg on the other side of its base joint than at the nominal pose (another assembly mode).
+OTHER_MODE = 6
 
 
 @njit(cache=True, inline="always")
@@ -78,3 +80,85 @@ def make_drivers(one):
                                 g, qmin, qmax, q_out, st_out, k)
 
     return drive_euler, drive_frames
+
+
+# ---- column kernels for the workspace engine --------------------------------------------------
+# A family with exact column intervals supplies ``leg(x, y, wx, wy, wz, p0, p1, p2) -> (a, b,
+# ok)``: the z interval [a, b] in which leg i (offset w = R·u_i - b_i, parameters p = P[i]) is
+# within its stroke on the column (x, y), ``ok = False`` where the leg cannot reach the column at
+# all. The drivers intersect these intervals over legs and orientations ("all") or unite the
+# per-orientation intersections ("any").
+
+
+@cache
+def make_column_kernels(leg):
+    """Parallel drivers ``(columns_all, columns_any)`` for the per-leg interval ``leg``."""
+    from .._intervals import union_merge
+
+    @njit(parallel=True)
+    def columns_all(xs, ys, W, P, out_lo, out_hi):
+        """Intersection over orientations ``W (M, 6, 3)`` and legs; rows vectorised along y.
+
+        Rows shrink from both ends as columns die, and stop when none is left.
+        """
+        nx, ny, M = xs.shape[0], ys.shape[0], W.shape[0]
+        for ix in prange(nx):
+            x = xs[ix]
+            lo = np.full(ny, -np.inf)
+            hi = np.full(ny, np.inf)
+            j0, j1 = 0, ny
+            for m in range(M):
+                for i in range(6):
+                    wx, wy, wz = W[m, i, 0], W[m, i, 1], W[m, i, 2]
+                    p0, p1, p2 = P[i, 0], P[i, 1], P[i, 2]
+                    for j in range(j0, j1):
+                        a, b, ok = leg(x, ys[j], wx, wy, wz, p0, p1, p2)
+                        lj = lo[j]
+                        hj = hi[j]
+                        lo[j] = (a if a > lj else lj) if ok else np.inf
+                        hi[j] = b if b < hj else hj
+                while j0 < j1 and lo[j0] > hi[j0]:
+                    j0 += 1
+                while j1 > j0 and lo[j1 - 1] > hi[j1 - 1]:
+                    j1 -= 1
+                if j0 == j1:
+                    break
+            for j in range(ny):
+                if j0 <= j < j1 and lo[j] <= hi[j]:
+                    out_lo[ix, j, 0] = lo[j]
+                    out_hi[ix, j, 0] = hi[j]
+                else:
+                    out_lo[ix, j, 0] = np.inf
+                    out_hi[ix, j, 0] = -np.inf
+
+    @njit(parallel=True)
+    def columns_any(xs, ys, W, P, allowed, out_lo, out_hi, count):
+        """Union over the orientations that ``allowed (nx, ny, M)`` permits."""
+        nx, ny, M, K = xs.shape[0], ys.shape[0], W.shape[0], out_lo.shape[2]
+        for ix in prange(nx):
+            blo = np.empty(M)
+            bhi = np.empty(M)
+            for iy in range(ny):
+                n = 0
+                for m in range(M):
+                    if not allowed[ix, iy, m]:
+                        continue
+                    lo, hi = -np.inf, np.inf
+                    for i in range(6):
+                        a, b, ok = leg(xs[ix], ys[iy], W[m, i, 0], W[m, i, 1], W[m, i, 2],
+                                       P[i, 0], P[i, 1], P[i, 2])
+                        if not ok:
+                            lo, hi = np.inf, -np.inf
+                            break
+                        lo = max(lo, a)
+                        hi = min(hi, b)
+                    if lo <= hi:
+                        blo[n] = lo
+                        bhi[n] = hi
+                        n += 1
+                for k in range(K):
+                    out_lo[ix, iy, k] = np.inf
+                    out_hi[ix, iy, k] = -np.inf
+                count[ix, iy] = union_merge(blo, bhi, n, out_lo[ix, iy], out_hi[ix, iy], K)
+
+    return columns_all, columns_any

@@ -48,6 +48,7 @@ LEG_STATUS = {
     _kernels.DEGENERATE: "degenerate leg geometry",
     _kernels.NO_SOLUTION: "no real solution",
     _kernels.INVALID_INPUT: "non-finite pose",
+    _kernels.OTHER_MODE: "leg outside the working mode",
 }
 
 
@@ -189,15 +190,45 @@ class Mechanism:
     #: Jacobian) does not depend on z, so non-stroke constraints act on whole columns.
     column_invariant: ClassVar[bool] = False
 
-    def _columns(self, xs, ys, R, mode, allowed=None, K=8):  # pragma: no cover - optional
+    #: numba per-leg column interval ``leg(x, y, wx, wy, wz, p0, p1, p2) -> (a, b, ok)`` (see
+    #: :func:`._kernels.make_column_kernels`); families with it set ``column_method``.
+    _column_leg: ClassVar[Any] = None
+
+    def _column_params(self) -> np.ndarray:  # pragma: no cover - optional
+        """``(6, 3)`` per-leg parameters of ``_column_leg``."""
+        raise NotImplementedError
+
+    def _leg_offsets(self, R: np.ndarray) -> np.ndarray:
+        """``(M, 6, 3)`` offsets ``w_i = R·u_i - b_i`` (u_i platform joints about the tool)."""
+        return np.ascontiguousarray(self._tool_points() @ R.transpose(0, 2, 1)
+                                    - self.base_points)
+
+    def _columns(self, xs, ys, R, mode, allowed=None, K=8):
         """Stroke-feasible z sets of the columns ``xs × ys``: ``(lo, hi, overflow)``.
 
         ``lo, hi`` are ``(nx, ny, K)`` sorted disjoint intervals (empty slots ``inf, -inf``);
-        ``mode="all"`` intersects over the orientations ``R (M, 3, 3)``, ``"any"`` unites the
-        orientations that ``allowed (nx, ny, M)`` permits. ``overflow`` counts columns that
-        needed more than ``K`` pieces.
+        ``mode="all"`` intersects over the orientations ``R (M, 3, 3)`` (K = 1), ``"any"``
+        unites the orientations that ``allowed (nx, ny, M)`` permits. ``overflow`` counts
+        columns whose union needed more than ``K`` pieces.
         """
-        raise NotImplementedError
+        columns_all, columns_any = _kernels.make_column_kernels(type(self)._column_leg)
+        W = self._leg_offsets(R)
+        P = np.ascontiguousarray(self._column_params(), dtype=float)
+        nx, ny = len(xs), len(ys)
+        if mode == "all":
+            if allowed is not None:
+                raise ValueError("mode 'all' takes no orientation mask; mask the columns")
+            # Most tilted orientations first: dead columns then die after a few of them.
+            W = W[np.argsort(-np.linalg.norm(R - np.eye(3), axis=(1, 2)), kind="stable")]
+            lo, hi = np.empty((nx, ny, 1)), np.empty((nx, ny, 1))
+            columns_all(xs, ys, np.ascontiguousarray(W), P, lo, hi)
+            return lo, hi, 0
+        if allowed is None:
+            allowed = np.ones((nx, ny, len(R)), dtype=np.bool_)
+        lo, hi = np.empty((nx, ny, K)), np.empty((nx, ny, K))
+        count = np.empty((nx, ny), dtype=np.int64)
+        columns_any(xs, ys, W, P, allowed, lo, hi, count)
+        return lo, hi, int(np.sum(count > K))
 
     def _position_bounds(self, R: np.ndarray) -> np.ndarray:
         """``(M, 2, 3)`` per-orientation box [min; max] that contains every feasible position."""

@@ -19,9 +19,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
-from .._intervals import union_merge
 from ..errors import ParameterError
 from . import _kernels
 from .base import Mechanism, as_points, as_positive, as_stroke, as_vector3
@@ -51,84 +50,15 @@ def _psu_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, q
     return worst
 
 
-# ---- column kernels for the workspace engine ------------------------------------------------
-# Along a vertical column (fixed x, y and orientation) q_i = z + w_iz - sqrt(l_i² - |a_i,xy|²)
-# with w_i = R·u_i - b_i and a_i,xy = (x, y) + w_i,xy, so the stroke window is the z interval
-# [qmin - w_iz + h_i, qmax - w_iz + h_i] (h_i the square root), empty where h_i² < 0.
-
-
-@njit(parallel=True, cache=True)
-def _columns_all(xs, ys, W, L2, qmin, qmax, out_lo, out_hi):
-    """Intersection over orientations and legs; rows are vectorised along y."""
-    nx, ny, M = xs.shape[0], ys.shape[0], W.shape[0]
-    for ix in prange(nx):
-        x = xs[ix]
-        lo = np.full(ny, -np.inf)
-        hi = np.full(ny, np.inf)
-        j0, j1 = 0, ny
-        for m in range(M):
-            for i in range(6):
-                ax = x + W[m, i, 0]
-                r2 = L2[i] - ax * ax
-                wy = W[m, i, 1]
-                a0 = qmin - W[m, i, 2]
-                b0 = qmax - W[m, i, 2]
-                for j in range(j0, j1):
-                    ay = ys[j] + wy
-                    h2 = r2 - ay * ay
-                    s = math.sqrt(h2 if h2 > 0.0 else 0.0)
-                    a = a0 + s
-                    b = b0 + s
-                    lj = lo[j]
-                    hj = hi[j]
-                    lo[j] = np.inf if h2 < 0.0 else (a if a > lj else lj)
-                    hi[j] = b if b < hj else hj
-            while j0 < j1 and lo[j0] > hi[j0]:
-                j0 += 1
-            while j1 > j0 and lo[j1 - 1] > hi[j1 - 1]:
-                j1 -= 1
-            if j0 == j1:
-                break
-        for j in range(ny):
-            if j0 <= j < j1 and lo[j] <= hi[j]:
-                out_lo[ix, j, 0] = lo[j]
-                out_hi[ix, j, 0] = hi[j]
-            else:
-                out_lo[ix, j, 0] = np.inf
-                out_hi[ix, j, 0] = -np.inf
-
-
-@njit(parallel=True, cache=True)
-def _columns_any(xs, ys, W, L2, qmin, qmax, allowed, out_lo, out_hi, count):
-    """Union over the allowed orientations of each orientation's interval."""
-    nx, ny, M, K = xs.shape[0], ys.shape[0], W.shape[0], out_lo.shape[2]
-    for ix in prange(nx):
-        blo = np.empty(M)
-        bhi = np.empty(M)
-        for iy in range(ny):
-            n = 0
-            for m in range(M):
-                if not allowed[ix, iy, m]:
-                    continue
-                lo, hi = -np.inf, np.inf
-                for i in range(6):
-                    ax = xs[ix] + W[m, i, 0]
-                    ay = ys[iy] + W[m, i, 1]
-                    h2 = L2[i] - ax * ax - ay * ay
-                    if h2 < 0.0:
-                        lo = np.inf
-                        break
-                    s = math.sqrt(h2)
-                    lo = max(lo, qmin - W[m, i, 2] + s)
-                    hi = min(hi, qmax - W[m, i, 2] + s)
-                if lo <= hi:
-                    blo[n] = lo
-                    bhi[n] = hi
-                    n += 1
-            for k in range(K):
-                out_lo[ix, iy, k] = np.inf
-                out_hi[ix, iy, k] = -np.inf
-            count[ix, iy] = union_merge(blo, bhi, n, out_lo[ix, iy], out_hi[ix, iy], K)
+@njit(inline="always")
+def _psu_column_leg(x, y, wx, wy, wz, l2, qmin, qmax):
+    """Along a column q = z + w_z - sqrt(l² - |a_xy|²) with a_xy = (x, y) + w_xy: the stroke
+    window is the z interval [qmin - w_z + h, qmax - w_z + h], none where h² < 0."""
+    ax = x + wx
+    ay = y + wy
+    h2 = l2 - ax * ax - ay * ay
+    s = math.sqrt(h2 if h2 > 0.0 else 0.0)
+    return qmin - wz + s, qmax - wz + s, h2 >= 0.0
 
 
 @dataclass(frozen=True)
@@ -233,30 +163,11 @@ class PSU6(Mechanism):
     column_method = "linear"
     column_invariant = True   # link vectors, joint angles and J do not depend on z
 
-    def _leg_offsets(self, R: np.ndarray) -> np.ndarray:
-        """``(M, 6, 3)`` w_i = R·u_i - b_i for each orientation."""
-        return np.ascontiguousarray(np.einsum("mij,kj->mki", R, self._tool_points())
-                                    - self.base_points)
+    _column_leg = _psu_column_leg
 
-    def _columns(self, xs, ys, R, mode, allowed=None, K=8):
-        W = self._leg_offsets(R)
-        L2 = self.link_length**2
-        lo_q, hi_q = self.stroke
-        nx, ny = len(xs), len(ys)
-        if mode == "all" and allowed is None:
-            lo = np.empty((nx, ny, 1))
-            hi = np.empty((nx, ny, 1))
-            _columns_all(xs, ys, W, L2, lo_q, hi_q, lo, hi)
-            return lo, hi, 0
-        if mode == "all":
-            raise ValueError("mode 'all' takes no orientation mask; mask the columns instead")
-        if allowed is None:
-            allowed = np.ones((nx, ny, len(R)), dtype=np.bool_)
-        lo = np.empty((nx, ny, K))
-        hi = np.empty((nx, ny, K))
-        count = np.empty((nx, ny), dtype=np.int64)
-        _columns_any(xs, ys, W, L2, lo_q, hi_q, allowed, lo, hi, count)
-        return lo, hi, int(np.sum(count > K))
+    def _column_params(self) -> np.ndarray:
+        lo, hi = self.stroke
+        return np.stack([self.link_length**2, np.full(6, lo), np.full(6, hi)], axis=1)
 
     def _position_bounds(self, R):
         """Per orientation, the box each leg's reach and stroke allow: ``(M, 2, 3)``."""

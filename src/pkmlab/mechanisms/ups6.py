@@ -3,17 +3,22 @@
 Leg i joins the base joint ``B_i`` to the platform joint ``W_i = p + R·(P_i - O)``; the actuator
 value is the leg length ``q_i = |W_i - B_i|``. With ``n_i = (W_i - B_i)/q_i`` and
 ``r_i = R·(P_i - O)`` the velocity Jacobian row is ``J_i = [n_iᵀ, (r_i × n_i)ᵀ]``.
+
+Working mode: each platform joint stays on the side of its base joint's height that it has at
+the nominal pose (above it, for the usual upright platform); a leg on the other side is
+reported as ``leg outside the working mode`` by :meth:`~UPS6.inverse`.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
-from .._intervals import intersect_pair, union_merge
+from ..poses import euler_to_matrix
 from . import _kernels
 from .base import Mechanism, as_points, as_stroke, as_vector3
 from .layout import build_paired
@@ -33,101 +38,32 @@ def _ups_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, q
         sz = pz + r20 * ux + r21 * uy + r22 * uz - bz
         v = math.sqrt(sx * sx + sy * sy + sz * sz)
         q[k, i] = v
-        s = _kernels.DEGENERATE if v < 1e-12 else _kernels.stroke_status(v, qmin, qmax)
+        if v < 1e-12:
+            s = _kernels.DEGENERATE
+        elif sz * g[36 + i] <= 0.0:
+            s = _kernels.OTHER_MODE
+        else:
+            s = _kernels.stroke_status(v, qmin, qmax)
         st[k, i] = s
         worst = max(worst, s)
     return worst
 
 
-# ---- column kernels for the workspace engine ------------------------------------------------
-# Along a vertical column q_i² = d_i² + (z + w_iz)² with w_i = R·u_i - b_i and d_i the
-# horizontal leg length, so qmin <= q_i <= qmax is |z + w_iz| in [sqrt(qmin² - d²), sqrt(qmax² -
-# d²)]: two z intervals mirrored about the base joint's height (one when d >= qmin).
-
-
 @njit(inline="always")
-def _leg_pieces(x, y, wx, wy, wz, qmin2, qmax2):
+def _ups_column_leg(x, y, wx, wy, wz, side, qmin2, qmax2):
+    """Along a column q² = d² + (z + w_z)² (d the horizontal leg length): the stroke window
+    is |z + w_z| in [sqrt(qmin² - d²), sqrt(qmax² - d²)], two intervals mirrored about the
+    base joint's height; the working mode keeps the one on the nominal pose's side."""
     sx = x + wx
     sy = y + wy
     d2 = sx * sx + sy * sy
     A = qmax2 - d2
-    if A < 0.0:
-        return np.inf, -np.inf, np.inf, -np.inf
-    ro = math.sqrt(A)
     B = qmin2 - d2
-    if B <= 0.0:
-        return -wz - ro, -wz + ro, np.inf, -np.inf
-    ri = math.sqrt(B)
-    return -wz - ro, -wz - ri, -wz + ri, -wz + ro
-
-
-@njit(parallel=True, cache=True)
-def _points_all(px, py, W, qmin, qmax, out_lo, out_hi, count):
-    """Exact intersection (all sign patterns) for the columns at ``(px[k], py[k])``."""
-    M, K = W.shape[0], out_lo.shape[1]
-    qmin2, qmax2 = qmin * qmin, qmax * qmax
-    for c in prange(px.shape[0]):
-        s_lo, s_hi = np.empty(K), np.empty(K)
-        t_lo, t_hi = np.empty(K), np.empty(K)
-        n = 1
-        s_lo[0], s_hi[0] = -np.inf, np.inf
-        count[c] = 0
-        for m in range(M):
-            for i in range(6):
-                a1, b1, a2, b2 = _leg_pieces(px[c], py[c], W[m, i, 0], W[m, i, 1],
-                                             W[m, i, 2], qmin2, qmax2)
-                n = intersect_pair(s_lo, s_hi, n, a1, b1, a2, b2, t_lo, t_hi, K)
-                if n > K:
-                    n = K
-                    count[c] = K + 1
-                for k in range(n):
-                    s_lo[k], s_hi[k] = t_lo[k], t_hi[k]
-                if n == 0:
-                    break
-            if n == 0:
-                break
-        if count[c] <= K:
-            count[c] = n
-        for k in range(K):
-            out_lo[c, k] = s_lo[k] if k < n else np.inf
-            out_hi[c, k] = s_hi[k] if k < n else -np.inf
-
-
-@njit(parallel=True, cache=True)
-def _columns_any(xs, ys, W, qmin, qmax, allowed, out_lo, out_hi, count):
-    nx, ny, M, K = xs.shape[0], ys.shape[0], W.shape[0], out_lo.shape[2]
-    qmin2, qmax2 = qmin * qmin, qmax * qmax
-    for ix in prange(nx):
-        s_lo, s_hi = np.empty(K), np.empty(K)
-        t_lo, t_hi = np.empty(K), np.empty(K)
-        b_lo, b_hi = np.empty(M * K), np.empty(M * K)
-        for iy in range(ny):
-            nb = 0
-            over = False
-            for m in range(M):
-                if not allowed[ix, iy, m]:
-                    continue
-                n = 1
-                s_lo[0], s_hi[0] = -np.inf, np.inf
-                for i in range(6):
-                    a1, b1, a2, b2 = _leg_pieces(xs[ix], ys[iy], W[m, i, 0], W[m, i, 1],
-                                                 W[m, i, 2], qmin2, qmax2)
-                    n = intersect_pair(s_lo, s_hi, n, a1, b1, a2, b2, t_lo, t_hi, K)
-                    if n > K:
-                        n = K
-                        over = True
-                    for k in range(n):
-                        s_lo[k], s_hi[k] = t_lo[k], t_hi[k]
-                    if n == 0:
-                        break
-                for k in range(n):
-                    b_lo[nb], b_hi[nb] = s_lo[k], s_hi[k]
-                    nb += 1
-            for k in range(K):
-                out_lo[ix, iy, k] = np.inf
-                out_hi[ix, iy, k] = -np.inf
-            c = union_merge(b_lo, b_hi, nb, out_lo[ix, iy], out_hi[ix, iy], K)
-            count[ix, iy] = K + 1 if over else c
+    ro = math.sqrt(A if A > 0.0 else 0.0)
+    ri = math.sqrt(B if B > 0.0 else 0.0)
+    if side > 0.0:
+        return -wz + ri, -wz + ro, A >= 0.0
+    return -wz - ro, -wz - ri, A >= 0.0
 
 
 @dataclass(frozen=True)
@@ -185,7 +121,24 @@ class UPS6(Mechanism):
                      + np.max(np.linalg.norm(self.platform_points, axis=1)) + self.stroke[1])
 
     def _gparams(self) -> np.ndarray:
-        return np.concatenate([self.base_points.ravel(), self._tool_points().ravel()])
+        return np.concatenate([self.base_points.ravel(), self._tool_points().ravel(),
+                               self._sides])
+
+    @cached_property
+    def _sides(self) -> np.ndarray:
+        """``(6,)`` ±1: the side of its base joint (above/below) each platform joint keeps.
+
+        The working mode: a leg that passes its base joint's height swaps to the mirror
+        assembly mode (with a level platform, through a parallel singularity where all legs
+        are horizontal). Taken from ``nominal`` when given, else +1 (platform above the base,
+        which is also where the mid-stroke nominal pose is searched).
+        """
+        if self.nominal is None:
+            return np.ones(6)
+        pose = np.asarray(self.nominal, dtype=float)
+        R = euler_to_matrix(pose[3:])
+        sz = pose[2] + self._tool_points() @ R[2] - self.base_points[:, 2]
+        return np.where(sz < 0, -1.0, 1.0)
 
     def _legs(self, p, R):
         r = np.einsum("nij,kj->nki", R, self._tool_points())
@@ -206,28 +159,11 @@ class UPS6(Mechanism):
     # ---- workspace hooks -------------------------------------------------------------------
     column_method = "quadratic"
 
-    def _leg_offsets(self, R: np.ndarray) -> np.ndarray:
-        return np.ascontiguousarray(np.einsum("mij,kj->mki", R, self._tool_points())
-                                    - self.base_points)
+    _column_leg = _ups_column_leg
 
-    def _columns(self, xs, ys, R, mode, allowed=None, K=8):
-        W = self._leg_offsets(R)
-        nx, ny = len(xs), len(ys)
-        lo = np.empty((nx, ny, K))
-        hi = np.empty((nx, ny, K))
-        count = np.zeros((nx, ny), dtype=np.int64)
-        if mode == "all":
-            if allowed is not None:
-                raise ValueError("mode 'all' takes no orientation mask; mask the columns")
-            X, Y = np.meshgrid(xs, ys, indexing="ij")
-            flat_lo, flat_hi = lo.reshape(-1, K), hi.reshape(-1, K)
-            _points_all(X.ravel(), Y.ravel(), W, *self.stroke, flat_lo, flat_hi,
-                        count.reshape(-1))
-        else:
-            if allowed is None:
-                allowed = np.ones((nx, ny, len(R)), dtype=np.bool_)
-            _columns_any(xs, ys, W, *self.stroke, allowed, lo, hi, count)
-        return lo, hi, int(np.sum(count > K))
+    def _column_params(self) -> np.ndarray:
+        lo, hi = self.stroke
+        return np.stack([self._sides, np.full(6, lo * lo), np.full(6, hi * hi)], axis=1)
 
     def _position_bounds(self, R):
         W = self._leg_offsets(R)

@@ -251,7 +251,8 @@ def _sampled_field(mech, xs, ys, zs, R, mode, cons, h):
             ik = mech._ik_frames_raw(p[sl], Rm)
             with np.errstate(invalid="ignore"):
                 mg = np.min(np.minimum(ik.q - lo_q, hi_q - ik.q), axis=1)
-            mg = np.where(np.isnan(mg), -np.inf, mg)
+            # raw IK (no stroke): any other status is a geometric failure or another mode
+            mg = np.where(ik.valid & ~np.isnan(mg), mg, -np.inf)
             if cons.extra:
                 good = np.nonzero(mg >= 0)[0]
                 okx = check(mech, p[sl[good]], Rm[good], cons)

@@ -172,6 +172,37 @@ class WorkspaceResult:
             "notes": list(self.notes),
         }
 
+    def contains(self, points: np.ndarray) -> np.ndarray:
+        """``(N,)`` bool: whether points ``(N, 3)`` lie in the workspace as stored.
+
+        A point belongs to its nearest column (x-y) and, on the column method, is tested
+        exactly against that column's z intervals; on the voxel method, its nearest voxel.
+        """
+        P = np.asarray(points, dtype=float).reshape(-1, 3)
+        h = self.resolution
+        out = np.zeros(len(P), dtype=bool)
+        if len(self.xs) == 0 or len(self.ys) == 0:
+            return out
+        ix = np.round((P[:, 0] - self.xs[0]) / h).astype(int)
+        iy = np.round((P[:, 1] - self.ys[0]) / h).astype(int)
+        ok = (ix >= 0) & (ix < len(self.xs)) & (iy >= 0) & (iy < len(self.ys))
+        if self.lo is not None:
+            lo, hi = self.lo[ix[ok], iy[ok]], self.hi[ix[ok], iy[ok]]
+            z = P[ok, 2, None]
+            out[ok] = np.any((lo <= z) & (z <= hi), axis=1)
+            return out
+        if len(self.zs) == 0:
+            return out
+        iz = np.round((P[:, 2] - self.zs[0]) / h).astype(int)
+        ok &= (iz >= 0) & (iz < len(self.zs))
+        out[ok] = self.occupancy[ix[ok], iy[ok], iz[ok]]
+        return out
+
+    def voxel_centres(self) -> np.ndarray:
+        """``(V, 3)`` centres of the occupied voxels (mm)."""
+        idx = np.argwhere(self.occupancy)
+        return np.stack([self.xs[idx[:, 0]], self.ys[idx[:, 1]], self.zs[idx[:, 2]]], axis=1)
+
     # ---- slices ------------------------------------------------------------------------------
     def slice(self, z: float) -> np.ndarray:
         """``(nx, ny)`` bool: the horizontal section at height ``z`` (exact on columns)."""

@@ -1,0 +1,273 @@
+"""Workspace engine: exactness against sampling, analytic volumes, convergence, constraints."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from conftest import MECH_DIR as STUDIES
+from typer.testing import CliRunner
+
+from pkmlab import PSU6, UPS6, load_mechanism
+from pkmlab.cli import app
+from pkmlab.errors import ParameterError
+from pkmlab.workspace import Constraints, JointLimits, OrientationSet, workspace
+from pkmlab.workspace.constraints import segment_distances
+from pkmlab.workspace.orientations import rotations_from_parameters
+
+HOPKINS = STUDIES / "hopkins-williams-6psu.yaml"
+BOX15 = OrientationSet.box(np.radians([15.0, 15.0, 15.0]), samples=3)
+
+
+@pytest.fixture(scope="module")
+def hopkins():
+    return load_mechanism(HOPKINS)
+
+
+def random_psu(rng) -> PSU6:
+    return PSU6.from_circles(
+        base_radii=tuple(sorted(rng.uniform(90, 180, 2))),
+        platform_radii=tuple(sorted(rng.uniform(40, 90, 2))),
+        platform_rotation=rng.uniform(0.1, 1.0), base_pair_separation=rng.uniform(0, 0.4),
+        link_length=rng.uniform(200, 260), stroke=(0.0, rng.uniform(60, 140)),
+        tool_offset=(0.0, 0.0, rng.uniform(0, 50)))
+
+
+def random_ups(rng) -> UPS6:
+    return UPS6.from_circles(
+        base_radii=tuple(sorted(rng.uniform(120, 200, 2))),
+        platform_radii=tuple(sorted(rng.uniform(50, 100, 2))),
+        platform_rotation=rng.uniform(0.1, 1.0), base_pair_separation=rng.uniform(0, 0.4),
+        platform_pair_separation=rng.uniform(0, 0.4),
+        stroke=(rng.uniform(180, 230), rng.uniform(300, 360)))
+
+
+def _agree(col, sam):
+    """Column and sampled voxel grids equal except where the sampled margin is ~0."""
+    assert np.array_equal(col.xs, sam.xs) and np.array_equal(col.ys, sam.ys)
+    ref = np.stack([col.slice(z) for z in sam.zs], axis=-1)
+    diff = ref != sam.occupancy
+    assert np.all(np.abs(sam.field[diff]) < 1e-6), "mismatches away from the boundary"
+    return int(diff.sum()), int(ref.sum())
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize("kind", ["constant", "dexterous", "reachable"])
+def test_columns_match_sampling_on_random_geometries(seed, kind):
+    rng = np.random.default_rng(seed)
+    for mech in (random_psu(rng), random_ups(rng)):
+        oset = OrientationSet.fixed(rng.uniform(-0.2, 0.2, 3)) if kind == "constant" else \
+            OrientationSet.box(np.radians([10.0, 8.0, 12.0]), samples=2)
+        h = 6.0 if mech.family == "psu6" else 10.0
+        cons = Constraints(connected=False)
+        col = workspace(mech, kind, oset, h, cons)
+        sam = workspace(mech, kind, oset, h, cons, method="sampled")
+        assert col.lo is not None and sam.lo is None
+        diff, inside = _agree(col, sam)
+        assert inside > 0
+        assert diff <= max(2, inside // 1000)
+
+
+def test_parallel_leg_psu_volume_is_a_disc_times_the_stroke():
+    # b_i = u_i: every leg sees the same disc of radius l about the origin, and every column's
+    # interval has length qmax - qmin. V = π l² Δq.
+    ang = np.radians([0, 50, 120, 170, 240, 290])
+    U = np.stack([80 * np.cos(ang), 80 * np.sin(ang), np.zeros(6)], axis=1)
+    mech = PSU6(U, U, 100.0, (0.0, 40.0))
+    res = workspace(mech, "constant", None, 1.0)
+    exact = math.pi * 100.0**2 * 40.0
+    assert res.volume == pytest.approx(exact, rel=0.005)
+    assert abs(res.volume - exact) <= res.volume_error
+
+
+def test_parallel_leg_ups_volume_is_a_half_spherical_shell():
+    # b_i = u_i: |p| is every leg's length, so the stroke admits the shell qmin <= |p| <= qmax;
+    # the working mode (platform joints above their base joints) keeps its upper half.
+    ang = np.radians([0, 50, 120, 170, 240, 290])
+    U = np.stack([80 * np.cos(ang), 80 * np.sin(ang), np.zeros(6)], axis=1)
+    mech = UPS6(U, U, (60.0, 100.0))
+    res = workspace(mech, "constant", None, 2.0)
+    exact = 2 / 3 * math.pi * (100.0**3 - 60.0**3)
+    assert res.components == 1
+    assert res.volume == pytest.approx(exact, rel=0.005)
+    assert res.metrics()["z_range_mm"] == pytest.approx([0.0, 100.0], abs=1e-9)
+    # the mirror (hanging) working mode is the lower half
+    down = UPS6(U, U, (60.0, 100.0), nominal=[0, 0, -80.0, 0, 0, 0])
+    res = workspace(down, "constant", None, 2.0)
+    assert res.volume == pytest.approx(exact, rel=0.005)
+    assert res.metrics()["z_range_mm"] == pytest.approx([-100.0, 0.0], abs=1e-9)
+    assert down.inverse([0, 0, 80.0, 0, 0, 0]).reason_text[0] == "leg outside the working mode"
+
+
+def test_volume_converges_with_resolution(hopkins):
+    vols = [workspace(hopkins, "dexterous", BOX15, h) for h in (8.0, 4.0, 2.0, 1.0)]
+    v = np.array([r.volume for r in vols])
+    errs = np.abs(v[:-1] - v[-1])
+    assert errs[1] <= errs[0] and errs[2] <= errs[1] + 1e-9
+    for r in vols[:-1]:
+        assert abs(r.volume - v[-1]) <= r.volume_error
+    e = [r.volume_error for r in vols]
+    assert e[0] > e[1] > e[2] > e[3]
+
+
+def test_mesh_is_watertight_and_matches_volume(hopkins, tmp_path):
+    res = workspace(hopkins, "dexterous", BOX15, 2.5)
+    mesh = res.mesh()
+    assert mesh.is_watertight and mesh.is_volume
+    assert abs(mesh.volume - res.volume) <= res.volume_error
+    for suffix in (".stl", ".ply", ".glb"):
+        path = res.save_mesh(tmp_path / f"w{suffix}")
+        assert path.stat().st_size > 1000
+
+
+def test_dexterous_within_reachable_and_nested_sets(hopkins):
+    small = workspace(hopkins, "dexterous", OrientationSet.box(np.radians([5] * 3), samples=3),
+                      4.0)
+    big = workspace(hopkins, "dexterous", BOX15, 4.0)
+    reach = workspace(hopkins, "reachable", BOX15, 4.0)
+    single = workspace(hopkins, "dexterous", OrientationSet.box(
+        np.radians([15.0] * 3), "single-axis", samples=3), 4.0)
+    const = workspace(hopkins, "constant", None, 4.0)
+    assert big.volume < small.volume < const.volume < reach.volume
+    assert big.volume <= single.volume
+    # containment of points, not just volumes
+    assert np.all(small.contains(big.voxel_centres()))
+    assert np.all(reach.contains(const.voxel_centres()))
+
+
+def test_each_constraint_shrinks_the_workspace(hopkins):
+    base = workspace(hopkins, "constant", None, 4.0)
+    for cons in (Constraints(link_diameter=25.0),
+                 Constraints(joint_limits=JointLimits(base=math.radians(12),
+                                                      platform=math.radians(12))),
+                 Constraints(kappa_max=4.0)):
+        res = workspace(hopkins, "constant", None, 4.0, cons)
+        assert 0 < res.volume < base.volume
+        assert np.all(base.contains(res.voxel_centres()))
+    tiny = workspace(hopkins, "constant", None, 4.0, Constraints(link_diameter=1.0))
+    assert tiny.volume == pytest.approx(base.volume)
+
+
+def test_z_dependent_constraints_on_ups_are_applied_per_voxel():
+    mech = load_mechanism(STUDIES / "gough-stewart-6ups.yaml")
+    base = workspace(mech, "constant", None, 25.0)
+    res = workspace(mech, "constant", None, 25.0,
+                    Constraints(joint_limits=JointLimits(base=math.radians(20))))
+    assert "voxels" in res.method
+    assert 0 < res.volume < base.volume
+
+
+def test_only_the_component_nearest_the_nominal_pose_is_kept(hopkins):
+    # Reachable with two orientations only (θx = ±50°): separate regions, neither holding the
+    # nominal position.
+    oset = OrientationSet.box(np.radians([50.0, 0.0, 0.0]), samples=2)
+    every = workspace(hopkins, "reachable", oset, 4.0, Constraints(connected=False))
+    kept = workspace(hopkins, "reachable", oset, 4.0)
+    assert every.components >= 2 and kept.components == every.components
+    assert not kept.nominal_inside and "nearest" in kept.notes[-1]
+    assert 0 < kept.volume < every.volume
+    assert np.all(every.contains(kept.voxel_centres()))
+
+
+def test_sampled_family_luzi():
+    mech = load_mechanism(STUDIES / "luzi-3chain.yaml")
+    res = workspace(mech, "constant", None, 40.0)
+    assert res.method == "sampled voxels" and not res.empty and res.nominal_inside
+    ik = mech.inverse(np.column_stack([
+        np.stack(np.meshgrid(res.xs, res.ys, res.zs, indexing="ij"), -1).reshape(-1, 3),
+        np.tile(mech.nominal_pose[3:], (res.occupancy.size, 1))]))
+    inside = res.occupancy.ravel()
+    assert np.all(ik.valid[inside])
+
+
+def test_empty_workspace_is_a_valid_answer(hopkins):
+    res = workspace(hopkins, "dexterous", OrientationSet.box(np.radians([30.0] * 3), samples=3),
+                    5.0)
+    assert res.empty and res.volume == 0.0
+    assert res.metrics()["empty"] is True
+    with pytest.raises(ValueError):
+        res.mesh()
+
+
+def test_orientation_sets():
+    box = OrientationSet.box(np.radians([10, 20, 30]), samples=5)
+    assert box.rotations().shape == (125, 3, 3)
+    single = OrientationSet.box(np.radians([10, 20, 30]), "single-axis", samples=5)
+    P = single.parameters()
+    assert len(P) == 13 and np.all(np.sum(P != 0, axis=1) <= 1)
+    tt = OrientationSet.tilt_torsion(math.radians(25), math.radians(10), samples=5)
+    R = tt.rotations()
+    tilt = np.degrees(np.arccos(np.clip(R[:, 2, 2], -1, 1)))
+    assert tilt.max() == pytest.approx(25.0) and tilt.min() == pytest.approx(0.0, abs=1e-9)
+    # torsion: with φ = 0 the rotation is Ry(θ)Rz(σ); recover σ from the parameters' round trip
+    params = tt.parameters()
+    assert np.allclose(rotations_from_parameters(tt, params), R)
+    assert np.abs(params[:, 2]).max() == pytest.approx(math.radians(10))
+    with pytest.raises(ParameterError, match="orientations.tilt"):
+        OrientationSet.tilt_torsion(math.radians(120))
+
+
+def test_segment_distance_against_dense_sampling():
+    rng = np.random.default_rng(3)
+    start, end = rng.normal(size=(50, 6, 3)), rng.normal(size=(50, 6, 3))
+    d = segment_distances(start, end)
+    s = np.linspace(0, 1, 201)
+    i, j = np.triu_indices(6, 1)
+    A = start[:, i, None, :] + s[:, None] * (end - start)[:, i, None, :]
+    B = start[:, j, None, :] + s[:, None] * (end - start)[:, j, None, :]
+    brute = np.linalg.norm(A[:, :, :, None] - B[:, :, None, :], axis=-1).min(axis=(2, 3))
+    assert np.all(d <= brute + 1e-12) and np.allclose(d, brute, atol=2e-2)
+
+
+def test_bad_requests_raise(hopkins):
+    with pytest.raises(ParameterError, match="kind"):
+        workspace(hopkins, "everything")
+    with pytest.raises(ParameterError, match="resolution"):
+        workspace(hopkins, resolution=0.0)
+    with pytest.raises(ParameterError, match="orientations"):
+        workspace(hopkins, "constant", BOX15)
+    with pytest.raises(ParameterError, match="link_diameter"):
+        Constraints(link_diameter=-1.0)
+
+
+def test_cli_workspace_writes_outputs(tmp_path):
+    out = tmp_path / "ws"
+    r = CliRunner().invoke(app, ["workspace", str(HOPKINS), "--kind", "dexterous", "--box",
+                                 "10,10,10", "--samples", "3", "--resolution", "4",
+                                 "--out", str(out), "--json"])
+    assert r.exit_code == 0, r.output
+    data = json.loads(r.stdout)
+    assert data["volume_cm3"] > 0
+    assert {p.name for p in out.iterdir()} == {"workspace.npz", "workspace.json", "slices.png",
+                                               "workspace.stl"}
+    with np.load(out / "workspace.npz") as z:
+        assert z["occupancy"].any()
+        assert json.loads(str(z["metrics"]))["volume_mm3"] == pytest.approx(data["volume_mm3"])
+
+
+def test_cli_empty_workspace_exits_zero_without_mesh(tmp_path):
+    out = tmp_path / "ws"
+    r = CliRunner().invoke(app, ["workspace", str(HOPKINS), "--kind", "dexterous", "--box",
+                                 "30,30,30", "--samples", "3", "--resolution", "5",
+                                 "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "empty" in r.stdout
+    assert not (out / "workspace.stl").exists()
+
+
+@pytest.mark.parametrize("args, field", [
+    (["--kind", "dexterous"], "--box"),
+    (["--kind", "dexterous", "--box", "10,10"], "--box"),
+    (["--kind", "dexterous", "--box", "10,10,10 furlong"], "--box"),
+    (["--resolution", "0"], "--resolution"),
+    (["--kind", "sideways"], "--kind"),
+    (["--mesh", "obj"], "--mesh"),
+])
+def test_cli_bad_input_exits_2_and_writes_nothing(tmp_path, args, field):
+    out = tmp_path / "ws"
+    r = CliRunner().invoke(app, ["workspace", str(HOPKINS), *args, "--out", str(out)])
+    assert r.exit_code == 2
+    assert field in r.stderr
+    assert not out.exists()
