@@ -271,3 +271,48 @@ def test_cli_bad_input_exits_2_and_writes_nothing(tmp_path, args, field):
     assert r.exit_code == 2
     assert field in r.stderr
     assert not out.exists()
+
+
+def _independent_check(mech, oset, pts, need_all=True):
+    """Every point valid for every orientation (or one), by plain per-orientation IK."""
+    ok = np.full(len(pts), need_all)
+    for Rm in oset.rotations():
+        frames = np.zeros((len(pts), 4, 4))
+        frames[:, :3, :3] = Rm
+        frames[:, :3, 3] = pts
+        frames[:, 3, 3] = 1.0
+        v = mech.inverse(frames).valid
+        ok = ok & v if need_all else ok | v
+    return ok
+
+
+@pytest.mark.parametrize("name, kind, h", [("hopkins-williams-6psu", "dexterous", 2.5),
+                                           ("gough-stewart-6ups", "constant", 20.0)])
+def test_inscribed_box_and_cylinder_hold_on_a_fresh_sample(name, kind, h):
+    mech = load_mechanism(STUDIES / f"{name}.yaml")
+    res = workspace(mech, kind, BOX15 if kind == "dexterous" else None, h)
+    start = res.inscribed_box(optimise=False)
+    box = res.inscribed_box()
+    cyl = res.inscribed_cylinder()
+    assert box.volume >= start.volume and box.iterations >= 1
+    assert box.volume < res.volume and cyl.volume < res.volume
+    for shape in (box, cyl):
+        pts = shape.sample(4000, seed=123)          # not the seed used to verify
+        assert np.all(_independent_check(mech, res.orientations, pts))
+    # the box is not trivially small: at least a fifth of the workspace's bounding box edge
+    bb = np.diff(np.array(res.metrics()["bbox_mm"]), axis=0)[0]
+    assert np.all(box.size > 0.2 * bb)
+
+
+def test_inscribed_box_respects_extra_constraints(hopkins):
+    cons = Constraints(joint_limits=JointLimits(base=math.radians(12), platform=math.radians(12)))
+    res = workspace(hopkins, "constant", None, 4.0, cons)
+    box = res.inscribed_box(samples=3000)
+    pts = box.sample(2000, seed=7)
+    from pkmlab.poses import as_frames
+    from pkmlab.workspace.constraints import joint_angles
+
+    _, Rn = as_frames(hopkins.nominal_pose)
+    R = np.broadcast_to(Rn[0], (len(pts), 3, 3))
+    ab, ap = joint_angles(hopkins, pts, R, cons.joint_limits)
+    assert np.all(ab <= math.radians(12)) and np.all(ap <= math.radians(12))
