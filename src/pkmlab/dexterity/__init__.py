@@ -1,0 +1,68 @@
+"""Dexterity analysis: conditioning, manipulability, singularities, force capability, stiffness.
+
+Pure, batched NumPy functions on the velocity Jacobian of :meth:`pkmlab.Mechanism.jacobian`
+(``q̇ = J·[v; ω]``, ``v`` in mm/s at the tool point, ``ω`` in rad/s, base frame) and
+workspace-wide aggregates on a :class:`pkmlab.workspace.WorkspaceResult`. Units: mm, rad, N,
+N·mm. Numerical failure is reported through masks and status fields, never raised; invalid
+*arguments* raise :class:`pkmlab.ParameterError`.
+
+Modules: :mod:`.metrics` (pointwise Jacobian metrics, characteristic length),
+:mod:`.singularity`, :mod:`.force`, :mod:`.stiffness`, :mod:`.aggregate` (GCI, κ statistics,
+well-conditioned volume).
+"""
+
+from .aggregate import (
+    GCIResult,
+    KappaGrid,
+    KappaStatistics,
+    WellConditionedVolume,
+    gci_grid,
+    gci_monte_carlo,
+    kappa_grid,
+    kappa_statistics,
+    sample_orientations,
+    well_conditioned_volume,
+)
+from .force import (
+    ForceAlong,
+    force_along,
+    force_along_closed_form,
+    max_force_all_directions,
+    max_moment_all_directions,
+    transpose_inverse,
+)
+from .metrics import (
+    SINGULAR_RTOL,
+    CharacteristicLength,
+    characteristic_length,
+    condition_number,
+    default_length,
+    homogenised_jacobian,
+    jacobian_ok,
+    lci,
+    manipulability,
+    singular_values,
+    smallest_singular_value,
+)
+from .singularity import (
+    SingularityFlags,
+    as_pose_frames,
+    direct_kinematic_matrix,
+    link_vectors,
+    singularity_flags,
+)
+from .stiffness import Stiffness, stiffness
+
+__all__ = [
+    "SINGULAR_RTOL", "jacobian_ok", "homogenised_jacobian", "singular_values",
+    "condition_number", "lci", "smallest_singular_value", "manipulability",
+    "CharacteristicLength", "characteristic_length", "default_length",
+    "SingularityFlags", "singularity_flags", "direct_kinematic_matrix", "link_vectors",
+    "as_pose_frames",
+    "ForceAlong", "max_force_all_directions", "max_moment_all_directions", "force_along",
+    "force_along_closed_form", "transpose_inverse",
+    "Stiffness", "stiffness",
+    "GCIResult", "KappaGrid", "KappaStatistics", "WellConditionedVolume", "kappa_grid",
+    "gci_grid", "gci_monte_carlo", "sample_orientations", "kappa_statistics",
+    "well_conditioned_volume",
+]
