@@ -19,7 +19,7 @@ import numpy as np
 import pkmlab
 from pkmlab import dexterity as dx
 from pkmlab.dexterity.aggregate import sample_orientations
-from pkmlab.workspace import OrientationSet, workspace
+from pkmlab.workspaces import OrientationSet, workspace
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLES, RUNS = 2_000, 21

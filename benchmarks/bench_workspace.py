@@ -3,7 +3,7 @@
 Prints, in one run:
 
 * the time of the 6-PSU (Hopkins & Williams) ±15° simultaneous dexterous workspace at 2.5 mm
-  with 7×7×7 orientations, through the public ``pkmlab.workspace`` call (median of repeats);
+  with 7×7×7 orientations, through the public ``pkmlab.workspaces`` call (median of repeats);
 * the time of a plain NumPy brute force on the same candidate grid (every voxel × every
   orientation × every leg), the ratio, and whether the two voxel grids agree;
 * the time of the same request on two 6-UPS: one sized like the 6-PSU (radii 165/100 mm
@@ -26,8 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from pkmlab import UPS6, load_mechanism
-from pkmlab.workspace import Constraints, OrientationSet, workspace
-from pkmlab.workspace.engine import _grid_xy
+from pkmlab.workspaces import Constraints, OrientationSet, workspace
+from pkmlab.workspaces.engine import _grid_xy
 
 ROOT = Path(__file__).resolve().parents[1]
 BOX = OrientationSet.box(np.radians([15.0, 15.0, 15.0]), "simultaneous", samples=7)
@@ -97,7 +97,7 @@ def peak_memory_1mm() -> float:
     code = (
         "import resource, numpy as np\n"
         "from pkmlab import load_mechanism\n"
-        "from pkmlab.workspace import workspace, OrientationSet\n"
+        "from pkmlab.workspaces import workspace, OrientationSet\n"
         f"m = load_mechanism(r'{ROOT / 'studies/mechanisms/hopkins-williams-6psu.yaml'}')\n"
         "r = workspace(m, 'dexterous', OrientationSet.box(np.radians([15]*3)), 1.0)\n"
         "r.mesh()\n"

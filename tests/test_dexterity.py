@@ -16,7 +16,7 @@ from pkmlab import PSU6
 from pkmlab import dexterity as dx
 from pkmlab.mechanisms import LEG_STATUS
 from pkmlab.poses import as_frames, euler_to_matrix, exp_so3, frames_to_poses, matrix_to_euler
-from pkmlab.workspace import OrientationSet, workspace
+from pkmlab.workspaces import OrientationSet, workspace
 
 REASON = {v: k for k, v in LEG_STATUS.items()}
 PSU = pkmlab.load_mechanism(MECH_DIR / "hopkins-williams-6psu.yaml")

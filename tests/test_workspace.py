@@ -13,9 +13,9 @@ from typer.testing import CliRunner
 from pkmlab import PSU6, UPS6, load_mechanism
 from pkmlab.cli import app
 from pkmlab.errors import ParameterError
-from pkmlab.workspace import Constraints, JointLimits, OrientationSet, workspace
-from pkmlab.workspace.constraints import segment_distances
-from pkmlab.workspace.orientations import rotations_from_parameters
+from pkmlab.workspaces import Constraints, JointLimits, OrientationSet, workspace
+from pkmlab.workspaces.constraints import segment_distances
+from pkmlab.workspaces.orientations import rotations_from_parameters
 
 HOPKINS = STUDIES / "hopkins-williams-6psu.yaml"
 BOX15 = OrientationSet.box(np.radians([15.0, 15.0, 15.0]), samples=3)
@@ -310,7 +310,7 @@ def test_inscribed_box_respects_extra_constraints(hopkins):
     box = res.inscribed_box(samples=3000)
     pts = box.sample(2000, seed=7)
     from pkmlab.poses import as_frames
-    from pkmlab.workspace.constraints import joint_angles
+    from pkmlab.workspaces.constraints import joint_angles
 
     _, Rn = as_frames(hopkins.nominal_pose)
     R = np.broadcast_to(Rn[0], (len(pts), 3, 3))

@@ -340,7 +340,7 @@ def workspace(
     Writes workspace.npz, workspace.json, slices.png and workspace.stl into --out.
     """
     from .config import workspace_spec
-    from .workspace import workspace as compute
+    from .workspaces import workspace as compute
 
     mech = _load(mech_file)
     data: dict = {"kind": kind, "semantics": semantics, "samples": samples,

@@ -289,8 +289,8 @@ class WorkspaceSpec(_Model):
     slice_spacing: PositiveLength = Field(12.7, description="slice plot spacing (mm)")
 
     def build(self):
-        """→ ``dict(kind, orientations, resolution, constraints)`` for ``pkmlab.workspace``."""
-        from .workspace import Constraints, JointLimits, OrientationSet
+        """→ ``dict(kind, orientations, resolution, constraints)`` for :func:`pkmlab.workspace`."""
+        from .workspaces import Constraints, JointLimits, OrientationSet
 
         if self.box is not None and self.tilt is not None:
             raise ParameterError("box", "absent when tilt is given (choose one orientation "

@@ -2,7 +2,7 @@
 
 Pure, batched NumPy functions on the velocity Jacobian of :meth:`pkmlab.Mechanism.jacobian`
 (``q̇ = J·[v; ω]``, ``v`` in mm/s at the tool point, ``ω`` in rad/s, base frame) and
-workspace-wide aggregates on a :class:`pkmlab.workspace.WorkspaceResult`. Units: mm, rad, N,
+workspace-wide aggregates on a :class:`pkmlab.workspaces.WorkspaceResult`. Units: mm, rad, N,
 N·mm. Numerical failure is reported through masks and status fields, never raised; invalid
 *arguments* raise :class:`pkmlab.ParameterError`.
 

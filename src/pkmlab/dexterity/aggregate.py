@@ -1,6 +1,6 @@
 """Workspace-wide dexterity: global conditioning index, κ statistics, well-conditioned volume.
 
-All aggregates work on a :class:`pkmlab.workspace.WorkspaceResult`: its occupied voxels
+All aggregates work on a :class:`pkmlab.workspaces.WorkspaceResult`: its occupied voxels
 (centres ``(xs[i], ys[j], zs[k])``, edge ``h = result.resolution``) and its orientation set
 ``result.orientations`` (already centred on the mechanism's nominal orientation).
 
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..workspace.orientations import rotations_from_parameters
+from ..workspaces.orientations import rotations_from_parameters
 from .metrics import _as_length, condition_number, lci
 
 log = logging.getLogger(__name__)
@@ -96,7 +96,7 @@ def kappa_grid(mech, result, L: float | None = None) -> KappaGrid:
 
     Args:
         mech: the mechanism of ``result``.
-        result: a :class:`pkmlab.workspace.WorkspaceResult`.
+        result: a :class:`pkmlab.workspaces.WorkspaceResult`.
         L: characteristic length in mm; default Angeles' (:func:`characteristic_length`).
 
     Returns:
@@ -184,7 +184,7 @@ def gci_grid(mech, result, L: float | None = None) -> GCIResult:
 
     Args:
         mech: the mechanism of ``result``.
-        result: a :class:`pkmlab.workspace.WorkspaceResult`.
+        result: a :class:`pkmlab.workspaces.WorkspaceResult`.
         L: characteristic length in mm; default Angeles'.
 
     Returns:
@@ -241,7 +241,7 @@ def gci_monte_carlo(mech, result, L: float | None = None, samples: int = 2000,
 
     Args:
         mech: the mechanism of ``result``.
-        result: a :class:`pkmlab.workspace.WorkspaceResult`.
+        result: a :class:`pkmlab.workspaces.WorkspaceResult`.
         L: characteristic length in mm; default Angeles'.
         samples: number of poses drawn (≥ 1).
         seed: seed of ``numpy.random.default_rng``.
@@ -350,7 +350,7 @@ def well_conditioned_volume(mech, result, kappa_max: float,
 
     Args:
         mech: the mechanism of ``result``.
-        result: a :class:`pkmlab.workspace.WorkspaceResult`.
+        result: a :class:`pkmlab.workspaces.WorkspaceResult`.
         kappa_max: bound on κ (≥ 1).
         L: characteristic length in mm; default Angeles'.
     """
