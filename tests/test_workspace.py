@@ -159,16 +159,26 @@ def test_z_dependent_constraints_on_ups_are_applied_per_voxel():
     assert 0 < res.volume < base.volume
 
 
-def test_only_the_component_nearest_the_nominal_pose_is_kept(hopkins):
-    # Reachable with two orientations only (θx = ±50°): separate regions, neither holding the
-    # nominal position.
-    oset = OrientationSet.box(np.radians([50.0, 0.0, 0.0]), samples=2)
-    every = workspace(hopkins, "reachable", oset, 4.0, Constraints(connected=False))
-    kept = workspace(hopkins, "reachable", oset, 4.0)
-    assert every.components >= 2 and kept.components == every.components
-    assert not kept.nominal_inside and "nearest" in kept.notes[-1]
-    assert 0 < kept.volume < every.volume
-    assert np.all(every.contains(kept.voxel_centres()))
+def test_components_keep_the_nominal_one():
+    from pkmlab.workspaces.engine import _components, _piece_components
+
+    xs = ys = np.arange(10) * 2.0
+    lo = np.full((10, 10, 2), np.inf)
+    hi = np.full((10, 10, 2), -np.inf)
+    lo[:4, :4, 0], hi[:4, :4, 0] = 0.0, 10.0          # blob A
+    lo[6:, 6:, 0], hi[6:, 6:, 0] = 0.0, 10.0          # blob B, apart in x-y
+    lo[:4, :4, 1], hi[:4, :4, 1] = 30.0, 40.0         # blob C above A, apart in z
+    lo[4, 4, 0], hi[4, 4, 0] = 11.0, 12.0             # within h of A's top: joins A
+    n, keep, inside = _piece_components(lo, hi, xs, ys, np.array([14.0, 14.0, 5.0]))
+    assert n == 3 and inside
+    assert keep[7, 7, 0] and not keep[0, 0, 0] and not keep[0, 0, 1]
+    n, keep, inside = _piece_components(lo, hi, xs, ys, np.array([2.0, 2.0, 20.0]))
+    assert not inside and keep[0, 0, 0] and keep[4, 4, 0] and not keep[0, 0, 1]
+    occ = np.zeros((10, 10, 10), dtype=bool)
+    occ[:3, :3, :3] = True
+    occ[6:, 6:, 6:] = True
+    n, keep, inside = _components(occ, xs, ys, xs, np.array([14.0, 14.0, 14.0]), 2.0)
+    assert n == 2 and inside and keep[9, 9, 9] and not keep[0, 0, 0]
 
 
 def test_sampled_family_luzi():
@@ -316,3 +326,33 @@ def test_inscribed_box_respects_extra_constraints(hopkins):
     R = np.broadcast_to(Rn[0], (len(pts), 3, 3))
     ab, ap = joint_angles(hopkins, pts, R, cons.joint_limits)
     assert np.all(ab <= math.radians(12)) and np.all(ap <= math.radians(12))
+
+
+def test_refined_extremes_are_the_limit_of_finer_sampling(hopkins):
+    box = OrientationSet.box(np.radians([15.0] * 3), samples=3)
+    coarse = workspace(hopkins, "dexterous", box, 2.5)
+    refined = workspace(hopkins, "dexterous", box, 2.5, refine=True)
+    fine = workspace(hopkins, "dexterous", box.with_samples(17), 2.5)
+    # more orientations only remove positions; refinement goes further, but not past the limit
+    assert refined.volume < fine.volume < coarse.volume
+    assert fine.volume - refined.volume < 0.05 * (coarse.volume - refined.volume)
+    assert np.all(fine.contains(refined.voxel_centres()))
+    # corner-only sampling (2 per axis) misses the legs' extremes inside the box
+    corners = workspace(hopkins, "dexterous", box.with_samples(2), 2.5)
+    assert corners.volume > coarse.volume
+
+
+def test_paper_study_runs_and_reports_the_empty_30_degree_set(tmp_path):
+    r = CliRunner().invoke(app, ["workspaces", str(STUDIES.parent / "papers" /
+                                                  "hopkins-williams-2002.yaml"),
+                                 "--out", str(tmp_path), "--json"])
+    assert r.exit_code == 0, r.output
+    ws = json.loads(r.stdout)["workspaces"]
+    assert ws["fig8-dexterous-30-simultaneous"]["empty"]
+    assert ws["dexterous-30-single-axis"]["volume_cm3"] > 10
+    assert (ws["dexterous-20-simultaneous"]["volume_cm3"]
+            < ws["dexterous-30-single-axis"]["volume_cm3"]
+            < ws["constant-level"]["volume_cm3"] < ws["fig7-reachable"]["volume_cm3"])
+    assert (tmp_path / "hopkins-williams-2002" / "fig7-reachable" / "slices.png").exists()
+    assert not (tmp_path / "hopkins-williams-2002" / "fig8-dexterous-30-simultaneous" /
+                "workspace.stl").exists()

@@ -49,11 +49,12 @@ def _find(parent, a):
 
 
 @njit(cache=True)
-def label_pieces(lo, hi):
+def label_pieces(lo, hi, tol):
     """Connected components of column interval pieces ``(nx, ny, K)``.
 
     Two pieces are connected when their columns are 8-neighbours in x-y and their z
-    intervals overlap. Returns ``(labels, n)``: ``labels (nx, ny, K)`` in ``0..n-1`` and -1
+    intervals overlap or lie within ``tol`` of each other (a thin, steep region moves by more
+    than its own height from one column to the next). Returns ``(labels, n)``: ``labels (nx, ny, K)`` in ``0..n-1`` and -1
     for empty slots.
     """
     nx, ny, K = lo.shape
@@ -73,7 +74,7 @@ def label_pieces(lo, hi):
                         l2, h2 = lo[jx, jy, kk], hi[jx, jy, kk]
                         if not l2 <= h2:
                             continue
-                        if max(lo[ix, iy, k], l2) <= min(hi[ix, iy, k], h2):
+                        if max(lo[ix, iy, k], l2) <= min(hi[ix, iy, k], h2) + tol:
                             ra = _find(parent, a)
                             rb = _find(parent, (jx * ny + jy) * K + kk)
                             if ra != rb:

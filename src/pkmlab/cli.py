@@ -294,9 +294,26 @@ def _workspace_summary(res, written, as_json: bool, extra: dict | None = None) -
         c = m["centroid_mm"]
         out.print(f"  z range {z0:.2f} … {z1:.2f} mm, centroid ({c[0]:.2f}, {c[1]:.2f}, "
                   f"{c[2]:.2f}) mm, {m['components']} component(s)")
-        for key in ("inscribed_box", "inscribed_cylinder"):
-            if extra and extra.get(key):
-                out.print(f"  {key.replace('_', ' ')}: {escape(json.dumps(extra[key]))}")
+        box, cyl = (extra or {}).get("inscribed_box"), (extra or {}).get("inscribed_cylinder")
+        if box:
+            sx, sy, sz = box["size_mm"]
+            cx, cy, cz = box["centre_mm"]
+            out.print(f"  inscribed box {sx:.2f} × {sy:.2f} × {sz:.2f} mm centred at ({cx:.2f}, "
+                      f"{cy:.2f}, {cz:.2f}) mm: {box['volume_cm3']:.3f} cm³, "
+                      f"{box['verified_samples']} points verified")
+        if cyl:
+            cx, cy = cyl["centre_xy_mm"]
+            z0, z1 = cyl["z_range_mm"]
+            out.print(f"  inscribed vertical cylinder r = {cyl['radius_mm']:.2f} mm at ({cx:.2f}, "
+                      f"{cy:.2f}) mm, z {z0:.2f} … {z1:.2f} mm: {cyl['volume_cm3']:.3f} cm³, "
+                      f"{cyl['verified_samples']} points verified")
+    if extra and extra.get("orientation_convergence"):
+        out.print("  orientation sampling convergence (volume in cm³):")
+        for row in extra["orientation_convergence"]:
+            ref = row.get("refined_volume_mm3")
+            out.print(f"    n = {row['samples']:2d} ({row['orientations']:5d} orientations): "
+                      f"{row['volume_mm3'] / 1e3:.4f}"
+                      + (f"   refined {ref / 1e3:.4f}" if ref is not None else ""))
     for note in m["notes"]:
         out.print(f"  note: {escape(note)}")
     out.print(f"  orientations: {m['orientations']['count']}, grid {m['grid']}, "
@@ -328,6 +345,12 @@ def workspace(
         "--all-components", help="keep regions not connected to the nominal pose")] = False,
     inscribed: Annotated[bool, typer.Option(
         "--inscribed", help="also find the largest inscribed box and vertical cylinder")]
+    = False,
+    refine: Annotated[bool, typer.Option(
+        "--refine", help="dexterous: search each leg's extremes over the continuous set")]
+    = False,
+    convergence: Annotated[bool, typer.Option(
+        "--convergence", help="also report the volume for 3, 5, 7, 9, 13, 17 samples")]
     = False,
     mesh: Annotated[str, typer.Option(help="mesh formats, comma-separated: stl,ply,glb")]
     = "stl",
@@ -367,11 +390,15 @@ def workspace(
     try:
         spec = workspace_spec(data, prefix="--")
         req = spec.build()
-        res = compute(mech, **req)
+        res = compute(mech, **req, refine=refine)
         extra = {}
         if inscribed and not res.empty:
             extra = {"inscribed_box": res.inscribed_box().as_dict(),
                      "inscribed_cylinder": res.inscribed_cylinder().as_dict()}
+        if convergence and req["kind"] != "constant":
+            from .workspaces.engine import orientation_convergence
+
+            extra["orientation_convergence"] = orientation_convergence(mech, **req)
     except ParameterError as exc:
         _fail(exc)
     written = _write_workspace(res, out_dir, formats, spec.slice_window, spec.slice_spacing)
@@ -379,6 +406,51 @@ def workspace(
         (out_dir / "workspace.json").write_text(
             json.dumps({**res.metrics(), **extra}, indent=2) + "\n")
     _workspace_summary(res, written, as_json, extra)
+
+
+@app.command()
+def workspaces(
+    study_file: Annotated[Path, typer.Argument(help="Workspace study YAML file.")],
+    out_dir: Annotated[Path, typer.Option("--out", help="output folder")] = Path("results"),
+    refine: Annotated[bool, typer.Option(help="refine dexterous leg extremes")] = True,
+    as_json: JsonOpt = False,
+) -> None:
+    """Run every workspace request of a study file (e.g. studies/papers/*.yaml).
+
+    Each request writes its npz, json, slices.png and mesh into OUT/<study>/<name>/.
+    """
+    from .config import load_workspace_study
+    from .workspaces import workspace as compute
+
+    try:
+        spec, mech, requests = load_workspace_study(study_file)
+    except ParameterError as exc:
+        _fail(exc)
+    rows = {}
+    for name, req in requests.items():
+        res = compute(mech, **req, refine=refine and req["kind"] == "dexterous")
+        ws = spec.workspaces[name]
+        written = _write_workspace(res, out_dir / spec.study / name, ["stl"], ws.slice_window,
+                                   ws.slice_spacing)
+        m = res.metrics()
+        m["files"] = [str(p) for p in written]
+        rows[name] = m
+    if as_json:
+        _emit({"study": spec.study, "mechanism": mech.name, "workspaces": rows})
+        return
+    table = Table(title=f"{spec.study}: {mech.name}")
+    for col in ("workspace", "kind", "orientations", "volume cm³", "z range mm", "components"):
+        table.add_column(col)
+    for name, m in rows.items():
+        o = m["orientations"]
+        oset = o["kind"] if o["kind"] == "fixed" else (
+            f"±{o['half_ranges_deg'][0]:g}° {o['semantics']}" if o["kind"] == "box"
+            else f"tilt {o['tilt_deg']:g}°, torsion ±{o['torsion_deg']:g}°")
+        z = "—" if m["empty"] else f"{m['z_range_mm'][0]:.1f} … {m['z_range_mm'][1]:.1f}"
+        vol = "empty" if m["empty"] else f"{m['volume_cm3']:.2f} ± {m['volume_error_cm3']:.2f}"
+        table.add_row(name, m["kind"], oset, vol, z, str(m["components"]))
+    out.print(table)
+    out.print(f"outputs under {escape(str(out_dir / spec.study))}/<workspace>/")
 
 
 def main() -> None:

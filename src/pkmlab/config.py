@@ -19,7 +19,8 @@ from .errors import ParameterError, format_value
 from .mechanisms import PSU6, UPS6, Luzi3, Mechanism
 from .units import ANGLE_UNITS, LENGTH_UNITS, parse_angle, parse_length
 
-__all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec", "workspace_spec", "WorkspaceSpec"]
+__all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec", "workspace_spec", "WorkspaceSpec",
+           "load_workspace_study", "WorkspaceStudySpec"]
 
 
 class _Shown(str):
@@ -341,6 +342,56 @@ def workspace_spec(data: dict, prefix: str = "") -> WorkspaceSpec:
     return spec
 
 
+class MechanismRef(_Model):
+    file: str = Field(description="mechanism YAML, relative to the study file")
+
+
+class WorkspaceStudySpec(_Model):
+    """A named set of workspace requests on one mechanism (e.g. a paper's figures)."""
+
+    study: str = Field(description="study name (output sub-folder)")
+    description: str = ""
+    mechanism: MechanismRef
+    workspaces: dict[str, WorkspaceSpec] = Field(min_length=1)
+
+
+def _read_yaml(path: Path, what: str) -> Any:
+    if not path.is_file():
+        raise ParameterError("path", f"an existing {what} YAML file", str(path))
+    try:
+        return yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        raise ParameterError(str(path), "valid YAML", str(exc).splitlines()[0]) from None
+
+
+def load_workspace_study(source: str | Path):
+    """A workspace study file → ``(spec, mechanism, {name: request})``."""
+    path = Path(source)
+    data = _read_yaml(path, "workspace study")
+    if not isinstance(data, dict):
+        raise ParameterError("(study)", "a mapping with study, mechanism, workspaces",
+                             type(data).__name__)
+    try:
+        spec = WorkspaceStudySpec.model_validate(data)
+    except ValidationError as exc:
+        raise _translate(exc) from None
+    for name, ws in spec.workspaces.items():
+        try:
+            ws.build()
+        except ParameterError as exc:
+            raise ParameterError(f"workspaces.{name}.{exc.field}", exc.allowed, exc.got) \
+                from None
+    mech_path = (path.parent / spec.mechanism.file).resolve()
+    try:
+        mech = load_mechanism(mech_path)
+    except ParameterError as exc:
+        if exc.field == "path":
+            raise ParameterError("mechanism.file", exc.allowed, spec.mechanism.file) from None
+        raise ParameterError(f"mechanism ({spec.mechanism.file}): {exc.field}", exc.allowed,
+                             exc.got) from None
+    return spec, mech, {name: ws.build() for name, ws in spec.workspaces.items()}
+
+
 def mechanism_spec(data: dict, prefix: str = "") -> PSU6Spec | UPS6Spec | Luzi3Spec:
     """Validate a mechanism mapping into its typed spec (no geometry checks yet)."""
     if not isinstance(data, dict):
@@ -361,13 +412,7 @@ def load_mechanism(source: str | Path | dict) -> Mechanism:
     if isinstance(source, dict):
         data = source
     else:
-        path = Path(source)
-        if not path.is_file():
-            raise ParameterError("path", "an existing mechanism YAML file", str(path))
-        try:
-            data = yaml.safe_load(path.read_text())
-        except yaml.YAMLError as exc:
-            raise ParameterError(str(path), "valid YAML", str(exc).splitlines()[0]) from None
+        data = _read_yaml(Path(source), "mechanism")
     spec = mechanism_spec(data)
     try:
         return spec.build()

@@ -15,7 +15,7 @@ from functools import cache
 import numpy as np
 from numba import njit, prange
 
-__all__ = ["make_drivers", "make_column_kernels", "stroke_status"]
+__all__ = ["make_drivers", "make_column_kernels", "make_leg_eval", "stroke_status"]
 
 # Leg status codes, ordered by severity: a pose's reason is its legs' maximum.
 OK, BELOW_STROKE, ABOVE_STROKE, DEGENERATE, NO_SOLUTION, INVALID_INPUT = 0, 1, 2, 3, 4, 5
@@ -162,3 +162,24 @@ def make_column_kernels(leg):
                 count[ix, iy] = union_merge(blo, bhi, n, out_lo[ix, iy], out_hi[ix, iy], K)
 
     return columns_all, columns_any
+
+
+@cache
+def make_leg_eval(leg):
+    """Vectorised ``leg`` over items: ``(x, y, W (n, 3), P (n, 3)) -> (a, b, ok)``, each (n,)."""
+
+    @njit(parallel=True)
+    def leg_eval(x, y, W, P, a, b, ok):
+        for k in prange(x.shape[0]):
+            a[k], b[k], ok[k] = leg(x[k], y[k], W[k, 0], W[k, 1], W[k, 2],
+                                    P[k, 0], P[k, 1], P[k, 2])
+
+    def run(x, y, W, P):
+        n = len(x)
+        a, b, ok = np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
+        leg_eval(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float),
+                 np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(P, dtype=float),
+                 a, b, ok)
+        return a, b, ok
+
+    return run

@@ -23,11 +23,12 @@ from ..errors import ParameterError
 from ..poses import as_frames, matrix_to_euler
 from .constraints import Constraints, check
 from .orientations import OrientationSet
+from .refine import refine_columns
 from .result import WorkspaceResult
 
 log = logging.getLogger(__name__)
 
-__all__ = ["workspace", "KINDS"]
+__all__ = ["workspace", "orientation_convergence", "KINDS"]
 
 KINDS = ("constant", "reachable", "dexterous")
 _CHUNK = 200_000
@@ -35,7 +36,7 @@ _CHUNK = 200_000
 
 def workspace(mech, kind: str = "constant", orientations: OrientationSet | None = None,
               resolution: float = 2.5, constraints: Constraints | None = None,
-              method: str = "auto") -> WorkspaceResult:
+              method: str = "auto", refine: bool = False) -> WorkspaceResult:
     """Compute a workspace of ``mech``.
 
     Args:
@@ -47,6 +48,9 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
         resolution: grid spacing h in mm (x, y and the display voxels in z).
         constraints: which constraints apply (default: stroke, connected to nominal).
         method: ``"auto"`` (exact columns where available), ``"columns"`` or ``"sampled"``.
+        refine: dexterous workspaces on the column method: search each leg's extremes over
+            the continuous orientation set from the best samples
+            (:mod:`pkmlab.workspaces.refine`) instead of trusting the samples alone.
 
     Returns:
         :class:`WorkspaceResult`; an empty workspace is a valid result (``result.empty``).
@@ -83,6 +87,16 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
         t = time.perf_counter()
         lo, hi, overflow = mech._columns(xs, ys, R, mode)
         timings["columns_s"] = time.perf_counter() - t
+        if refine and mode == "all" and oset.kind != "fixed":
+            t = time.perf_counter()
+            before = _column_volume(lo, hi, h)
+            lo, hi, changed = refine_columns(mech, xs, ys, oset, lo, hi)
+            after = _column_volume(lo, hi, h)
+            timings["refine_s"] = time.perf_counter() - t
+            rel = 100 * (after - before) / max(before, 1e-300)
+            notes.append(f"leg extremes refined over the continuous orientation set: "
+                         f"{changed} columns shrank, volume {before / 1e3:.4f} -> "
+                         f"{after / 1e3:.4f} cm3 ({rel:+.3f} %)")
         if cons.extra and mech.column_invariant:
             t = time.perf_counter()
             lo, hi, overflow = _column_extras(mech, xs, ys, R, mode, cons, lo, hi, overflow)
@@ -134,6 +148,34 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
 
 
 # ---------------------------------------------------------------------------------------------
+
+
+def _column_volume(lo, hi, h) -> float:
+    with np.errstate(invalid="ignore"):
+        return float(np.sum(np.where(lo <= hi, hi - lo, 0.0)) * h * h)
+
+
+def orientation_convergence(mech, kind: str, orientations: OrientationSet,
+                            resolution: float = 2.5, constraints: Constraints | None = None,
+                            samples=(3, 5, 7, 9, 13, 17)) -> list[dict]:
+    """Volume against orientation sampling: one row per sample count, sampled and refined.
+
+    Each row: ``samples``, ``orientations`` (count), ``volume_mm3`` and, for dexterous
+    workspaces on the column method, ``refined_volume_mm3``. Dexterous volumes fall as the
+    sampling is refined (more orientations can only remove positions); the refined value is
+    the limit they approach.
+    """
+    rows = []
+    for n in samples:
+        o = orientations.with_samples(int(n))
+        r = workspace(mech, kind, o, resolution, constraints)
+        row = {"samples": int(n), "orientations": int(len(o.parameters())),
+               "volume_mm3": r.volume, "seconds": r.timings["total_s"]}
+        if kind == "dexterous" and mech.column_method is not None:
+            rr = workspace(mech, kind, o, resolution, constraints, refine=True)
+            row["refined_volume_mm3"] = rr.volume
+        rows.append(row)
+    return rows
 
 
 def _grid_xy(mech, R, mode, h):
@@ -264,7 +306,8 @@ def _sampled_field(mech, xs, ys, zs, R, mode, cons, h):
 
 def _piece_components(lo, hi, xs, ys, p_nom):
     """Components of column pieces; keep mask ``(nx, ny, K)`` of the nominal one."""
-    labels, n = label_pieces(lo, hi)
+    h = xs[1] - xs[0] if len(xs) > 1 else 1.0
+    labels, n = label_pieces(lo, hi, h)
     if n == 0:
         return 0, labels >= 0, False
     ix, iy, k = np.nonzero(labels >= 0)
@@ -272,7 +315,6 @@ def _piece_components(lo, hi, xs, ys, p_nom):
     dz = np.maximum(np.maximum(a - p_nom[2], p_nom[2] - b), 0.0)
     d = np.hypot(np.hypot(xs[ix] - p_nom[0], ys[iy] - p_nom[1]), dz)
     j = int(np.argmin(d))
-    h = xs[1] - xs[0] if len(xs) > 1 else np.inf
     inside = bool(d[j] <= 0.5 * h * math.sqrt(2))
     return n, labels == labels[ix[j], iy[j], k[j]], inside
 

@@ -59,8 +59,8 @@ def slice_figure(result, window: float = 152.4, spacing: float = 12.7, centre=No
     if im is not None:
         fig.colorbar(im, ax=axes, shrink=0.6, label=label)
     name = getattr(result.mechanism, "name", "") or result.mechanism.family
-    fig.suptitle(f"{name}: {result.kind} workspace, {window:g} × {window:g} mm slices "
-                 f"every {spacing:g} mm (lowest top-left)", fontsize=9)
+    fig.suptitle(f"{name}: {result.kind} workspace\n{window:g} × {window:g} mm top views "
+                 f"every {spacing:g} mm, lowest top-left", fontsize=9)
     return fig
 
 
