@@ -54,8 +54,8 @@ def label_pieces(lo, hi, tol):
 
     Two pieces are connected when their columns are 8-neighbours in x-y and their z
     intervals overlap or lie within ``tol`` of each other (a thin, steep region moves by more
-    than its own height from one column to the next). Returns ``(labels, n)``: ``labels (nx, ny, K)`` in ``0..n-1`` and -1
-    for empty slots.
+    than its own height from one column to the next). Returns ``(labels, n)``: ``labels
+    (nx, ny, K)`` in ``0..n-1`` and -1 for empty slots.
     """
     nx, ny, K = lo.shape
     parent = np.arange(nx * ny * K)
