@@ -121,7 +121,7 @@ def main() -> None:
         t, res = timed(lambda m=mech: workspace(m, "dexterous", BOX, H), reps)
         print(f"{name}, same request: {t * 1e3:.0f} ms (target <= 50 ms); volume "
               f"{res.volume / 1e3:.1f} cm3 on {len(res.xs)} x {len(res.ys)} columns "
-              "(brute force not run: the grid includes the mirror region below the base)")
+              f"(exactness: tests/test_workspace.py)")
     print(f"peak memory, 6-PSU case at 1 mm with mesh: {peak_memory_1mm():.0f} MB "
           "(target < 1024 MB)")
 

@@ -166,9 +166,14 @@ class UPS6(Mechanism):
         return np.stack([self._sides, np.full(6, lo * lo), np.full(6, hi * hi)], axis=1)
 
     def _position_bounds(self, R):
+        """Per orientation: each leg within qmax, on its working-mode side: ``(M, 2, 3)``."""
         W = self._leg_offsets(R)
         qmax = self.stroke[1]
-        return np.stack([(-W - qmax).max(axis=1), (-W + qmax).min(axis=1)], axis=1)
+        lo, hi = -W - qmax, -W + qmax
+        up = self._sides > 0
+        lo[:, up, 2] = -W[:, up, 2]              # z + w_z >= 0 above the base joint
+        hi[:, ~up, 2] = -W[:, ~up, 2]
+        return np.stack([lo.max(axis=1), hi.min(axis=1)], axis=1)
 
     def leg_segments(self, p, R):
         """Leg end points ``(N, 6, 3)`` each: base U joint → platform S joint."""
