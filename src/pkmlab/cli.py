@@ -322,27 +322,66 @@ def _workspace_summary(res, written, as_json: bool, extra: dict | None = None) -
         out.print(f"  wrote {escape(str(p))}")
 
 
+KindOpt = Annotated[str, typer.Option(help="constant | reachable | dexterous")]
+OrientationOpt = Annotated[str | None, typer.Option(
+    help='constant kind: "θx,θy,θz" relative to nominal (deg or with units)')]
+BoxOpt = Annotated[str | None, typer.Option(help='Euler half-ranges "a,b,c" (deg)')]
+SemanticsOpt = Annotated[str, typer.Option(help="simultaneous | single-axis")]
+TiltOpt = Annotated[str | None, typer.Option(help="tilt-and-torsion set: largest tilt")]
+TorsionOpt = Annotated[str, typer.Option(help="tilt-and-torsion set: torsion half-range")]
+SamplesOpt = Annotated[int, typer.Option(help="orientation samples per angle")]
+ResolutionOpt = Annotated[str, typer.Option(help="grid spacing (mm or with units)")]
+LinkDiameterOpt = Annotated[str | None, typer.Option(help="leg interference diameter")]
+JointLimitOpt = Annotated[str | None, typer.Option(
+    help='passive joint cone half-angles "base,platform" (deg)')]
+KappaMaxOpt = Annotated[float | None, typer.Option(help="largest condition number")]
+AllComponentsOpt = Annotated[bool, typer.Option(
+    "--all-components", help="keep regions not connected to the nominal pose")]
+
+
+def _request(kind, orientation, box, semantics, tilt, torsion, samples, resolution,
+             link_diameter, joint_limit, kappa_max, all_components):
+    """CLI workspace options → validated request (the config module does the validation)."""
+    from .config import workspace_spec
+
+    data: dict = {"kind": kind, "semantics": semantics, "samples": samples,
+                  "resolution": resolution, "torsion": torsion,
+                  "constraints": {"connected": not all_components}}
+    for key, text in (("orientation", orientation), ("box", box)):
+        vals = _csv_list(text, f"--{key}", 3)
+        if vals is not None:
+            data[key] = vals
+    if tilt is not None:
+        data["tilt"] = tilt
+    if link_diameter is not None:
+        data["constraints"]["link_diameter"] = link_diameter
+    if kappa_max is not None:
+        data["constraints"]["kappa_max"] = kappa_max
+    jl = _csv_list(joint_limit, "--joint-limit", 2)
+    if jl is not None:
+        data["constraints"]["joint_limits"] = {"base": jl[0], "platform": jl[1]}
+    try:
+        spec = workspace_spec(data, prefix="--")
+    except ParameterError as exc:
+        _fail(exc)
+    return spec, spec.build()
+
+
 @app.command()
 def workspace(
     mech_file: MechArg,
-    kind: Annotated[str, typer.Option(help="constant | reachable | dexterous")] = "constant",
-    orientation: Annotated[str | None, typer.Option(
-        help='constant kind: "θx,θy,θz" relative to nominal (deg or with units)')] = None,
-    box: Annotated[str | None, typer.Option(help='Euler half-ranges "a,b,c" (deg)')] = None,
-    semantics: Annotated[str, typer.Option(help="simultaneous | single-axis")]
-    = "simultaneous",
-    tilt: Annotated[str | None, typer.Option(help="tilt-and-torsion set: largest tilt")] = None,
-    torsion: Annotated[str, typer.Option(help="tilt-and-torsion set: torsion half-range")]
-    = "0",
-    samples: Annotated[int, typer.Option(help="orientation samples per angle")] = 7,
-    resolution: Annotated[str, typer.Option(help="grid spacing (mm or with units)")] = "2.5",
-    link_diameter: Annotated[str | None, typer.Option(help="leg interference diameter")]
-    = None,
-    joint_limit: Annotated[str | None, typer.Option(
-        help='passive joint cone half-angles "base,platform" (deg)')] = None,
-    kappa_max: Annotated[float | None, typer.Option(help="largest condition number")] = None,
-    all_components: Annotated[bool, typer.Option(
-        "--all-components", help="keep regions not connected to the nominal pose")] = False,
+    kind: KindOpt = "constant",
+    orientation: OrientationOpt = None,
+    box: BoxOpt = None,
+    semantics: SemanticsOpt = "simultaneous",
+    tilt: TiltOpt = None,
+    torsion: TorsionOpt = "0",
+    samples: SamplesOpt = 7,
+    resolution: ResolutionOpt = "2.5",
+    link_diameter: LinkDiameterOpt = None,
+    joint_limit: JointLimitOpt = None,
+    kappa_max: KappaMaxOpt = None,
+    all_components: AllComponentsOpt = False,
     inscribed: Annotated[bool, typer.Option(
         "--inscribed", help="also find the largest inscribed box and vertical cylinder")]
     = False,
@@ -362,34 +401,17 @@ def workspace(
 
     Writes workspace.npz, workspace.json, slices.png and workspace.stl into --out.
     """
-    from .config import workspace_spec
     from .workspaces import workspace as compute
 
     mech = _load(mech_file)
-    data: dict = {"kind": kind, "semantics": semantics, "samples": samples,
-                  "resolution": resolution, "torsion": torsion,
-                  "constraints": {"connected": not all_components}}
-    for key, text in (("orientation", orientation), ("box", box)):
-        vals = _csv_list(text, f"--{key}", 3)
-        if vals is not None:
-            data[key] = vals
-    if tilt is not None:
-        data["tilt"] = tilt
-    if link_diameter is not None:
-        data["constraints"]["link_diameter"] = link_diameter
-    if kappa_max is not None:
-        data["constraints"]["kappa_max"] = kappa_max
-    jl = _csv_list(joint_limit, "--joint-limit", 2)
-    if jl is not None:
-        data["constraints"]["joint_limits"] = {"base": jl[0], "platform": jl[1]}
+    spec, req = _request(kind, orientation, box, semantics, tilt, torsion, samples, resolution,
+                         link_diameter, joint_limit, kappa_max, all_components)
     formats = [f.strip().lower() for f in mesh.split(",") if f.strip()]
     bad = [f for f in formats if f not in ("stl", "ply", "glb")]
     if bad or not formats:
         _fail(ParameterError("--mesh", "comma-separated formats from ['stl', 'ply', 'glb']",
                              mesh))
     try:
-        spec = workspace_spec(data, prefix="--")
-        req = spec.build()
         res = compute(mech, **req, refine=refine)
         extra = {}
         if inscribed and not res.empty:
@@ -406,6 +428,260 @@ def workspace(
         (out_dir / "workspace.json").write_text(
             json.dumps({**res.metrics(), **extra}, indent=2) + "\n")
     _workspace_summary(res, written, as_json, extra)
+
+
+def _finite_or_none(v):
+    v = float(v)
+    return v if math.isfinite(v) else None
+
+
+@app.command()
+def dexterity(
+    mech_file: MechArg,
+    kind: KindOpt = "dexterous",
+    orientation: OrientationOpt = None,
+    box: BoxOpt = "15,15,15",
+    semantics: SemanticsOpt = "simultaneous",
+    tilt: TiltOpt = None,
+    torsion: TorsionOpt = "0",
+    samples: SamplesOpt = 7,
+    resolution: ResolutionOpt = "2.5",
+    link_diameter: LinkDiameterOpt = None,
+    joint_limit: JointLimitOpt = None,
+    kappa_max: KappaMaxOpt = None,
+    all_components: AllComponentsOpt = False,
+    metric: Annotated[str, typer.Option(help="map: kappa | lci | force | stiffness")]
+    = "kappa",
+    characteristic_length: Annotated[str, typer.Option(
+        help="L for κ: a length, or 'auto' (Angeles: the L minimising κ at nominal)")]
+    = "auto",
+    well_conditioned: Annotated[float, typer.Option(
+        help="κ bound of the well-conditioned sub-workspace")] = 10.0,
+    force_limit: Annotated[float, typer.Option(help="actuator force limit (N)")] = 150.0,
+    actuator_stiffness: Annotated[float, typer.Option(help="actuator stiffness (N/mm)")]
+    = 1.0e4,
+    gci_samples: Annotated[int, typer.Option(help="Monte-Carlo GCI samples")] = 2000,
+    seed: Annotated[int, typer.Option(help="Monte-Carlo seed")] = 0,
+    out_dir: Annotated[Path, typer.Option("--out", help="output folder")]
+    = Path("results/dexterity"),
+    as_json: JsonOpt = False,
+) -> None:
+    """Conditioning, force and stiffness at the nominal pose and over a workspace.
+
+    Writes dexterity.json, <metric>_slices.png and workspace_<metric>.ply/.glb (the workspace
+    mesh coloured by the metric's worst value over the orientation set) into --out.
+    """
+    import shutil
+    import tempfile
+
+    from . import dexterity as dx
+    from .dexterity.maps import METRICS, mesh_colours, metric_map
+    from .workspaces import workspace as compute
+    from .workspaces.plots import slice_figure
+
+    mech = _load(mech_file)
+    spec, req = _request(kind, orientation, box, semantics, tilt, torsion, samples, resolution,
+                         link_diameter, joint_limit, kappa_max, all_components)
+    if metric not in METRICS:
+        _fail(ParameterError("--metric", f"one of {list(METRICS)}", metric))
+    if characteristic_length.strip().lower() == "auto":
+        cl = dx.characteristic_length(mech)
+        L, L_source = cl.length, "Angeles (minimises κ at the nominal pose)"
+    else:
+        try:
+            L = parse_length(characteristic_length, "--characteristic-length")
+        except ParameterError as exc:
+            _fail(exc)
+        if not L > 0:
+            _fail(ParameterError("--characteristic-length", "a length > 0 mm or 'auto'",
+                                 characteristic_length))
+        L_source = "given"
+    for name, v, lo in (("--force-limit", force_limit, 0), ("--actuator-stiffness",
+                                                              actuator_stiffness, 0),
+                        ("--well-conditioned", well_conditioned, 1)):
+        if not (math.isfinite(v) and v > lo):
+            _fail(ParameterError(name, f"a number > {lo}", v))
+    if not 10 <= gci_samples <= 10_000_000:
+        _fail(ParameterError("--gci-samples", "an integer in [10, 10000000]", gci_samples))
+
+    # nominal pose
+    X = mech.nominal_pose
+    J = mech.jacobian(X)
+    flags = dx.singularity_flags(mech, X)
+    wt, wr = dx.manipulability(J)
+    st = dx.stiffness(J, actuator_stiffness)
+    nominal = {
+        "pose": _pose_json(X),
+        "characteristic_length_mm": L, "characteristic_length_source": L_source,
+        "kappa": _finite_or_none(dx.condition_number(J, L)[0]),
+        "lci": float(dx.lci(J, L)[0]),
+        "sigma_min": _finite_or_none(dx.smallest_singular_value(J, L)[0]),
+        "manipulability_translational": _finite_or_none(wt[0]),
+        "manipulability_rotational": _finite_or_none(wr[0]),
+        "singularity": str(flags.kind[0]),
+        "force_all_directions_N": _finite_or_none(dx.max_force_all_directions(J, force_limit)[0]),
+        "moment_all_directions_Nmm": _finite_or_none(
+            dx.max_moment_all_directions(J, force_limit)[0]),
+        "stiffness_translational_min_N_per_mm": _finite_or_none(st.translational_min[0]),
+        "stiffness_rotational_min_Nmm_per_rad": _finite_or_none(st.rotational_min[0]),
+    }
+    res = compute(mech, **req)
+    agg: dict = {"workspace_volume_cm3": res.volume / 1e3, "empty": res.empty}
+    mmap = None
+    if not res.empty:
+        g = dx.kappa_grid(mech, res, L)
+        ks = dx.kappa_statistics(g.kappa[g.valid])
+        grid_gci = dx.gci_grid(mech, res, L)
+        mc = dx.gci_monte_carlo(mech, res, L, samples=gci_samples, seed=seed)
+        wc = dx.well_conditioned_volume(mech, res, well_conditioned, L)
+        mmap = metric_map(mech, res, metric, L, force_limit, actuator_stiffness)
+        fmap = mmap if metric == "force" else metric_map(mech, res, "force", L, force_limit)
+        agg.update({
+            "gci_grid": grid_gci.gci, "gci_monte_carlo": mc.gci,
+            "gci_monte_carlo_std_error": mc.std_error, "gci_samples": mc.samples,
+            "gci_rejected": mc.rejected,
+            "kappa": {"min": ks.min, "mean": ks.mean, "p5": ks.p5, "p50": ks.p50,
+                      "p95": ks.p95, "max": _finite_or_none(ks.max)},
+            "well_conditioned_kappa_max": well_conditioned,
+            "well_conditioned_volume_cm3": wc.volume / 1e3,
+            "well_conditioned_fraction": wc.fraction,
+            "force_all_directions_N": {"min": float(fmap.values.min()),
+                                       "mean": float(fmap.values.mean())},
+        })
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    with tempfile.TemporaryDirectory(dir=out_dir, prefix=".partial-") as tmp:
+        tmp = Path(tmp)
+        report = {"mechanism": mech.name, "workspace": res.metrics(), "nominal": nominal,
+                  "aggregates": agg, "metric": metric}
+        files = [tmp / "dexterity.json"]
+        files[0].write_text(json.dumps(report, indent=2, default=float) + "\n")
+        if mmap is not None:
+            import matplotlib.pyplot as plt
+
+            vals = np.where(np.isfinite(mmap.grid), mmap.grid, np.nan)
+            fig = slice_figure(res, window=spec.slice_window, spacing=spec.slice_spacing,
+                               values=vals, label=mmap.label)
+            files.append(tmp / f"{metric}_slices.png")
+            fig.savefig(files[-1], dpi=120)
+            plt.close(fig)
+            m = res.mesh()
+            m.visual.vertex_colors = mesh_colours(m, mmap)
+            for fmt in ("ply", "glb"):
+                files.append(tmp / f"workspace_{metric}.{fmt}")
+                m.export(files[-1])
+        for f in files:
+            shutil.move(str(f), out_dir / f.name)
+            written.append(out_dir / f.name)
+    if as_json:
+        report["files"] = [str(p) for p in written]
+        _emit(report)
+        return
+    n = nominal
+    out.print(f"[bold]{escape(mech.name or mech.family)}[/] at the nominal pose "
+              f"{_pose_str(X)}:")
+    out.print(f"  κ = {n['kappa']:.4g} (L = {L:.2f} mm, {L_source}), LCI = {n['lci']:.4f}, "
+              f"σ_min = {n['sigma_min']:.4g}; singularity: {n['singularity']}")
+    out.print(f"  force in every direction {n['force_all_directions_N']:.1f} N, moment "
+              f"{n['moment_all_directions_Nmm'] / 1e3:.2f} N·m (actuators ±{force_limit:g} N); "
+              f"stiffness ≥ {n['stiffness_translational_min_N_per_mm']:.0f} N/mm")
+    if res.empty:
+        out.print("  workspace: [bold]empty[/] — no aggregates")
+    else:
+        k = agg["kappa"]
+        out.print(f"  over the {res.kind} workspace ({agg['workspace_volume_cm3']:.2f} cm³): "
+                  f"GCI {agg['gci_monte_carlo']:.4f} ± {agg['gci_monte_carlo_std_error']:.4f} "
+                  f"(Monte-Carlo, {agg['gci_samples']} samples), {agg['gci_grid']:.4f} (grid)")
+        out.print(f"  κ min {k['min']:.3g}, mean {k['mean']:.3g}, p95 {k['p95']:.3g}, max "
+                  f"{k['max'] if k['max'] is None else format(k['max'], '.3g')}; κ ≤ "
+                  f"{well_conditioned:g} in {agg['well_conditioned_volume_cm3']:.2f} cm³ "
+                  f"({100 * agg['well_conditioned_fraction']:.1f} %)")
+    for p in written:
+        out.print(f"  wrote {escape(str(p))}")
+
+
+@app.command()
+def trajectory(
+    mech_file: MechArg,
+    csv: Annotated[Path | None, typer.Option(
+        help="CSV with t,x,y,z,theta_x,theta_y,theta_z (s, mm, deg)")] = None,
+    paper_motion: Annotated[bool, typer.Option(
+        "--paper-motion", help="Hopkins & Williams' motion: ±2 in in x, y, z then ±30° in "
+        "θz, θy, θx, one after the other")] = False,
+    segment_time: Annotated[float, typer.Option(help="paper motion: s per cubic segment")]
+    = 1.0,
+    payload: Annotated[float, typer.Option(help="payload mass (kg) at the tool point")] = 0.0,
+    max_speed: Annotated[float | None, typer.Option(help="actuator speed limit (mm/s)")]
+    = None,
+    max_force: Annotated[float | None, typer.Option(help="actuator force limit (N)")] = 150.0,
+    out_dir: Annotated[Path, typer.Option("--out", help="output folder")]
+    = Path("results/trajectory"),
+    as_json: JsonOpt = False,
+) -> None:
+    """Actuator values, rates and forces along a trajectory, checked against the limits.
+
+    Writes trajectory.json, trajectory.csv and actuators.png into --out.
+    """
+    import shutil
+    import tempfile
+
+    from . import trajectory as tr
+
+    mech = _load(mech_file)
+    if (csv is None) == (not paper_motion):
+        _fail(ParameterError("--csv / --paper-motion", "exactly one of them", "both"
+                             if paper_motion else "neither"))
+    try:
+        if csv is not None:
+            t, poses = tr.load_csv(csv)
+        else:
+            t, poses = tr.paper_motion(mech, segment_time=segment_time)
+        rep = tr.check_trajectory(mech, t, poses, payload_mass_kg=payload,
+                                  max_speed=max_speed, max_force=max_force)
+    except ParameterError as exc:
+        _fail(exc)
+    summary = rep.summary()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    with tempfile.TemporaryDirectory(dir=out_dir, prefix=".partial-") as tmp:
+        tmp = Path(tmp)
+        (tmp / "trajectory.json").write_text(json.dumps(summary, indent=2, default=float)
+                                             + "\n")
+        names = mech.actuator_names
+        header = ",".join(["t", *[f"{n}_mm" for n in names], *[f"{n}_rate_mm_s" for n in names],
+                           *[f"{n}_force_N" for n in names], "status"])
+        rows = [",".join([f"{t[i]:.6g}", *[f"{v:.6g}" for v in rep.q[i]],
+                          *[f"{v:.6g}" for v in rep.qdot[i]], *[f"{v:.6g}" for v in
+                                                               rep.force[i]], str(rep.status[i])])
+                for i in range(len(t))]
+        (tmp / "trajectory.csv").write_text(header + "\n" + "\n".join(rows) + "\n")
+        phases = tr.paper_motion_phases(segment_time) if paper_motion else None
+        tr.plot_actuators(rep, tmp / "actuators.png", title=f"{mech.name}: actuator values",
+                          phases=phases)
+        for name in ("trajectory.json", "trajectory.csv", "actuators.png"):
+            shutil.move(str(tmp / name), out_dir / name)
+            written.append(out_dir / name)
+    if as_json:
+        summary["files"] = [str(p) for p in written]
+        _emit(summary)
+        return
+    verdict = "[bold green]fits[/]" if rep.fits else "[bold red]does not fit[/]"
+    out.print(f"{escape(mech.name or mech.family)}: {len(t)} samples over {t[-1] - t[0]:.2f} s "
+              f"— {verdict} the limits")
+    for kind, v in rep.violations.items():
+        if v is not None:
+            what = "" if v.value is None else (
+                f", {escape(str(v.actuator))} = {v.value:.6g}"
+                + ("" if v.limit is None else f" vs limit {v.limit:.6g}"))
+            out.print(f"  first {kind} violation: sample {v.index} (t = {v.time:.3f} s){what}"
+                      + (f" — {escape(v.reason)}" if v.reason else ""))
+    lo_m, hi_m = rep.margin_low, rep.margin_high
+    out.print("  stroke margins (mm) below / above: " + ", ".join(
+        f"{n} {a:.2f}/{b:.2f}" for n, a, b in zip(mech.actuator_names, lo_m, hi_m)))
+    out.print(f"  peak speed {np.nanmax(np.abs(rep.qdot)):.1f} mm/s, peak force "
+              f"{np.nanmax(np.abs(rep.force)):.2f} N")
+    for p in written:
+        out.print(f"  wrote {escape(str(p))}")
 
 
 @app.command()

@@ -447,7 +447,8 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
                      payload_mass_kg: float = 0.0, payload_com: Sequence[float] = (0.0, 0.0, 0.0),
                      gravity: Sequence[float] = (0.0, 0.0, -9810.0),
                      max_speed: float | Sequence[float] | None = None,
-                     max_force: float | Sequence[float] | None = None) -> TrajectoryReport:
+                     max_force: float | Sequence[float] | None = None,
+                     stroke_tolerance: float = 1e-9) -> TrajectoryReport:
     """Check a trajectory against the stroke, an optional speed and an optional force limit.
 
     Per sample: actuator values ``q`` from ``mech.inverse``; speeds ``q̇ = np.gradient(q, t)``;
@@ -468,6 +469,9 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
         gravity: gravitational acceleration ``(3,)`` in mm/s², base frame.
         max_speed: actuator speed limit in mm/s, scalar or ``(6,)``, compared with ``|q̇|``.
         max_force: actuator force limit in N, scalar or ``(6,)``, compared with ``|f|``.
+        stroke_tolerance: round-off allowance in mm: an actuator value at most this far
+            outside its window still counts as inside (a motion planned to touch a limit
+            exactly, as the paper's z motion does, is not a violation).
 
     Returns:
         :class:`TrajectoryReport`.
@@ -506,7 +510,9 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
     T = len(t)
 
     # --- kinematics --------------------------------------------------------------------------
-    ik = mech.inverse(X)
+    tol = _positive(stroke_tolerance, "stroke_tolerance", "mm", allow_zero=True)
+    qlo, qhi = mech.stroke
+    ik = mech._run_ik(np.ascontiguousarray(X), None, qlo - tol, qhi + tol)
     q = np.array(ik.q, dtype=float)
     ik_valid = np.asarray(ik.valid, dtype=bool)
     ik_reason = ik.reason_text

@@ -1,0 +1,118 @@
+"""Per-voxel metric maps over a workspace, and their export as coloured meshes.
+
+A map reduces a metric over the orientation set at every occupied voxel to its worst case
+(the value a designer can count on at that position): the largest κ, the smallest LCI, the
+smallest isotropic force capability, the smallest translational stiffness eigenvalue.
+Unreachable (voxel, orientation) pairs count as the worst possible value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+from .aggregate import _CHUNK, _ik_valid, _voxels
+from .force import max_force_all_directions
+from .metrics import condition_number
+from .stiffness import stiffness
+
+__all__ = ["METRICS", "MetricMap", "metric_map", "mesh_colours"]
+
+#: metric → (label, unit, worse is larger)
+METRICS = {
+    "kappa": ("worst κ (homogenised condition number)", "", True),
+    "lci": ("worst LCI = 1/κ", "", False),
+    "force": ("smallest force held in every direction", "N", False),
+    "stiffness": ("smallest translational stiffness eigenvalue", "N/mm", False),
+}
+
+
+@dataclass(frozen=True)
+class MetricMap:
+    """Worst value of a metric over the orientation set at every occupied voxel.
+
+    Attributes:
+        metric: key of :data:`METRICS`.
+        values: ``(V,)`` per occupied voxel (``inf``/0 where an orientation is unreachable).
+        index: ``(V, 3)`` voxel indices into the workspace grid.
+        positions: ``(V, 3)`` voxel centres (mm).
+        grid: ``(nx, ny, nz)`` values on the workspace grid, NaN outside.
+    """
+
+    metric: str
+    values: np.ndarray
+    index: np.ndarray
+    positions: np.ndarray
+    grid: np.ndarray
+
+    @property
+    def label(self) -> str:
+        name, unit, _ = METRICS[self.metric]
+        return f"{name} ({unit})" if unit else name
+
+
+def metric_map(mech, result, metric: str = "kappa", L: float = 1.0, f_max=150.0,
+               k=1.0e4) -> MetricMap:
+    """Worst-case ``metric`` over ``result``'s orientation set at every occupied voxel.
+
+    Args:
+        mech, result: the mechanism and its :class:`~pkmlab.WorkspaceResult`.
+        metric: ``"kappa"``, ``"lci"``, ``"force"`` or ``"stiffness"``.
+        L: characteristic length (mm) for κ and LCI.
+        f_max: actuator force limit(s) in N for ``"force"``.
+        k: actuator stiffness(es) in N/mm for ``"stiffness"``.
+    """
+    if metric not in METRICS:
+        raise ParameterError("metric", f"one of {list(METRICS)}", metric)
+    idx, pos = _voxels(result)
+    R = result.orientations.rotations()
+    V, M = len(pos), len(R)
+    worse_is_larger = METRICS[metric][2]
+    worst = np.full(V, -np.inf if worse_is_larger else np.inf)
+    step = max(1, _CHUNK // max(V, 1))
+    for m0 in range(0, M, step):
+        Rm = R[m0:m0 + step]
+        n = len(Rm)
+        p = np.tile(pos, (n, 1))
+        Rr = np.repeat(Rm, V, axis=0)
+        J = mech._jacobian(p, Rr)
+        valid = _ik_valid(mech, p, Rr)
+        if metric in ("kappa", "lci"):
+            val = condition_number(J, L)
+            val = np.where(valid, val, np.inf)
+            if metric == "lci":
+                val = 1.0 / val
+        elif metric == "force":
+            val = np.where(valid, np.nan_to_num(max_force_all_directions(J, f_max)), 0.0)
+        else:
+            ok = np.all(np.isfinite(J), axis=(1, 2))
+            val = np.zeros(len(J))
+            if ok.any():
+                val[ok] = stiffness(J[ok], k).translational_min
+            val = np.where(valid, val, 0.0)
+        val = val.reshape(n, V)
+        worst = np.maximum(worst, val.max(axis=0)) if worse_is_larger else \
+            np.minimum(worst, val.min(axis=0))
+    grid = np.full(result.occupancy.shape, np.nan)
+    grid[idx[:, 0], idx[:, 1], idx[:, 2]] = worst
+    return MetricMap(metric, worst, idx, pos, grid)
+
+
+def mesh_colours(mesh, mmap: MetricMap, vmin=None, vmax=None, cmap: str = "viridis"):
+    """``(n_vertices, 4)`` uint8 RGBA colours: each vertex takes its nearest voxel's value."""
+    import matplotlib
+    from scipy.spatial import cKDTree
+
+    vals = mmap.values.astype(float)
+    finite = np.isfinite(vals)
+    if not finite.any():
+        return np.tile([128, 128, 128, 255], (len(mesh.vertices), 1)).astype(np.uint8)
+    lo = np.min(vals[finite]) if vmin is None else vmin
+    hi = np.max(vals[finite]) if vmax is None else vmax
+    _, near = cKDTree(mmap.positions).query(mesh.vertices)
+    v = vals[near]
+    t = np.clip((np.where(np.isfinite(v), v, hi) - lo) / max(hi - lo, 1e-300), 0, 1)
+    rgba = matplotlib.colormaps[cmap](t)
+    return (rgba * 255).round().astype(np.uint8)
