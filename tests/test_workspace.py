@@ -356,3 +356,18 @@ def test_paper_study_runs_and_reports_the_empty_30_degree_set(tmp_path):
     assert (tmp_path / "hopkins-williams-2002" / "fig7-reachable" / "slices.png").exists()
     assert not (tmp_path / "hopkins-williams-2002" / "fig8-dexterous-30-simultaneous" /
                 "workspace.stl").exists()
+
+
+def test_stroke_window_override_reaches_the_papers_30_degree_set(hopkins):
+    box30 = OrientationSet.box(np.radians([30.0] * 3), samples=5)
+    assert workspace(hopkins, "dexterous", box30, 2.5, refine=True).empty
+    small = workspace(hopkins, "dexterous", box30, 2.5, Constraints(stroke=(0.0, 125.0)),
+                      refine=True)
+    big = workspace(hopkins, "dexterous", box30, 2.5, Constraints(stroke=(0.0, 150.0)),
+                    refine=True)
+    assert small.empty and not big.empty
+    assert big.mechanism.stroke == (0.0, 150.0) and hopkins.stroke == (0.0, 101.6)
+    pts = big.voxel_centres()
+    assert np.all(_independent_check(big.mechanism, big.orientations, pts))
+    with pytest.raises(ParameterError, match="constraints.stroke"):
+        Constraints(stroke=False)

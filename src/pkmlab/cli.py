@@ -337,10 +337,12 @@ JointLimitOpt = Annotated[str | None, typer.Option(
 KappaMaxOpt = Annotated[float | None, typer.Option(help="largest condition number")]
 AllComponentsOpt = Annotated[bool, typer.Option(
     "--all-components", help="keep regions not connected to the nominal pose")]
+StrokeOpt = Annotated[str | None, typer.Option(
+    help='evaluate with another actuator window "min,max" (mm or with units)')]
 
 
 def _request(kind, orientation, box, semantics, tilt, torsion, samples, resolution,
-             link_diameter, joint_limit, kappa_max, all_components):
+             link_diameter, joint_limit, kappa_max, all_components, stroke=None):
     """CLI workspace options → validated request (the config module does the validation)."""
     from .config import workspace_spec
 
@@ -360,6 +362,9 @@ def _request(kind, orientation, box, semantics, tilt, torsion, samples, resoluti
     jl = _csv_list(joint_limit, "--joint-limit", 2)
     if jl is not None:
         data["constraints"]["joint_limits"] = {"base": jl[0], "platform": jl[1]}
+    win = _csv_list(stroke, "--stroke", 2)
+    if win is not None:
+        data["constraints"]["stroke"] = win
     try:
         spec = workspace_spec(data, prefix="--")
     except ParameterError as exc:
@@ -382,6 +387,7 @@ def workspace(
     joint_limit: JointLimitOpt = None,
     kappa_max: KappaMaxOpt = None,
     all_components: AllComponentsOpt = False,
+    stroke: StrokeOpt = None,
     inscribed: Annotated[bool, typer.Option(
         "--inscribed", help="also find the largest inscribed box and vertical cylinder")]
     = False,
@@ -405,7 +411,7 @@ def workspace(
 
     mech = _load(mech_file)
     spec, req = _request(kind, orientation, box, semantics, tilt, torsion, samples, resolution,
-                         link_diameter, joint_limit, kappa_max, all_components)
+                         link_diameter, joint_limit, kappa_max, all_components, stroke)
     formats = [f.strip().lower() for f in mesh.split(",") if f.strip()]
     bad = [f for f in formats if f not in ("stl", "ply", "glb")]
     if bad or not formats:
@@ -450,6 +456,7 @@ def dexterity(
     joint_limit: JointLimitOpt = None,
     kappa_max: KappaMaxOpt = None,
     all_components: AllComponentsOpt = False,
+    stroke: StrokeOpt = None,
     metric: Annotated[str, typer.Option(help="map: kappa | lci | force | stiffness")]
     = "kappa",
     characteristic_length: Annotated[str, typer.Option(
@@ -458,6 +465,9 @@ def dexterity(
     well_conditioned: Annotated[float, typer.Option(
         help="κ bound of the well-conditioned sub-workspace")] = 10.0,
     force_limit: Annotated[float, typer.Option(help="actuator force limit (N)")] = 150.0,
+    force_required: Annotated[float, typer.Option(
+        help="force (N) the platform must hold in every direction: its sub-workspace")]
+    = 100.0,
     actuator_stiffness: Annotated[float, typer.Option(help="actuator stiffness (N/mm)")]
     = 1.0e4,
     gci_samples: Annotated[int, typer.Option(help="Monte-Carlo GCI samples")] = 2000,
@@ -481,7 +491,7 @@ def dexterity(
 
     mech = _load(mech_file)
     spec, req = _request(kind, orientation, box, semantics, tilt, torsion, samples, resolution,
-                         link_diameter, joint_limit, kappa_max, all_components)
+                         link_diameter, joint_limit, kappa_max, all_components, stroke)
     if metric not in METRICS:
         _fail(ParameterError("--metric", f"one of {list(METRICS)}", metric))
     if characteristic_length.strip().lower() == "auto":
@@ -498,12 +508,15 @@ def dexterity(
         L_source = "given"
     for name, v, lo in (("--force-limit", force_limit, 0), ("--actuator-stiffness",
                                                               actuator_stiffness, 0),
-                        ("--well-conditioned", well_conditioned, 1)):
+                        ("--well-conditioned", well_conditioned, 1),
+                        ("--force-required", force_required, 0)):
         if not (math.isfinite(v) and v > lo):
             _fail(ParameterError(name, f"a number > {lo}", v))
     if not 10 <= gci_samples <= 10_000_000:
         _fail(ParameterError("--gci-samples", "an integer in [10, 10000000]", gci_samples))
 
+    res = compute(mech, **req)
+    mech = res.mechanism          # carries a --stroke window, if one was given
     # nominal pose
     X = mech.nominal_pose
     J = mech.jacobian(X)
@@ -525,7 +538,6 @@ def dexterity(
         "stiffness_translational_min_N_per_mm": _finite_or_none(st.translational_min[0]),
         "stiffness_rotational_min_Nmm_per_rad": _finite_or_none(st.rotational_min[0]),
     }
-    res = compute(mech, **req)
     agg: dict = {"workspace_volume_cm3": res.volume / 1e3, "empty": res.empty}
     mmap = None
     if not res.empty:
@@ -545,8 +557,14 @@ def dexterity(
             "well_conditioned_kappa_max": well_conditioned,
             "well_conditioned_volume_cm3": wc.volume / 1e3,
             "well_conditioned_fraction": wc.fraction,
-            "force_all_directions_N": {"min": float(fmap.values.min()),
-                                       "mean": float(fmap.values.mean())},
+            "force_all_directions_N": {
+                "min": float(fmap.values.min()), "mean": float(fmap.values.mean()),
+                "p5": float(np.percentile(fmap.values, 5)),
+                "p50": float(np.percentile(fmap.values, 50)),
+                "max": float(fmap.values.max())},
+            "force_required_N": force_required,
+            "force_capable_volume_cm3": float(np.mean(fmap.values >= force_required))
+            * res.volume / 1e3,
         })
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
@@ -596,6 +614,10 @@ def dexterity(
                   f"{k['max'] if k['max'] is None else format(k['max'], '.3g')}; κ ≤ "
                   f"{well_conditioned:g} in {agg['well_conditioned_volume_cm3']:.2f} cm³ "
                   f"({100 * agg['well_conditioned_fraction']:.1f} %)")
+        f = agg["force_all_directions_N"]
+        out.print(f"  force held in every direction: min {f['min']:.1f} N, median "
+                  f"{f['p50']:.1f} N; ≥ {force_required:g} N in "
+                  f"{agg['force_capable_volume_cm3']:.2f} cm³")
     for p in written:
         out.print(f"  wrote {escape(str(p))}")
 

@@ -264,8 +264,18 @@ class JointLimitsSpec(_Model):
     platform_axes: Points | None = Field(None, description="6 mounting axes, platform frame")
 
 
+def _stroke_choice(v: Any) -> bool | list[float]:
+    if v is True:
+        return True
+    if v is False:
+        raise _Invalid("must be true or a window [min, max] (without a stroke limit the "
+                       "workspace is unbounded); got False")
+    return _stroke(v)
+
+
 class ConstraintsSpec(_Model):
-    stroke: bool = True
+    stroke: Annotated[bool | list[float], BeforeValidator(_stroke_choice)] = Field(
+        True, description="true (the mechanism's window) or [min, max] to try another")
     joint_limits: JointLimitsSpec | None = None
     link_diameter: PositiveLength | None = Field(None, description="leg diameter (mm)")
     kappa_max: float | None = Field(None, ge=1, description="largest condition number")
@@ -319,7 +329,8 @@ class WorkspaceSpec(_Model):
         if c.joint_limits is not None:
             j = c.joint_limits
             jl = JointLimits(j.base, j.platform, j.base_axes, j.platform_axes)
-        cons = Constraints(stroke=c.stroke, joint_limits=jl, link_diameter=c.link_diameter,
+        cons = Constraints(stroke=c.stroke if c.stroke is True else tuple(c.stroke),
+                           joint_limits=jl, link_diameter=c.link_diameter,
                            kappa_max=c.kappa_max, characteristic_length=c.characteristic_length,
                            connected=c.connected)
         return {"kind": self.kind, "orientations": oset, "resolution": self.resolution,

@@ -57,7 +57,9 @@ class Constraints:
     """Which constraints a workspace request applies.
 
     Attributes:
-        stroke: actuator windows (always exact along columns where the family allows).
+        stroke: ``True`` = the mechanism's actuator window, or ``(min, max)`` in mm to
+            evaluate the same geometry with another window (what-if strokes). It cannot be
+            switched off: without it a workspace is unbounded.
         joint_limits: passive joint cones, or ``None``.
         link_diameter: legs are cylinders of this diameter (mm); two legs interfere when
             their axes come closer than it. ``None`` = not checked.
@@ -68,7 +70,7 @@ class Constraints:
             regions that the stroke alone admits).
     """
 
-    stroke: bool = True
+    stroke: bool | tuple[float, float] = True
     joint_limits: JointLimits | None = None
     link_diameter: float | None = None
     kappa_max: float | None = None
@@ -76,6 +78,14 @@ class Constraints:
     connected: bool = True
 
     def __post_init__(self):
+        if self.stroke is not True:
+            win = np.asarray(self.stroke, dtype=float) if self.stroke is not False else None
+            if win is None or win.shape != (2,) or not np.all(np.isfinite(win)) \
+                    or win[0] >= win[1]:
+                raise ParameterError("constraints.stroke", "true or a window [min, max] in mm "
+                                     "with min < max (without a stroke limit the workspace "
+                                     "is unbounded)", self.stroke)
+            object.__setattr__(self, "stroke", (float(win[0]), float(win[1])))
         if self.link_diameter is not None and not (self.link_diameter > 0):
             raise ParameterError("constraints.link_diameter", "a length > 0 mm",
                                  self.link_diameter)
@@ -94,7 +104,7 @@ class Constraints:
     def describe(self) -> dict:
         jl = self.joint_limits
         return {
-            "stroke": self.stroke,
+            "stroke": self.stroke if self.stroke is True else list(self.stroke),
             "joint_limits_deg": None if jl is None else {
                 "base": None if jl.base is None else math.degrees(jl.base),
                 "platform": None if jl.platform is None else math.degrees(jl.platform)},

@@ -11,6 +11,7 @@ kept for display: slices, meshes.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import time
@@ -64,6 +65,9 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
     if method not in ("auto", "columns", "sampled"):
         raise ParameterError("method", "one of ['auto', 'columns', 'sampled']", method)
     cons = constraints or Constraints()
+    if cons.stroke is not True:
+        # the same geometry with another actuator window (the family re-validates it)
+        mech = dataclasses.replace(mech, stroke_window=cons.stroke)
     oset = orientations or OrientationSet.fixed()
     if kind == "constant" and oset.kind != "fixed":
         raise ParameterError("orientations", "a single fixed orientation for kind 'constant'",

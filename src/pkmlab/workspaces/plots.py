@@ -35,6 +35,10 @@ def slice_figure(result, window: float = 152.4, spacing: float = 12.7, centre=No
     extent = (result.xs[0] - h / 2, result.xs[-1] + h / 2, result.ys[0] - h / 2,
               result.ys[-1] + h / 2) if len(result.xs) else (0, 1, 0, 1)
     im = None
+    if values is not None and not np.any(np.isfinite(values)):
+        values = None                     # nothing to colour: plain sections
+    if values is not None:
+        vmin, vmax = np.nanmin(values), np.nanmax(values)
     for a, ax in enumerate(axes.ravel()):
         ax.set_xlim(cx - half, cx + half)
         ax.set_ylim(cy - half, cy + half)
@@ -52,8 +56,7 @@ def slice_figure(result, window: float = 152.4, spacing: float = 12.7, centre=No
         else:
             k = int(np.clip(round((z - result.zs[0]) / h), 0, len(result.zs) - 1))
             img = np.where(sec, values[:, :, k], np.nan).T
-            im = ax.imshow(img, origin="lower", extent=extent, cmap=cmap,
-                           vmin=np.nanmin(values), vmax=np.nanmax(values),
+            im = ax.imshow(img, origin="lower", extent=extent, cmap=cmap, vmin=vmin, vmax=vmax,
                            interpolation="nearest")
         ax.set_title(f"z = {z:.1f} mm", fontsize=7)
     if im is not None:
