@@ -751,6 +751,140 @@ def workspaces(
     out.print(f"outputs under {escape(str(out_dir / spec.study))}/<workspace>/")
 
 
+# ---- design studies ------------------------------------------------------------------------------
+
+StudyArg = Annotated[Path, typer.Argument(help="Study YAML file.")]
+
+
+def _load_study(path: Path):
+    from .config import load_study
+
+    try:
+        return load_study(path)
+    except ParameterError as exc:
+        _fail(exc)
+        raise  # unreachable
+
+
+@app.command()
+def validate(study_file: StudyArg) -> None:
+    """Check a study file (exit 2 with the offending field on error; writes nothing)."""
+    _, resolved = _load_study(study_file)
+    from .study.run import expected_evaluations
+
+    out.print(f"{escape(str(study_file))}: valid — {len(resolved['variables'])} design "
+              f"variables, {len(resolved['objectives'])} objectives, "
+              f"{len(resolved['constraints'])} constraints, {resolved['optimizer']['method']} "
+              f"(~{expected_evaluations(resolved)} evaluations), output "
+              f"{escape(resolved['output'])}")
+
+
+@app.command()
+def schema() -> None:
+    """Print the JSON Schema of study files (for editors)."""
+    from .config import study_schema
+
+    _emit(study_schema())
+
+
+def _progress_bar(total: int):
+    """A rich progress bar with rate and ETA on a terminal, nothing otherwise."""
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    if not err.is_terminal:
+        return None, (lambda n: None)
+    prog = Progress(TextColumn("evaluating"), BarColumn(), MofNCompleteColumn(),
+                    TextColumn("{task.completed} done"), TimeElapsedColumn(),
+                    TimeRemainingColumn(), console=err, transient=True)
+    task = prog.add_task("eval", total=total)
+    return prog, (lambda n: prog.advance(task, n))
+
+
+@app.command()
+def run(
+    study_file: StudyArg,
+    jobs: Annotated[int, typer.Option(help="parallel evaluations (joblib workers)")] = 1,
+    resume: Annotated[bool, typer.Option(
+        "--resume", help="continue the study in its output folder without repeating work")]
+    = False,
+    backend: Annotated[str, typer.Option(help="loky | dask")] = "loky",
+    scheduler: Annotated[str | None, typer.Option(help="Dask scheduler address")] = None,
+    out_dir: Annotated[Path | None, typer.Option(
+        "--out", help="output folder (default: the study's, results/<study>)")] = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """Run a design study: evaluate candidates, keep every result, report the Pareto set."""
+    import time
+
+    from .study.report import export_designs, pareto_records, write_report
+    from .study.run import expected_evaluations, run_study
+    from .study.runners import make_runner
+
+    _, resolved = _load_study(study_file)
+    if out_dir is not None:
+        resolved["output"] = str(out_dir)
+    try:
+        runner = make_runner(backend, jobs, scheduler)
+    except ParameterError as exc:
+        _fail(exc)
+    prog, advance = _progress_bar(expected_evaluations(resolved))
+    t0 = time.perf_counter()
+    try:
+        if prog is not None:
+            prog.start()
+        store = run_study(resolved, runner, resume=resume, progress=advance)
+    except ParameterError as exc:
+        _fail(exc)
+    finally:
+        if prog is not None:
+            prog.stop()
+        runner.close()
+    elapsed = time.perf_counter() - t0
+    records = store.all()
+    store.close()
+    outp = Path(resolved["output"])
+    info = write_report(outp, resolved, records)
+    front = pareto_records(resolved, records)
+    export_designs(outp, resolved, front)
+    info.update(seconds=elapsed, output=str(outp))
+    if as_json:
+        _emit(info)
+        return
+    out.print(f"[bold]{escape(resolved['study'])}[/]: {info['evaluations']} evaluations "
+              f"({info['failed']} invalid or failed) in {elapsed:.1f} s, "
+              f"{info['pareto']} Pareto designs")
+    out.print((outp / "summary.md").read_text())
+    out.print(f"results in {escape(str(outp))}/ (summary.md, pareto.csv, pareto.png, "
+              "evaluations.csv, designs/)")
+
+
+@app.command()
+def report(results_dir: Annotated[Path, typer.Argument(help="a study's results folder")]
+           ) -> None:
+    """Rebuild the tables, Pareto plot and summary from the store (no re-evaluation)."""
+    from .study.report import write_report
+    from .study.store import Store
+
+    path = results_dir / "evaluations.sqlite"
+    if not path.is_file():
+        _fail(ParameterError("RESULTS_DIR", "a study results folder with evaluations.sqlite",
+                             str(results_dir)))
+    store = Store(path)
+    resolved = store.get_meta("resolved")
+    records = store.all()
+    store.close()
+    info = write_report(results_dir, resolved, records)
+    out.print(f"rebuilt {escape(str(results_dir))}: {info['evaluations']} evaluations, "
+              f"{info['pareto']} Pareto designs")
+
+
 def main() -> None:
     app()
 

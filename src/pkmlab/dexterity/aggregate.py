@@ -151,6 +151,7 @@ class GCIResult:
         method: ``'grid'`` or ``'monte-carlo'``.
         L: characteristic length used (mm).
         ok: at least one pose was accepted.
+        lci_min: smallest accepted LCI (1/lci_min is the worst κ met), NaN if none.
     """
 
     gci: float
@@ -161,6 +162,7 @@ class GCIResult:
     method: str
     L: float
     ok: bool
+    lci_min: float = float("nan")
 
 
 def _summarise(values: np.ndarray, rejected: int, method: str, L: float) -> GCIResult:
@@ -171,7 +173,8 @@ def _summarise(values: np.ndarray, rejected: int, method: str, L: float) -> GCIR
                          False)
     std = float(values.std(ddof=1)) if n > 1 else 0.0
     se = 0.0 if method == "grid" else (std / math.sqrt(n) if n > 1 else float("inf"))
-    return GCIResult(float(values.mean()), se, std, n, rejected, method, L, True)
+    return GCIResult(float(values.mean()), se, std, n, rejected, method, L, True,
+                     float(values.min()))
 
 
 def gci_grid(mech, result, L: float | None = None) -> GCIResult:
@@ -229,6 +232,21 @@ def sample_orientations(oset, n: int, rng: np.random.Generator) -> np.ndarray:
     return rotations_from_parameters(oset, np.stack([phi, theta, sigma], axis=1))
 
 
+def sample_poses(result, samples: int, rng: np.random.Generator):
+    """``samples`` poses ``(p (n, 3), R (n, 3, 3))`` uniform over a workspace × its set.
+
+    Positions: an occupied voxel chosen uniformly, then a point uniform within it;
+    orientations: :func:`sample_orientations`.
+    """
+    occ = np.flatnonzero(result.occupancy)
+    pick = occ[rng.integers(0, len(occ), samples)]
+    i, j, k = np.unravel_index(pick, result.occupancy.shape)
+    h = result.resolution
+    p = np.stack([result.xs[i], result.ys[j], result.zs[k]], axis=1)
+    p += rng.uniform(-0.5 * h, 0.5 * h, size=(samples, 3))
+    return p, sample_orientations(result.orientations, samples, rng)
+
+
 def gci_monte_carlo(mech, result, L: float | None = None, samples: int = 2000,
                     seed: int | None = 0) -> GCIResult:
     """GCI by Monte Carlo over the workspace volume × orientation set.
@@ -254,15 +272,9 @@ def gci_monte_carlo(mech, result, L: float | None = None, samples: int = 2000,
     if samples < 1:
         raise ParameterError("samples", "an integer >= 1", samples)
     rng = np.random.default_rng(seed)
-    occ = np.flatnonzero(result.occupancy)
-    if len(occ) == 0:
+    if not result.occupancy.any():
         return _summarise(np.empty(0), samples, "monte-carlo", L)
-    pick = occ[rng.integers(0, len(occ), samples)]
-    i, j, k = np.unravel_index(pick, result.occupancy.shape)
-    h = result.resolution
-    p = np.stack([result.xs[i], result.ys[j], result.zs[k]], axis=1)
-    p += rng.uniform(-0.5 * h, 0.5 * h, size=(samples, 3))
-    R = sample_orientations(result.orientations, samples, rng)
+    p, R = sample_poses(result, samples, rng)
     valid = _ik_valid(mech, p, R)
     J = mech._jacobian(p[valid], R[valid])
     vals = lci(J, L)

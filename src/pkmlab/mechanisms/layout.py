@@ -66,14 +66,20 @@ def equal_leg_base_angle(base_radii, platform_radii, platform_rotation, base_pai
     ``|B1 - P1|_xy = |B2 - P2|_xy``. Of the roots on (-π, π] the one closest to the mirror
     symmetric position ``150° - ρ`` is returned.
     """
-    def gap(beta: float) -> float:
-        B, P = paired_layout(base_radii, platform_radii, beta, platform_rotation,
-                             base_pair_separation, platform_pair_separation, pairing)
-        d = np.linalg.norm((B - P)[:, :2], axis=1)
-        return d[0] ** 2 - d[1] ** 2
+    # The platform points do not depend on β; B1 (outer) and B2 (inner) turn with it.
+    _, P = paired_layout(base_radii, platform_radii, 0.0, platform_rotation,
+                         base_pair_separation, platform_pair_separation, pairing)
+    b_in, b_out = base_radii
+
+    def gap(beta):
+        a1 = np.asarray(beta) - base_pair_separation / 2
+        a2 = np.asarray(beta) + base_pair_separation / 2
+        d1 = (b_out * np.cos(a1) - P[0, 0]) ** 2 + (b_out * np.sin(a1) - P[0, 1]) ** 2
+        d2 = (b_in * np.cos(a2) - P[1, 0]) ** 2 + (b_in * np.sin(a2) - P[1, 1]) ** 2
+        return d1 - d2
 
     grid = np.linspace(-np.pi, np.pi, 1441)
-    vals = np.array([gap(b) for b in grid])
+    vals = gap(grid)
     roots = [brentq(gap, grid[i], grid[i + 1], xtol=1e-14)
              for i in range(len(grid) - 1) if vals[i] == 0 or vals[i] * vals[i + 1] < 0]
     if not roots:

@@ -1,0 +1,92 @@
+"""Where candidate evaluations run: in process, in joblib workers, or on a Dask cluster.
+
+A runner maps a function over tasks and hands each result back *as it finishes*, so the
+caller can commit it to the store immediately. Runners are passed to the study driver, never
+created inside it.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Iterable, Iterator
+
+__all__ = ["SerialRunner", "JoblibRunner", "DaskRunner", "make_runner"]
+
+log = logging.getLogger(__name__)
+
+
+def _call(fn, task_id, args):
+    return task_id, fn(*args)
+
+
+class SerialRunner:
+    """Evaluate in this process, in order."""
+
+    name = "serial"
+
+    def map(self, fn: Callable, tasks: Iterable[tuple]) -> Iterator[tuple]:
+        for task_id, args in tasks:
+            yield task_id, fn(*args)
+
+    def close(self) -> None:
+        pass
+
+
+class JoblibRunner:
+    """Evaluate in ``jobs`` joblib (loky) worker processes; results in completion order."""
+
+    name = "loky"
+
+    def __init__(self, jobs: int = 2):
+        from joblib import Parallel
+
+        self.jobs = jobs
+        self.pool = Parallel(n_jobs=jobs, backend="loky", return_as="generator_unordered")
+
+    def map(self, fn, tasks):
+        from joblib import delayed
+
+        yield from self.pool(delayed(_call)(fn, tid, args) for tid, args in tasks)
+
+    def close(self) -> None:
+        pass
+
+
+class DaskRunner:
+    """Evaluate on a Dask cluster (an existing scheduler address, or a given client)."""
+
+    name = "dask"
+
+    def __init__(self, scheduler: str | None = None, client=None):
+        from distributed import Client
+
+        self._own = client is None
+        self.client = client if client is not None else Client(scheduler)
+
+    def map(self, fn, tasks):
+        from distributed import as_completed
+
+        tasks = list(tasks)
+        futures = [self.client.submit(_call, fn, tid, args, pure=False) for tid, args in tasks]
+        for fut in as_completed(futures):
+            yield fut.result()
+
+    def close(self) -> None:
+        if self._own:
+            self.client.close()
+
+
+def make_runner(backend: str, jobs: int = 1, scheduler: str | None = None):
+    """Runner for the CLI's ``--backend`` / ``--jobs`` / ``--scheduler`` options."""
+    from ..errors import ParameterError
+
+    if backend == "dask":
+        if not scheduler:
+            raise ParameterError("--scheduler", "a Dask scheduler address (tcp://host:port) "
+                                 "with --backend dask", scheduler)
+        return DaskRunner(scheduler)
+    if backend != "loky":
+        raise ParameterError("--backend", "one of ['loky', 'dask']", backend)
+    if jobs < 1:
+        raise ParameterError("--jobs", "an integer >= 1", jobs)
+    return SerialRunner() if jobs == 1 else JoblibRunner(jobs)
