@@ -15,13 +15,16 @@ $(STAMP): pyproject.toml | $(PY)
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(VENV)/bin/pkmlab demo studies/mechanisms
+	$(VENV)/bin/pkmlab run studies/hopkins-6psu-redesign.yaml --jobs 2
 
 test: $(STAMP)
 	$(PY) -m pytest
 
 bench: $(STAMP)
 	$(PY) benchmarks/bench_kinematics.py
+	$(PY) benchmarks/bench_workspace.py
+	$(PY) benchmarks/bench_dexterity.py
+	$(PY) benchmarks/bench_study.py
 
 clean:
 	rm -rf $(VENV) results/*/ .pytest_cache

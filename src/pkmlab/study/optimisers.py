@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import logging
+import warnings
 
 import numpy as np
 
@@ -78,7 +79,9 @@ def _grid(space, evaluate_batch, opt, seed):
 def _sobol(space, evaluate_batch, opt, seed):
     from scipy.stats import qmc
 
-    u = qmc.Sobol(d=len(space.variables), scramble=True, seed=seed).random(opt["samples"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)   # any n; powers of 2 balance best
+        u = qmc.Sobol(d=len(space.variables), scramble=True, seed=seed).random(opt["samples"])
     evaluate_batch([space.from_unit(r) for r in u])
 
 

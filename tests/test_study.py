@@ -1,0 +1,265 @@
+"""Design studies: validation corpus, Pareto filter, resume after kill -9, runners agree."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from conftest import MECH_DIR
+from typer.testing import CliRunner
+
+from pkmlab.cli import app
+from pkmlab.config import load_study
+from pkmlab.errors import ParameterError
+from pkmlab.study import SerialRunner, pareto_mask, pareto_records, run_study
+from pkmlab.study.runners import DaskRunner, JoblibRunner
+
+HOPKINS = MECH_DIR / "hopkins-williams-6psu.yaml"
+
+
+def small_study(tmp_path: Path, **over) -> dict:
+    data = {
+        "study": "tiny",
+        "mechanism": {"file": str(HOPKINS)},
+        "design": {"platform_outer_radius": {"low": "55 mm", "high": "90 mm"},
+                   "platform_rotation": {"low": "10 deg", "high": "50 deg"},
+                   "link_length": {"low": "200 mm", "high": "260 mm"}},
+        "evaluate": {"workspace": {"kind": "dexterous", "box": ["10 deg"] * 3, "samples": 2,
+                                   "resolution": "6 mm"},
+                     "dexterity": {"gci_samples": 100}},
+        "objectives": [{"maximize": "dexterous_volume"}, {"maximize": "gci"}],
+        "constraints": [{"worst_kappa": {"max": 20}}],
+        "optimizer": {"method": "sobol", "samples": 8},
+        "seed": 3,
+        "output": str(tmp_path / "out"),
+        "top": 1,
+    }
+    for k, v in over.items():
+        data[k] = v
+    return data
+
+
+def write(tmp_path: Path, data: dict, name="study.yaml") -> Path:
+    p = tmp_path / name
+    p.write_text(yaml.safe_dump(data))
+    return p
+
+
+def _drop(d, key):
+    d = dict(d)
+    d.pop(key)
+    return d
+
+
+# ---- validation corpus -------------------------------------------------------------------------
+
+BAD = [
+    ("unknown key", {"colour": "red"}, "colour"),
+    ("wrong unit", {"design": {"link_length": {"low": "200 furlong", "high": "260 mm"}}},
+     "design.link_length.low"),
+    ("low > high", {"design": {"link_length": {"low": "260 mm", "high": "200 mm"}}},
+     "design.link_length"),
+    ("non-numeric bound", {"design": {"link_length": {"low": "long", "high": "260 mm"}}},
+     "design.link_length.low"),
+    ("unknown variable", {"design": {"wheel_base": {"low": 1, "high": 2}}},
+     "design.wheel_base"),
+    ("empty design space", {"design": {}}, "design"),
+    ("unknown family", {"mechanism": {"file": str(HOPKINS), "overrides": {"family": "hexa"}}},
+     "mechanism.family"),
+    ("unknown metric", {"objectives": [{"maximize": "beauty"}]}, "objectives[0].maximize"),
+    ("metric not computed", {"objectives": [{"maximize": "paper_motion_margin"}]},
+     "objectives[0].maximize"),
+    ("wrong kind volume", {"objectives": [{"maximize": "reachable_volume"}]},
+     "objectives[0].maximize"),
+    ("bad constraint", {"constraints": [{"worst_kappa": {"below": 3}}]},
+     "constraints[0].worst_kappa"),
+    ("bad optimizer", {"optimizer": {"method": "annealing"}}, "optimizer.method"),
+    ("de with two objectives", {"optimizer": {"method": "de"}}, "optimizer.method"),
+]
+
+
+@pytest.mark.parametrize("label, over, field", BAD, ids=[b[0] for b in BAD])
+def test_bad_study_files_name_the_field_and_write_nothing(tmp_path, label, over, field):
+    path = write(tmp_path, small_study(tmp_path, **over))
+    with pytest.raises(ParameterError) as exc:
+        load_study(path)
+    assert exc.value.field == field, str(exc.value)
+    for cmd in ("validate", "run"):
+        r = CliRunner().invoke(app, [cmd, str(path)])
+        assert r.exit_code == 2 and field in r.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_missing_section_and_schema(tmp_path):
+    path = write(tmp_path, _drop(small_study(tmp_path), "objectives"))
+    with pytest.raises(ParameterError, match="objectives"):
+        load_study(path)
+    r = CliRunner().invoke(app, ["schema"])
+    assert r.exit_code == 0
+    schema = json.loads(r.stdout)
+    assert {"study", "design", "evaluate", "objectives", "optimizer"} <= set(
+        schema["properties"])
+
+
+def test_resolved_study_converts_units_once(tmp_path):
+    _, res = load_study(write(tmp_path, small_study(tmp_path)))
+    v = {x["name"]: x for x in res["variables"]}
+    assert v["platform_rotation"]["low"] == pytest.approx(np.radians(10))
+    assert v["link_length"]["high"] == 260.0
+    assert res["objectives"][0] == {"metric": "dexterous_volume", "sense": "maximize"}
+
+
+# ---- Pareto ---------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_pareto_mask_equals_brute_force(seed):
+    rng = np.random.default_rng(seed)
+    F = rng.integers(0, 6, size=(60, 3)).astype(float)      # ties on purpose
+    brute = np.array([not any(np.all(F[j] <= F[i]) and np.any(F[j] < F[i])
+                              for j in range(len(F))) for i in range(len(F))])
+    np.testing.assert_array_equal(pareto_mask(F), brute)
+
+
+# ---- running --------------------------------------------------------------------------------------
+
+
+def _snapshot(store_path: Path) -> dict:
+    con = sqlite3.connect(store_path)
+    rows = con.execute("SELECT key, status, metrics FROM evaluations").fetchall()
+    con.close()
+    return {k: (s, json.loads(m)) for k, s, m in rows}
+
+
+@pytest.fixture(scope="module")
+def serial_run(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("serial")
+    _, res = load_study(write(tmp, small_study(tmp)))
+    store = run_study(res, SerialRunner())
+    records = store.all()
+    store.close()
+    return res, records, _snapshot(Path(res["output"]) / "evaluations.sqlite")
+
+
+def test_serial_run_records_every_candidate(serial_run):
+    res, records, snap = serial_run
+    assert len(records) == 9                                 # 8 sobol + the baseline
+    assert sum(r["role"] == "baseline" for r in records) == 1
+    assert all(r["status"] in ("ok", "invalid", "failed") for r in records)
+    front = pareto_records(res, records)
+    assert front and all(r["status"] == "ok" for r in front)
+
+
+def test_joblib_and_dask_give_the_same_store(serial_run, tmp_path):
+    from distributed import Client, LocalCluster
+
+    res, _, snap = serial_run
+    for name in ("joblib", "dask"):
+        r2 = dict(res, output=str(tmp_path / name))
+        if name == "joblib":
+            runner = JoblibRunner(2)
+            run_study(r2, runner).close()
+        else:
+            with LocalCluster(n_workers=2, processes=False, dashboard_address=None) as c, \
+                    Client(c) as client:
+                run_study(r2, DaskRunner(client=client)).close()
+        other = _snapshot(tmp_path / name / "evaluations.sqlite")
+        assert other == snap, name
+
+
+NSGA = {"optimizer": {"method": "nsga2", "population": 6, "generations": 4}, "seed": 5}
+
+
+def test_resume_after_kill_loses_and_repeats_nothing(tmp_path):
+    data = small_study(tmp_path, **NSGA)
+    data["output"] = str(tmp_path / "killed")
+    path = write(tmp_path, data)
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    proc = subprocess.Popen([sys.executable, "-m", "pkmlab.cli", "run", str(path)], env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    db = tmp_path / "killed" / "evaluations.sqlite"
+    deadline = time.time() + 120
+    n_before = 0
+    while time.time() < deadline:
+        if db.exists():
+            try:
+                con = sqlite3.connect(db)
+                n_before = con.execute("SELECT COUNT(*) FROM evaluations").fetchone()[0]
+                con.close()
+            except sqlite3.Error:
+                n_before = 0
+            if n_before >= 6:
+                break
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    before = _snapshot(db)
+    assert 6 <= len(before), "the run was killed before it stored anything"
+
+    _, res = load_study(path)
+    done = []
+    store = run_study(res, SerialRunner(), resume=True, progress=done.append)
+    after = store.all()
+    store.close()
+    # nothing lost: every stored row is still there, unchanged
+    snap = _snapshot(db)
+    assert all(snap[k] == v for k, v in before.items())
+    # nothing repeated: only the missing candidates were evaluated
+    assert len(before) < len(after), "the run finished before it was killed"
+    assert len(done) == len(after) - len(before)
+    # the same result as an uninterrupted run with the same seed
+    data["output"] = str(tmp_path / "straight")
+    _, res2 = load_study(write(tmp_path, data, "straight.yaml"))
+    store2 = run_study(res2, SerialRunner())
+    straight = store2.all()
+    store2.close()
+    assert {r["key"] for r in straight} == {r["key"] for r in after}
+    assert [r["key"] for r in pareto_records(res2, straight)] == \
+        [r["key"] for r in pareto_records(res, after)]
+
+
+def test_resume_refuses_a_changed_study(tmp_path):
+    data = small_study(tmp_path)
+    _, res = load_study(write(tmp_path, data))
+    run_study(res, SerialRunner()).close()
+    data["seed"] = 99
+    _, res2 = load_study(write(tmp_path, data))
+    with pytest.raises(ParameterError, match="--resume"):
+        run_study(res2, SerialRunner(), resume=True)
+
+
+def test_cli_run_end_to_end_and_report(tmp_path):
+    data = small_study(tmp_path)
+    data["evaluate"]["trajectory"] = {"paper_motion": True}
+    data["constraints"].append({"paper_motion_fits": True})
+    path = write(tmp_path, data)
+    t0 = time.perf_counter()
+    r = CliRunner().invoke(app, ["run", str(path), "--json"])
+    assert r.exit_code == 0, r.output
+    assert time.perf_counter() - t0 < 60
+    info = json.loads(r.stdout)
+    out = tmp_path / "out"
+    for name in ("evaluations.csv", "pareto.csv", "pareto.png", "summary.md",
+                 "study.resolved.yaml", "evaluations.sqlite"):
+        assert (out / name).exists(), name
+    assert info["evaluations"] == 9
+    lines = (out / "evaluations.csv").read_text().splitlines()
+    assert len(lines) == 10
+    designs = list((out / "designs").iterdir())
+    assert len(designs) == 1 and (designs[0] / "mechanism.yaml").exists()
+    assert "baseline" in (out / "summary.md").read_text()
+    (out / "pareto.png").unlink()
+    r = CliRunner().invoke(app, ["report", str(out)])
+    assert r.exit_code == 0 and (out / "pareto.png").exists()
+    # the exported design is a valid mechanism file
+    r = CliRunner().invoke(app, ["inspect", str(designs[0] / "mechanism.yaml"), "--json"])
+    assert r.exit_code == 0, r.output
