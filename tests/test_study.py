@@ -118,7 +118,7 @@ def test_resolved_study_converts_units_once(tmp_path):
     assert res["objectives"][0] == {"metric": "dexterous_volume", "sense": "maximize"}
 
 
-# ---- Pareto ---------------------------------------------------------------------------------------
+# ---- Pareto ----------------------------------------------------------------------------------
 
 
 @pytest.mark.parametrize("seed", range(5))
@@ -130,7 +130,7 @@ def test_pareto_mask_equals_brute_force(seed):
     np.testing.assert_array_equal(pareto_mask(F), brute)
 
 
-# ---- running --------------------------------------------------------------------------------------
+# ---- running ---------------------------------------------------------------------------------
 
 
 def _snapshot(store_path: Path) -> dict:
