@@ -263,3 +263,30 @@ def test_cli_run_end_to_end_and_report(tmp_path):
     # the exported design is a valid mechanism file
     r = CliRunner().invoke(app, ["inspect", str(designs[0] / "mechanism.yaml"), "--json"])
     assert r.exit_code == 0, r.output
+
+
+def test_compare_files_and_pareto_rows(tmp_path, serial_run):
+    res, records, _ = serial_run
+    from pkmlab.study.report import write_report
+
+    out = Path(res["output"])
+    write_report(out, res, records)
+    r = CliRunner().invoke(app, ["compare", str(HOPKINS), "--pareto", str(out / "pareto.csv"),
+                                 "--rows", "1", "--box", "10", "--resolution", "5",
+                                 "--out", str(tmp_path / "cmp"), "--json"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)["designs"]
+    assert [x["label"] for x in d] == ["hopkins-williams-6psu", "tiny #1"]
+    # the Pareto row is the study's rank-1 candidate, evaluated with the compare protocol
+    from pkmlab import OrientationSet, load_mechanism, workspace
+    from pkmlab.study import candidate_mapping
+
+    front = pareto_records(res, records)
+    mech = load_mechanism(candidate_mapping(res["mechanism"], res["variables"],
+                                            front[0]["params"]))
+    ref = workspace(mech, "dexterous", OrientationSet.box(np.radians([10.0] * 3), samples=5),
+                    5.0)
+    assert d[1]["dexterous_volume_cm3"] == pytest.approx(ref.volume / 1e3)
+    assert (tmp_path / "cmp" / "compare.md").read_text().count("|") > 20
+    r = CliRunner().invoke(app, ["compare", "--pareto", str(out / "pareto.csv"), "--rows", "99"])
+    assert r.exit_code == 2 and "--rows" in r.stderr

@@ -885,6 +885,76 @@ def report(results_dir: Annotated[Path, typer.Argument(help="a study's results f
               f"{info['pareto']} Pareto designs")
 
 
+@app.command()
+def compare(
+    mech_files: Annotated[list[Path] | None, typer.Argument(help="Mechanism YAML files.")]
+    = None,
+    pareto: Annotated[Path | None, typer.Option(
+        help="a study's pareto.csv: compare its rows (with --rows)")] = None,
+    rows: Annotated[str | None, typer.Option(help='Pareto ranks, e.g. "1,3"')] = None,
+    box: Annotated[float, typer.Option(help="dexterous set: ±box° simultaneous")] = 15.0,
+    resolution: ResolutionOpt = "2.5",
+    out_dir: Annotated[Path, typer.Option("--out", help="output folder")]
+    = Path("results/compare"),
+    as_json: JsonOpt = False,
+) -> None:
+    """Compare designs side by side: volumes, inscribed shapes, GCI, κ, force, footprint,
+    stroke use on the paper's motion; writes compare.md and overlaid slice plots."""
+    import csv as csv_mod
+
+    from .config import load_mechanism as load_map
+    from .study.compare import compare_designs, comparison_markdown, plot_overlaid_slices
+    from .study.evaluate import candidate_mapping
+    from .study.store import Store
+
+    loaded = [_load(f) for f in (mech_files or [])]
+    designs = [(m.name or f.stem, m) for f, m in zip(mech_files or [], loaded)]
+    if pareto is not None:
+        store_path = pareto.parent / "evaluations.sqlite"
+        if not pareto.is_file() or not store_path.is_file():
+            _fail(ParameterError("--pareto", "a study's pareto.csv next to its "
+                                 "evaluations.sqlite", str(pareto)))
+        with open(pareto) as fh:
+            table = list(csv_mod.DictReader(fh))
+        wanted = [r.strip() for r in (rows or "1").split(",")]
+        store = Store(store_path)
+        resolved = store.get_meta("resolved")
+        records = {str(r["seq"]): r for r in store.all()}
+        store.close()
+        by_rank = {row["rank"]: row for row in table}
+        for w in wanted:
+            if w not in by_rank:
+                _fail(ParameterError("--rows", f"ranks present in {pareto.name} "
+                                     f"(1..{len(table)})", w))
+            rec = records[by_rank[w]["seq"]]
+            data = candidate_mapping(resolved["mechanism"], resolved["variables"],
+                                     rec["params"])
+            designs.append((f"{resolved['study']} #{w}", load_map(data)))
+    if len(designs) < 1:
+        _fail(ParameterError("MECH_FILES / --pareto", "at least one design", "none"))
+    try:
+        h = parse_length(resolution, "--resolution")
+    except ParameterError as exc:
+        _fail(exc)
+    if not (0 <= box <= 90):
+        _fail(ParameterError("--box", "an angle in [0, 90] deg", box))
+    table_rows = compare_designs(designs, box_deg=box, resolution=h)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    md = comparison_markdown(table_rows, box)
+    (out_dir / "compare.md").write_text(md)
+    plot_overlaid_slices(table_rows, out_dir / "compare_dexterous_slices.png", which=1)
+    plot_overlaid_slices(table_rows, out_dir / "compare_level_slices.png", which=0)
+    if as_json:
+        _emit({"designs": [{k: v for k, v in r.items() if k not in ("mechanism", "results")}
+                           for r in table_rows],
+               "files": [str(out_dir / n) for n in ("compare.md",
+                                                    "compare_dexterous_slices.png",
+                                                    "compare_level_slices.png")]})
+        return
+    out.print(md)
+    out.print(f"wrote {escape(str(out_dir))}/compare.md and overlaid slice plots")
+
+
 def main() -> None:
     app()
 
