@@ -290,3 +290,34 @@ def test_compare_files_and_pareto_rows(tmp_path, serial_run):
     assert (tmp_path / "cmp" / "compare.md").read_text().count("|") > 20
     r = CliRunner().invoke(app, ["compare", "--pareto", str(out / "pareto.csv"), "--rows", "99"])
     assert r.exit_code == 2 and "--rows" in r.stderr
+
+
+@pytest.mark.parametrize("optimizer, n", [({"method": "grid"}, 3 * 2 + 1),
+                                          ({"method": "lhs", "samples": 5}, 6),
+                                          ({"method": "de", "population": 4, "generations": 1},
+                                           None)])
+def test_other_optimisers_and_inline_mechanism(tmp_path, optimizer, n):
+    data = small_study(tmp_path, optimizer=optimizer)
+    data["mechanism"] = {"inline": {"name": "inline-6psu", "family": "psu6",
+                                    "generator": {"base_radii": [100, 165],
+                                                  "platform_radii": [50, 80],
+                                                  "platform_rotation": "33.7 deg"},
+                                    "link_length": "225 mm", "stroke": [0, "4 in"],
+                                    "tool_offset": [0, 0, 47]}}
+    data["design"] = {"platform_outer_radius": {"low": "60 mm", "high": "90 mm", "levels": 3},
+                      "link_length": {"type": "integer", "low": 220, "high": 230, "levels": 2}}
+    if optimizer["method"] == "lhs":
+        data["design"]["pairing"] = {"choices": ["same", "crossed"]}
+    if optimizer["method"] == "de":
+        data["objectives"] = [{"maximize": "dexterous_volume"}]
+    _, res = load_study(write(tmp_path, data))
+    store = run_study(res, SerialRunner())
+    recs = store.all()
+    store.close()
+    if n is not None:
+        assert len(recs) == n
+    cand = [r for r in recs if r["role"] == "candidate"]
+    assert cand and all(isinstance(r["params"]["link_length"], int) for r in cand)
+    assert all(220 <= r["params"]["link_length"] <= 230 for r in cand)
+    if optimizer["method"] == "lhs":
+        assert {r["params"]["pairing"] for r in cand} == {"same", "crossed"}

@@ -457,6 +457,7 @@ DESIGN_ALIASES: dict[str, dict[str, tuple[str, str]]] = {
         "stroke_min": ("stroke[0]", "length"),
         "stroke_max": ("stroke[1]", "length"),
         "tool_offset_z": ("tool_offset[2]", "length"),
+        "pairing": ("generator.pairing", "text"),
         **({"link_length": ("link_length", "length")} if fam == "psu6" else {}),
     } for fam in ("psu6", "ups6")
 }
@@ -469,7 +470,7 @@ DESIGN_ALIASES["luzi3"] = {
     "stroke_max": ("stroke[1]", "length"),
 }
 _QUANTITY = {"length": (parse_length, "mm"), "angle": (parse_angle, "deg"),
-             "number": (None, "")}
+             "number": (None, ""), "text": ("text", "")}
 
 
 class DesignVariableSpec(_Model):
@@ -480,7 +481,7 @@ class DesignVariableSpec(_Model):
     choices: list[Any] | None = None
     type: Literal["continuous", "integer", "choice"] | None = None
     path: str | None = Field(None, description="mechanism field, e.g. generator.base_radii[1]")
-    quantity: Literal["length", "angle", "number"] | None = None
+    quantity: Literal["length", "angle", "number", "text"] | None = None
     levels: int = Field(5, ge=2, le=1000, description="grid optimiser: values per variable")
 
 
@@ -512,8 +513,12 @@ class OptimizerSpec(_Model):
 
 
 class MechanismSource(_Model):
-    file: str = Field(description="mechanism YAML, relative to the study file")
+    """A mechanism file plus overrides, or (``inline``) the mechanism mapping itself."""
+
+    file: str | None = Field(None, description="mechanism YAML, relative to the study file")
     overrides: dict[str, Any] = Field(default_factory=dict)
+    inline: dict[str, Any] | None = Field(None, description="a mechanism mapping (family, "
+                                          "generator, ...) instead of a file")
 
 
 class StudySpec(_Model):
@@ -546,7 +551,15 @@ def _design_variable(name: str, v: DesignVariableSpec, family: str) -> dict:
     kind = v.type or ("choice" if v.choices is not None else "continuous")
     parse, unit = _QUANTITY[quantity]
 
+    if quantity == "text" and kind != "choice":
+        raise ParameterError(f"{field}.choices", "a list of choices (a text variable has no "
+                             "range)", None)
+
     def conv(x, which):
+        if parse == "text":
+            if not isinstance(x, str):
+                raise ParameterError(f"{field}.{which}", "a text choice", x)
+            return x
         try:
             if parse is None:
                 if isinstance(x, bool) or not isinstance(x, int | float):
@@ -593,20 +606,35 @@ def load_study(source: str | Path):
         spec = StudySpec.model_validate(data)
     except ValidationError as exc:
         raise _translate(exc) from None
-    mech_path = (path.parent / spec.mechanism.file).resolve()
-    mech_data = _read_yaml(mech_path, "mechanism") if mech_path.is_file() else None
-    if not isinstance(mech_data, dict):
-        raise ParameterError("mechanism.file", "an existing mechanism YAML file",
-                             spec.mechanism.file)
-    mech_data = _merge(mech_data, spec.mechanism.overrides)
+    src = spec.mechanism
+    if (src.file is None) == (src.inline is None):
+        raise ParameterError("mechanism", "exactly one of 'file' (with optional 'overrides') "
+                             "or 'inline'", sorted(k for k in ("file", "inline")
+                                                   if getattr(src, k) is not None))
+    if src.file is not None:
+        mech_path = (path.parent / src.file).resolve()
+        mech_data = _read_yaml(mech_path, "mechanism") if mech_path.is_file() else None
+        if not isinstance(mech_data, dict):
+            raise ParameterError("mechanism.file", "an existing mechanism YAML file", src.file)
+    else:
+        mech_path, mech_data = path, dict(src.inline)
+    mech_data = _merge(mech_data, src.overrides)
     try:
         mech = load_mechanism(mech_data)
     except ParameterError as exc:
         raise ParameterError(f"mechanism.{exc.field}", exc.allowed, exc.got) from None
     variables = [_design_variable(n, v, mech.family) for n, v in spec.design.items()]
-    for var in variables:                      # the path must exist in the mechanism mapping
+    for var in variables:            # the path's parent must exist in the mechanism mapping
         try:
-            get_path(mech_data, var["path"])
+            parts = _path_parts(var["path"])
+            node = mech_data
+            for p in parts[:-1]:
+                node = node[p]
+            leaf = parts[-1]
+            if isinstance(leaf, int):
+                node[leaf]
+            elif not isinstance(node, dict):
+                raise TypeError(var["path"])
         except (KeyError, IndexError, TypeError):
             raise ParameterError(f"design.{var['name']}.path", "a field present in the "
                                  "mechanism file (generator block, stroke, ...)",

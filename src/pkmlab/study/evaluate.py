@@ -26,9 +26,12 @@ def candidate_mapping(base: dict, variables: list[dict], values: dict) -> dict:
     data = base
     for v in variables:
         x = values[v["name"]]
+        if v["quantity"] == "text":
+            data = set_path(data, v["path"], x)
+            continue
         if v["quantity"] == "angle":
             x = math.degrees(x)                  # bare numbers in mechanism files are degrees
-        data = set_path(data, v["path"], float(x) if v["type"] != "integer" else int(x))
+        data = set_path(data, v["path"], int(x) if v["type"] == "integer" else float(x))
     return data
 
 

@@ -38,8 +38,6 @@ def pareto_mask(F: np.ndarray) -> np.ndarray:
 
 def display_value(var: dict, x):
     """A parameter in display units (mm, deg) for tables."""
-    if var["quantity"] == "angle" and var["type"] != "choice":
-        return math.degrees(x)
     if var["quantity"] == "angle":
         return math.degrees(x)
     return x
