@@ -65,7 +65,8 @@ class Constraints:
             their axes come closer than it. ``None`` = not checked.
         kappa_max: largest admissible homogenised condition number, or ``None``.
         characteristic_length: L_c (mm) dividing the rotational Jacobian columns for κ;
-            ``None`` = the mean platform joint radius about the tool point.
+            ``None`` = Angeles' (the L minimising κ at the nominal pose, resolved by
+            :func:`pkmlab.workspace` and shown in the result's metrics).
         connected: keep only the region connected to the nominal position (drops mirror
             regions that the stroke alone admits).
     """

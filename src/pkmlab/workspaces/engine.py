@@ -68,6 +68,12 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
     if cons.stroke is not True:
         # the same geometry with another actuator window (the family re-validates it)
         mech = dataclasses.replace(mech, stroke_window=cons.stroke)
+    if cons.kappa_max is not None and cons.characteristic_length is None:
+        from ..dexterity import characteristic_length
+
+        cl = characteristic_length(mech)          # Angeles': the L minimising κ at nominal
+        if cl.ok:
+            cons = dataclasses.replace(cons, characteristic_length=cl.length)
     oset = orientations or OrientationSet.fixed()
     if kind == "constant" and oset.kind != "fixed":
         raise ParameterError("orientations", "a single fixed orientation for kind 'constant'",
