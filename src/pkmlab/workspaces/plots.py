@@ -62,7 +62,12 @@ def slice_figure(result, window: float = 152.4, spacing: float = 12.7, centre=No
     if im is not None:
         fig.colorbar(im, ax=axes, shrink=0.6, label=label)
     name = getattr(result.mechanism, "name", "") or result.mechanism.family
-    fig.suptitle(f"{name}: {result.kind} workspace\n{window:g} × {window:g} mm top views "
+    if result.empty:
+        axes.ravel()[0].text(0.5, 0.5, "empty: no position satisfies\nthe constraints",
+                             ha="center", va="center", transform=axes.ravel()[0].transAxes,
+                             fontsize=8)
+    empty = " (empty)" if result.empty else ""
+    fig.suptitle(f"{name}: {result.kind} workspace{empty}\n{window:g} × {window:g} mm top views "
                  f"every {spacing:g} mm, lowest top-left", fontsize=9)
     return fig
 
