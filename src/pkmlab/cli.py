@@ -789,20 +789,19 @@ def schema() -> None:
 
 def _progress_bar(total: int):
     """A rich progress bar with rate and ETA on a terminal, nothing otherwise."""
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
+    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, ProgressColumn,
+                               TextColumn, TimeElapsedColumn, TimeRemainingColumn)
+    from rich.text import Text
+
+    class Rate(ProgressColumn):
+        def render(self, task):
+            return Text(f"{task.speed:.1f} candidates/s" if task.speed else "… candidates/s")
 
     if not err.is_terminal:
         return None, (lambda n: None)
-    prog = Progress(TextColumn("evaluating"), BarColumn(), MofNCompleteColumn(),
-                    TextColumn("{task.completed} done"), TimeElapsedColumn(),
-                    TimeRemainingColumn(), console=err, transient=True)
+    prog = Progress(TextColumn("evaluating"), BarColumn(), MofNCompleteColumn(), Rate(),
+                    TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(),
+                    console=err, transient=True)
     task = prog.add_task("eval", total=total)
     return prog, (lambda n: prog.advance(task, n))
 
