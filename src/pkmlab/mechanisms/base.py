@@ -298,11 +298,12 @@ class Mechanism:
         q = np.empty((n, 6))
         st = np.empty((n, 6), dtype=np.int8)
         reason = np.empty(n, dtype=np.int8)
+        g = tuple(self._gparams().tolist())  # a tuple: constants to the compiled loops
         if R is None:
-            euler(X_or_p, self._gparams(), lo, hi, q, st, reason)
+            euler(np.ascontiguousarray(X_or_p), g, lo, hi, q, st, reason)
         else:
-            frames(np.ascontiguousarray(X_or_p), np.ascontiguousarray(R), self._gparams(),
-                   lo, hi, q, st, reason)
+            frames(np.ascontiguousarray(X_or_p), np.ascontiguousarray(R), g, lo, hi, q, st,
+                   reason)
         return IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st)
 
     def jacobian(self, poses: np.ndarray) -> np.ndarray:

@@ -25,7 +25,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from numba.extending import register_jitable
 
 from ..errors import ParameterError
 from ..poses import as_frames, frames_to_poses, skew
@@ -35,42 +35,53 @@ from .base import Mechanism, as_points, as_positive, as_stroke, as_vector3
 __all__ = ["Luzi3", "pose_to_psi", "psi_to_pose", "reduced_dpa", "ReducedDPAResult"]
 
 
-@njit(cache=True, inline="always")
-def _luzi_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st, k):
+@register_jitable(inline="always")
+def _luzi_chain(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, i):
+    """Chain ``i``: lengths ``(q_i1, q_i2)`` of its legs, and False where the chain is degenerate
+    (its plane parallel to the platform normal, |k × u_i| ≈ 0; the lengths are then garbage)."""
+    a1x, a1y, a1z = g[6 * i], g[6 * i + 1], g[6 * i + 2]
+    a2x, a2y, a2z = g[6 * i + 3], g[6 * i + 4], g[6 * i + 5]
+    ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
     half = 0.5 * g[27]
     kx, ky, kz = r02, r12, r22
-    worst = _kernels.OK
-    for i in range(3):
-        a1x, a1y, a1z = g[6 * i], g[6 * i + 1], g[6 * i + 2]
-        a2x, a2y, a2z = g[6 * i + 3], g[6 * i + 4], g[6 * i + 5]
-        ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
-        cx = px + r00 * ux + r01 * uy + r02 * uz
-        cy = py + r10 * ux + r11 * uy + r12 * uz
-        cz = pz + r20 * ux + r21 * uy + r22 * uz
-        rx, ry, rz = a2x - a1x, a2y - a1y, a2z - a1z
-        dx, dy, dz = cx - a1x, cy - a1y, cz - a1z
-        wx, wy, wz = ry * dz - rz * dy, rz * dx - rx * dz, rx * dy - ry * dx
-        nx, ny, nz = ky * wz - kz * wy, kz * wx - kx * wz, kx * wy - ky * wx
-        nn = math.sqrt(nx * nx + ny * ny + nz * nz)
-        scale = math.sqrt(rx * rx + ry * ry + rz * rz) * math.sqrt(dx * dx + dy * dy + dz * dz)
-        if not nn > 1e-12 * scale:
-            q[k, 2 * i] = np.nan
-            q[k, 2 * i + 1] = np.nan
-            st[k, 2 * i] = _kernels.DEGENERATE
-            st[k, 2 * i + 1] = _kernels.DEGENERATE
-            worst = _kernels.DEGENERATE if worst < _kernels.DEGENERATE else worst
-            continue
-        s = half / nn if nx * rx + ny * ry + nz * rz >= 0.0 else -half / nn
-        ex, ey, ez = cx - s * nx - a1x, cy - s * ny - a1y, cz - s * nz - a1z
-        v1 = math.sqrt(ex * ex + ey * ey + ez * ez)
-        ex, ey, ez = cx + s * nx - a2x, cy + s * ny - a2y, cz + s * nz - a2z
-        v2 = math.sqrt(ex * ex + ey * ey + ez * ez)
-        q[k, 2 * i], q[k, 2 * i + 1] = v1, v2
-        s1 = _kernels.stroke_status(v1, qmin, qmax)
-        s2 = _kernels.stroke_status(v2, qmin, qmax)
-        st[k, 2 * i], st[k, 2 * i + 1] = s1, s2
-        worst = max(worst, max(s1, s2))
-    return worst
+    cx = px + r00 * ux + r01 * uy + r02 * uz
+    cy = py + r10 * ux + r11 * uy + r12 * uz
+    cz = pz + r20 * ux + r21 * uy + r22 * uz
+    rx, ry, rz = a2x - a1x, a2y - a1y, a2z - a1z
+    dx, dy, dz = cx - a1x, cy - a1y, cz - a1z
+    wx, wy, wz = ry * dz - rz * dy, rz * dx - rx * dz, rx * dy - ry * dx
+    nx, ny, nz = ky * wz - kz * wy, kz * wx - kx * wz, kx * wy - ky * wx
+    nn = math.sqrt(nx * nx + ny * ny + nz * nz)
+    scale = math.sqrt(rx * rx + ry * ry + rz * rz) * math.sqrt(dx * dx + dy * dy + dz * dz)
+    # ±1 such that t_i · r_i >= 0 (arithmetic, not a conditional expression: this function is
+    # inlined twice over, where numba's IR inliner mishandles conditional expressions)
+    sign = (nx * rx + ny * ry + nz * rz >= 0.0) * 2.0 - 1.0
+    s = sign * (half / nn)
+    ex, ey, ez = cx - s * nx - a1x, cy - s * ny - a1y, cz - s * nz - a1z
+    v1 = math.sqrt(ex * ex + ey * ey + ez * ez)
+    ex, ey, ez = cx + s * nx - a2x, cy + s * ny - a2y, cz + s * nz - a2z
+    v2 = math.sqrt(ex * ex + ey * ey + ez * ez)
+    return v1, v2, nn > 1e-12 * scale
+
+
+@register_jitable(inline="always")
+def _luzi_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st, j):
+    """Per-pose inverse kinematics (see :mod:`._kernels`); both legs of a degenerate chain are
+    ``DEGENERATE`` with NaN lengths.
+
+    Branch-free (the degenerate case is computed too, a division by zero that is discarded),
+    and the chains are unrolled by hand so that ``g`` is indexed by constants.
+    """
+    chains = (_luzi_chain(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, 0),
+              _luzi_chain(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, 1),
+              _luzi_chain(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, 2))
+    for i, (v1, v2, ok) in enumerate(chains):
+        k = 2 * i * _kernels.BLOCK + j
+        q[k] = v1 if ok else np.nan
+        st[k] = _kernels.stroke_status(v1, qmin, qmax) if ok else _kernels.DEGENERATE
+        k += _kernels.BLOCK
+        q[k] = v2 if ok else np.nan
+        st[k] = _kernels.stroke_status(v2, qmin, qmax) if ok else _kernels.DEGENERATE
 
 
 @dataclass(frozen=True)

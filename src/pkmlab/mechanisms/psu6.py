@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
+from numba.extending import register_jitable
 
 from ..errors import ParameterError
 from . import _kernels
@@ -29,9 +30,9 @@ from .layout import build_paired
 __all__ = ["PSU6"]
 
 
-@njit(cache=True, inline="always")
-def _psu_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st, k):
-    worst = _kernels.OK
+@register_jitable(inline="always")
+def _psu_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st, j):
+    """Per-pose inverse kinematics (see :mod:`._kernels`): eq. (6), NaN where h² < 0."""
     for i in range(6):
         bx, by, bz = g[3 * i], g[3 * i + 1], g[3 * i + 2]
         ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
@@ -40,14 +41,11 @@ def _psu_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, q
         ay = py + r10 * ux + r11 * uy + r12 * uz - by
         wz = pz + r20 * ux + r21 * uy + r22 * uz
         h2 = ll * ll - ax * ax - ay * ay
-        # Branch-free: a third of random poses lack a root, which defeats branch prediction.
         real = h2 >= 0.0
         v = wz - bz - math.sqrt(h2 if real else 0.0)
-        q[k, i] = v if real else np.nan
-        s = _kernels.stroke_status(v, qmin, qmax) if real else _kernels.NO_SOLUTION
-        st[k, i] = s
-        worst = max(worst, s)
-    return worst
+        k = i * _kernels.BLOCK + j
+        q[k] = v if real else np.nan
+        st[k] = _kernels.stroke_status(v, qmin, qmax) if real else _kernels.NO_SOLUTION
 
 
 @njit(inline="always")

@@ -17,6 +17,7 @@ from functools import cached_property
 
 import numpy as np
 from numba import njit
+from numba.extending import register_jitable
 
 from ..poses import euler_to_matrix
 from . import _kernels
@@ -27,9 +28,10 @@ from .psu6 import _radii
 __all__ = ["UPS6"]
 
 
-@njit(cache=True, inline="always")
-def _ups_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st, k):
-    worst = _kernels.OK
+@register_jitable(inline="always")
+def _ups_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st, j):
+    """Per-pose inverse kinematics (see :mod:`._kernels`): leg lengths; ``g[36 + i]`` is leg
+    i's working-mode side (±1), a leg on the other side of its base joint is ``OTHER_MODE``."""
     for i in range(6):
         bx, by, bz = g[3 * i], g[3 * i + 1], g[3 * i + 2]
         ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
@@ -37,16 +39,10 @@ def _ups_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, q
         sy = py + r10 * ux + r11 * uy + r12 * uz - by
         sz = pz + r20 * ux + r21 * uy + r22 * uz - bz
         v = math.sqrt(sx * sx + sy * sy + sz * sz)
-        q[k, i] = v
-        if v < 1e-12:
-            s = _kernels.DEGENERATE
-        elif sz * g[36 + i] <= 0.0:
-            s = _kernels.OTHER_MODE
-        else:
-            s = _kernels.stroke_status(v, qmin, qmax)
-        st[k, i] = s
-        worst = max(worst, s)
-    return worst
+        s = _kernels.OTHER_MODE if sz * g[36 + i] <= 0.0 else _kernels.stroke_status(v, qmin, qmax)
+        k = i * _kernels.BLOCK + j
+        q[k] = v
+        st[k] = _kernels.DEGENERATE if v < 1e-12 else s
 
 
 @njit(inline="always")
