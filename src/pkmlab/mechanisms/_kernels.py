@@ -1,10 +1,11 @@
 """Numba drivers shared by every family's inverse kinematics.
 
 Each family supplies a per-pose function ``one(px, py, pz, r00, ..., r22, g, qmin, qmax, q, st,
-j)``, declared with :func:`numba.extending.register_jitable`, that writes the six actuator values
-and leg status codes of one pose with :func:`put`. :func:`make_drivers` wraps it in parallel
-drivers over poses; the family function is captured as a compile-time constant, so it is inlined
-and a new family needs no driver code of its own.
+j)``, declared with ``numba.extending.register_jitable(inline="always")``, that writes the
+actuator value and status code of each leg ``i`` of block pose ``j`` to ``q[i * ROW + j]`` and
+``st[i * ROW + j]``. :func:`make_drivers` wraps it in parallel drivers over poses; the family
+function is captured as a compile-time constant and inlined, so a new family needs no driver
+code of its own.
 
 The drivers work on blocks of :data:`BLOCK` poses held as structure-of-arrays buffers, so that
 LLVM vectorises each stage over the poses of a block:
@@ -13,15 +14,17 @@ LLVM vectorises each stage over the poses of a block:
    ``r00 ... r22`` into rows 3-11 (Euler input: sines and cosines by the vectorisable
    :func:`_sincos`, the Z-Y-X product by :func:`_euler_matrix`);
 2. legs: call ``one`` for every pose ``j`` of the block; it writes leg ``i`` to slot
-   ``i * BLOCK + j`` of the leg-major buffers ``q`` (float64) and ``st`` (int8);
+   ``i * ROW + j`` of the leg-major buffers ``q`` (float64) and ``st`` (int8);
 3. store: transpose the buffers into the ``(N, 6)`` outputs and take each pose's reason, the
    most severe leg status.
 
 For stage 2 to vectorise, ``one`` must be branch-free (conditional expressions that LLVM turns
-into selects, no early exit or ``continue``), and ``g``, the family's geometry, is passed as a
-tuple of floats, so its entries are constants to the loop rather than memory that the output
-buffers might alias. Every pose of a block goes through the same code, whatever its position
-in the batch, so a pose's result does not depend on the batch it is part of.
+into selects, no early exit or ``continue``), its loop over legs must be small enough for LLVM
+to unroll it (``g`` is then indexed by constants; see ``_luzi_one`` for a hand-unrolled one),
+and ``g``, the family's geometry, is passed as a tuple of floats, so its entries are constants
+to the loop rather than memory that the output buffers might alias. Every pose goes through the
+same code, whatever its position in the batch, so a pose's result does not depend on the batch
+it is part of.
 
 Poses with a non-finite coordinate (and, in the Euler driver, poses with an angle beyond
 :data:`TRIG_MAX`, whose rotation is then taken from ``math.sin``/``math.cos``) take a scalar
@@ -39,16 +42,19 @@ from functools import cache
 import numpy as np
 from numba import njit, prange
 
-__all__ = ["BLOCK", "make_drivers", "make_column_kernels", "make_leg_eval", "stroke_status"]
+__all__ = ["BLOCK", "ROW", "make_drivers", "make_column_kernels", "make_leg_eval", "stroke_status"]
 
 # Leg status codes, ordered by severity: a pose's reason is its legs' maximum.
 OK, BELOW_STROKE, ABOVE_STROKE, DEGENERATE, NO_SOLUTION, INVALID_INPUT = 0, 1, 2, 3, 4, 5
 # A leg on the other side of its base joint than at the nominal pose (another assembly mode).
 OTHER_MODE = 6
 
-#: Poses per block of the inverse-kinematics drivers (the buffers of a block, ~50 kB, stay in
-#: the L1/L2 caches).
-BLOCK = 256
+#: Poses per block of the inverse-kinematics drivers (the buffers of a block, ~110 kB, stay in
+#: the L2 cache).
+BLOCK = 512
+#: Row stride of the block buffers: a little more than BLOCK, so that the rows a loop streams
+#: through do not all map to the same cache sets (4 KiB aliasing).
+ROW = BLOCK + 8
 #: Largest angle sum |θx| + |θy| + |θz| (rad) for which the Euler driver uses :func:`_sincos`.
 TRIG_MAX = 1e5
 
@@ -112,15 +118,15 @@ def _euler_matrix(sx, cx, sy, cy, sz, cz):
 @njit(cache=True, inline="always")
 def _store_matrix(T, j, r):
     """Rotation entries ``r`` (9-tuple) into rows 3-11 of the block buffer ``T`` at pose ``j``."""
-    T[3 * BLOCK + j] = r[0]
-    T[4 * BLOCK + j] = r[1]
-    T[5 * BLOCK + j] = r[2]
-    T[6 * BLOCK + j] = r[3]
-    T[7 * BLOCK + j] = r[4]
-    T[8 * BLOCK + j] = r[5]
-    T[9 * BLOCK + j] = r[6]
-    T[10 * BLOCK + j] = r[7]
-    T[11 * BLOCK + j] = r[8]
+    T[3 * ROW + j] = r[0]
+    T[4 * ROW + j] = r[1]
+    T[5 * ROW + j] = r[2]
+    T[6 * ROW + j] = r[3]
+    T[7 * ROW + j] = r[4]
+    T[8 * ROW + j] = r[5]
+    T[9 * ROW + j] = r[6]
+    T[10 * ROW + j] = r[7]
+    T[11 * ROW + j] = r[8]
 
 
 # ---- stage 1: load a block ---------------------------------------------------------------------
@@ -136,23 +142,33 @@ def _load_euler(x, m, T, A, C):
         px, py, pz = x[6 * j], x[6 * j + 1], x[6 * j + 2]
         tx, ty, tz = x[6 * j + 3], x[6 * j + 4], x[6 * j + 5]
         T[j] = px
-        T[BLOCK + j] = py
-        T[2 * BLOCK + j] = pz
+        T[ROW + j] = py
+        T[2 * ROW + j] = pz
         A[j] = tx
-        A[BLOCK + j] = ty
-        A[2 * BLOCK + j] = tz
+        A[ROW + j] = ty
+        A[2 * ROW + j] = tz
         fast = math.isfinite(px + py + pz) & (abs(tx) + abs(ty) + abs(tz) <= TRIG_MAX)
         slow += 0 if fast else 1
     for j in range(m, BLOCK):                 # tail of the last block: harmless values
         for r in range(3):
-            T[r * BLOCK + j] = 0.0
-            A[r * BLOCK + j] = 0.0
-    for j in range(3 * BLOCK):
-        A[j], C[j] = _sincos(A[j])
+            T[r * ROW + j] = 0.0
+            A[r * ROW + j] = 0.0
+    _sincos_block(A, C)
     for j in range(BLOCK):
-        _store_matrix(T, j, _euler_matrix(A[j], C[j], A[BLOCK + j], C[BLOCK + j],
-                                          A[2 * BLOCK + j], C[2 * BLOCK + j]))
+        _store_matrix(T, j, _euler_matrix(A[j], C[j], A[ROW + j], C[ROW + j],
+                                          A[2 * ROW + j], C[2 * ROW + j]))
     return slow
+
+
+@njit(cache=True, fastmath={"contract"})
+def _sincos_block(A, C):
+    """Angles ``A`` (3·BLOCK) → their sines in place, cosines in ``C``.
+
+    Fused multiply-adds (``contract``) shorten the polynomials; they do not change the error
+    bound. Kept apart from the matrix products, which stay unfused as in ``euler_to_matrix``.
+    """
+    for j in range(3 * ROW):
+        A[j], C[j] = _sincos(A[j])
 
 
 @njit(cache=True)
@@ -176,15 +192,15 @@ def _load_frames(p, R, m, T):
     for j in range(m):
         total = p[3 * j] + p[3 * j + 1] + p[3 * j + 2]
         for r in range(3):
-            T[r * BLOCK + j] = p[3 * j + r]
+            T[r * ROW + j] = p[3 * j + r]
         for r in range(9):
             v = R[9 * j + r]
-            T[(3 + r) * BLOCK + j] = v
+            T[(3 + r) * ROW + j] = v
             total += v
         nbad += 0 if math.isfinite(total) else 1
     for j in range(m, BLOCK):
         for r in range(12):
-            T[r * BLOCK + j] = 0.0
+            T[r * ROW + j] = 0.0
     return nbad
 
 
@@ -205,8 +221,8 @@ def _store(q, st, m, q_out, st_out, reason_out):
     for j in range(m):
         worst = np.int8(OK)
         for i in range(6):
-            s = st[i * BLOCK + j]
-            q_out[6 * j + i] = q[i * BLOCK + j]
+            s = st[i * ROW + j]
+            q_out[6 * j + i] = q[i * ROW + j]
             st_out[6 * j + i] = s
             worst = max(worst, s)
         reason_out[j] = worst
@@ -250,20 +266,20 @@ def make_drivers(one):
             k0 = b * BLOCK
             m = min(BLOCK, n - k0)
             xb = x[6 * k0:6 * (k0 + m)]
-            T = np.empty(12 * BLOCK)
-            A = np.empty(3 * BLOCK)
-            C = np.empty(3 * BLOCK)
-            q = np.empty(6 * BLOCK)
-            st = np.empty(6 * BLOCK, dtype=np.int8)
+            T = np.empty(12 * ROW)
+            A = np.empty(3 * ROW)
+            C = np.empty(3 * ROW)
+            q = np.empty(6 * ROW)
+            st = np.empty(6 * ROW, dtype=np.int8)
             slow = _load_euler(xb, m, T, A, C)
             bad = np.zeros(BLOCK, dtype=np.bool_)
             if slow:
                 _euler_slow(xb, m, T, bad)
             for j in range(BLOCK):
-                one(T[j], T[BLOCK + j], T[2 * BLOCK + j],
-                    T[3 * BLOCK + j], T[4 * BLOCK + j], T[5 * BLOCK + j],
-                    T[6 * BLOCK + j], T[7 * BLOCK + j], T[8 * BLOCK + j],
-                    T[9 * BLOCK + j], T[10 * BLOCK + j], T[11 * BLOCK + j],
+                one(T[j], T[ROW + j], T[2 * ROW + j],
+                    T[3 * ROW + j], T[4 * ROW + j], T[5 * ROW + j],
+                    T[6 * ROW + j], T[7 * ROW + j], T[8 * ROW + j],
+                    T[9 * ROW + j], T[10 * ROW + j], T[11 * ROW + j],
                     g, qmin, qmax, q, st, j)
             out = slice(6 * k0, 6 * (k0 + m))
             _store(q, st, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
@@ -281,15 +297,15 @@ def make_drivers(one):
             k0 = b * BLOCK
             m = min(BLOCK, n - k0)
             pb, Rb = pf[3 * k0:3 * (k0 + m)], Rf[9 * k0:9 * (k0 + m)]
-            T = np.empty(12 * BLOCK)
-            q = np.empty(6 * BLOCK)
-            st = np.empty(6 * BLOCK, dtype=np.int8)
+            T = np.empty(12 * ROW)
+            q = np.empty(6 * ROW)
+            st = np.empty(6 * ROW, dtype=np.int8)
             nbad = _load_frames(pb, Rb, m, T)
             for j in range(BLOCK):
-                one(T[j], T[BLOCK + j], T[2 * BLOCK + j],
-                    T[3 * BLOCK + j], T[4 * BLOCK + j], T[5 * BLOCK + j],
-                    T[6 * BLOCK + j], T[7 * BLOCK + j], T[8 * BLOCK + j],
-                    T[9 * BLOCK + j], T[10 * BLOCK + j], T[11 * BLOCK + j],
+                one(T[j], T[ROW + j], T[2 * ROW + j],
+                    T[3 * ROW + j], T[4 * ROW + j], T[5 * ROW + j],
+                    T[6 * ROW + j], T[7 * ROW + j], T[8 * ROW + j],
+                    T[9 * ROW + j], T[10 * ROW + j], T[11 * ROW + j],
                     g, qmin, qmax, q, st, j)
             out = slice(6 * k0, 6 * (k0 + m))
             _store(q, st, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])

@@ -76,10 +76,10 @@ def _luzi_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, 
               _luzi_chain(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, 1),
               _luzi_chain(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, 2))
     for i, (v1, v2, ok) in enumerate(chains):
-        k = 2 * i * _kernels.BLOCK + j
+        k = 2 * i * _kernels.ROW + j
         q[k] = v1 if ok else np.nan
         st[k] = _kernels.stroke_status(v1, qmin, qmax) if ok else _kernels.DEGENERATE
-        k += _kernels.BLOCK
+        k += _kernels.ROW
         q[k] = v2 if ok else np.nan
         st[k] = _kernels.stroke_status(v2, qmin, qmax) if ok else _kernels.DEGENERATE
 

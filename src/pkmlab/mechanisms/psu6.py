@@ -43,7 +43,7 @@ def _psu_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, q
         h2 = ll * ll - ax * ax - ay * ay
         real = h2 >= 0.0
         v = wz - bz - math.sqrt(h2 if real else 0.0)
-        k = i * _kernels.BLOCK + j
+        k = i * _kernels.ROW + j
         q[k] = v if real else np.nan
         st[k] = _kernels.stroke_status(v, qmin, qmax) if real else _kernels.NO_SOLUTION
 

@@ -40,7 +40,7 @@ def _ups_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, q
         sz = pz + r20 * ux + r21 * uy + r22 * uz - bz
         v = math.sqrt(sx * sx + sy * sy + sz * sz)
         s = _kernels.OTHER_MODE if sz * g[36 + i] <= 0.0 else _kernels.stroke_status(v, qmin, qmax)
-        k = i * _kernels.BLOCK + j
+        k = i * _kernels.ROW + j
         q[k] = v
         st[k] = _kernels.DEGENERATE if v < 1e-12 else s
 
