@@ -19,12 +19,14 @@ LLVM vectorises each stage over the poses of a block:
    most severe leg status.
 
 For stage 2 to vectorise, ``one`` must be branch-free (conditional expressions that LLVM turns
-into selects, no early exit or ``continue``), its loop over legs must be small enough for LLVM
-to unroll it (``g`` is then indexed by constants; see ``_luzi_one`` for a hand-unrolled one),
-and ``g``, the family's geometry, is passed as a tuple of floats, so its entries are constants
-to the loop rather than memory that the output buffers might alias. Every pose goes through the
-same code, whatever its position in the batch, so a pose's result does not depend on the batch
-it is part of.
+into selects, no early exit or ``continue``; helpers it calls are ``njit(inline="always")``),
+its loop over legs must be small enough for LLVM to unroll it (``g`` is then indexed by
+constants; see ``_luzi_one`` for a hand-unrolled one), and ``g``, the family's geometry, is
+passed as a tuple of floats, so its entries are constants to the loop rather than memory that
+the output buffers might alias. The stage loops run from 0 (numba's negative-index handling
+otherwise hides from LLVM that the indices are >= 0) over the block's poses rounded up to
+:data:`LANES`, so every pose goes through the same vector code, whatever its position in the
+batch: a pose's result does not depend on the batch it is part of.
 
 Poses with a non-finite coordinate (and, in the Euler driver, poses with an angle beyond
 :data:`TRIG_MAX`, whose rotation is then taken from ``math.sin``/``math.cos``) take a scalar
@@ -41,6 +43,7 @@ from functools import cache
 
 import numpy as np
 from numba import njit, prange
+from numba.extending import register_jitable
 
 __all__ = ["BLOCK", "ROW", "make_drivers", "make_column_kernels", "make_leg_eval", "stroke_status"]
 
@@ -55,6 +58,10 @@ BLOCK = 512
 #: Row stride of the block buffers: a little more than BLOCK, so that the rows a loop streams
 #: through do not all map to the same cache sets (4 KiB aliasing).
 ROW = BLOCK + 8
+#: The stages run over a block's poses rounded up to a multiple of LANES (a multiple of any
+#: SIMD width × unroll LLVM picks), so every pose goes through the vector loop bodies and a
+#: short batch does not pay for a whole block.
+LANES = 64
 #: Largest angle sum |θx| + |θy| + |θz| (rad) for which the Euler driver uses :func:`_sincos`.
 TRIG_MAX = 1e5
 
@@ -129,13 +136,19 @@ def _store_matrix(T, j, r):
     T[11 * ROW + j] = r[8]
 
 
+@njit(cache=True, inline="always")
+def _width(m):
+    """``m`` rounded up to a multiple of LANES (the low bits are then known zero to LLVM)."""
+    return (m + LANES - 1) & ~(LANES - 1)
+
+
 # ---- stage 1: load a block ---------------------------------------------------------------------
 @njit(cache=True)
-def _load_euler(x, m, T, A, C):
+def _load_euler(x, m, w, T, A, C):
     """Block of ``m`` Euler poses (``x`` flat, 6 per pose) → ``T``; returns the number of poses
     that need :func:`_euler_slow` (non-finite, or angles beyond ``TRIG_MAX``).
 
-    ``A`` and ``C`` (3·BLOCK each) are scratch: the angles, then their sines and cosines.
+    ``A`` and ``C`` (3 rows of ROW each) are scratch: the angles, then their sines and cosines.
     """
     slow = 0
     for j in range(m):
@@ -149,26 +162,27 @@ def _load_euler(x, m, T, A, C):
         A[2 * ROW + j] = tz
         fast = math.isfinite(px + py + pz) & (abs(tx) + abs(ty) + abs(tz) <= TRIG_MAX)
         slow += 0 if fast else 1
-    for j in range(m, BLOCK):                 # tail of the last block: harmless values
+    for j in range(m, w):                     # padding up to w: harmless values
         for r in range(3):
             T[r * ROW + j] = 0.0
             A[r * ROW + j] = 0.0
-    _sincos_block(A, C)
-    for j in range(BLOCK):
+    _sincos_block(A, C, w)
+    for j in range(w):
         _store_matrix(T, j, _euler_matrix(A[j], C[j], A[ROW + j], C[ROW + j],
                                           A[2 * ROW + j], C[2 * ROW + j]))
     return slow
 
 
 @njit(cache=True, fastmath={"contract"})
-def _sincos_block(A, C):
-    """Angles ``A`` (3·BLOCK) → their sines in place, cosines in ``C``.
+def _sincos_block(A, C, w):
+    """Angles ``A`` (3 rows, first ``w`` of each) → their sines in place, cosines in ``C``.
 
     Fused multiply-adds (``contract``) shorten the polynomials; they do not change the error
     bound. Kept apart from the matrix products, which stay unfused as in ``euler_to_matrix``.
     """
-    for j in range(3 * ROW):
-        A[j], C[j] = _sincos(A[j])
+    for r in range(3):
+        for j in range(w):      # not range(r * ROW, ...): LLVM must see the index is >= 0
+            A[r * ROW + j], C[r * ROW + j] = _sincos(A[r * ROW + j])
 
 
 @njit(cache=True)
@@ -185,7 +199,7 @@ def _euler_slow(x, m, T, bad):
 
 
 @njit(cache=True)
-def _load_frames(p, R, m, T):
+def _load_frames(p, R, m, w, T):
     """Block of ``m`` frames (``p`` flat 3 per pose, ``R`` flat 9 per pose) → ``T``; returns the
     number of non-finite poses."""
     nbad = 0
@@ -198,7 +212,7 @@ def _load_frames(p, R, m, T):
             T[(3 + r) * ROW + j] = v
             total += v
         nbad += 0 if math.isfinite(total) else 1
-    for j in range(m, BLOCK):
+    for j in range(m, w):
         for r in range(12):
             T[r * ROW + j] = 0.0
     return nbad
@@ -251,62 +265,67 @@ def _fingerprint(fn) -> tuple:
 def make_drivers(one):
     """Parallel drivers ``(euler, frames)`` for the per-pose function ``one``.
 
-    ``one`` must be a module-level function declared with ``register_jitable``: the drivers are
-    closures over it, cached on disk under a key that names ``one`` and its file's stamp.
+    ``one`` must be a module-level function declared with ``register_jitable``. The drivers are
+    cached on disk under a key that includes what their closure holds, pickled: ``legs``, a plain
+    function (a numba dispatcher would pickle differently in every process) that holds ``one``
+    (by name) and the stamp of ``one``'s file (numba itself only watches this file). ``legs`` is
+    compiled as a function of its own, which keeps the parallel loop bodies small: numba's
+    parfor passes are slow on large ones.
     """
     source = _fingerprint(one)
 
-    @njit(parallel=True, cache=True, error_model="numpy")
+    @register_jitable(error_model="numpy")
+    def legs(T, w, g, qmin, qmax, q, st):
+        """Stage 2 over the first ``w`` poses of a block."""
+        source  # noqa: B018 - in the closure, so the cache key changes with ``one``'s file
+        for j in range(w):
+            one(T[j], T[ROW + j], T[2 * ROW + j],
+                T[3 * ROW + j], T[4 * ROW + j], T[5 * ROW + j],
+                T[6 * ROW + j], T[7 * ROW + j], T[8 * ROW + j],
+                T[9 * ROW + j], T[10 * ROW + j], T[11 * ROW + j],
+                g, qmin, qmax, q, st, j)
+
+    @njit(parallel=True, cache=True)
     def drive_euler(poses, g, qmin, qmax, q_out, st_out, reason_out):
         """Inverse kinematics over Euler poses ``(N, 6)`` (R = Rz·Ry·Rx), C-contiguous."""
-        source  # noqa: B018 - in the closure, so the cache key changes with ``one``'s file
         n = poses.shape[0]
         x, q_flat, st_flat = poses.reshape(-1), q_out.reshape(-1), st_out.reshape(-1)
         for b in prange((n + BLOCK - 1) // BLOCK):
             k0 = b * BLOCK
             m = min(BLOCK, n - k0)
+            w = _width(m)
             xb = x[6 * k0:6 * (k0 + m)]
             T = np.empty(12 * ROW)
             A = np.empty(3 * ROW)
             C = np.empty(3 * ROW)
             q = np.empty(6 * ROW)
             st = np.empty(6 * ROW, dtype=np.int8)
-            slow = _load_euler(xb, m, T, A, C)
+            slow = _load_euler(xb, m, w, T, A, C)
             bad = np.zeros(BLOCK, dtype=np.bool_)
             if slow:
                 _euler_slow(xb, m, T, bad)
-            for j in range(BLOCK):
-                one(T[j], T[ROW + j], T[2 * ROW + j],
-                    T[3 * ROW + j], T[4 * ROW + j], T[5 * ROW + j],
-                    T[6 * ROW + j], T[7 * ROW + j], T[8 * ROW + j],
-                    T[9 * ROW + j], T[10 * ROW + j], T[11 * ROW + j],
-                    g, qmin, qmax, q, st, j)
+            legs(T, w, g, qmin, qmax, q, st)
             out = slice(6 * k0, 6 * (k0 + m))
             _store(q, st, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
             if slow:
                 _store_invalid(bad, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
 
-    @njit(parallel=True, cache=True, error_model="numpy")
+    @njit(parallel=True, cache=True)
     def drive_frames(p, R, g, qmin, qmax, q_out, st_out, reason_out):
         """Inverse kinematics over positions ``(N, 3)`` and rotations ``(N, 3, 3)``."""
-        source  # noqa: B018 - in the closure, so the cache key changes with ``one``'s file
         n = p.shape[0]
         pf, Rf = p.reshape(-1), R.reshape(-1)
         q_flat, st_flat = q_out.reshape(-1), st_out.reshape(-1)
         for b in prange((n + BLOCK - 1) // BLOCK):
             k0 = b * BLOCK
             m = min(BLOCK, n - k0)
+            w = _width(m)
             pb, Rb = pf[3 * k0:3 * (k0 + m)], Rf[9 * k0:9 * (k0 + m)]
             T = np.empty(12 * ROW)
             q = np.empty(6 * ROW)
             st = np.empty(6 * ROW, dtype=np.int8)
-            nbad = _load_frames(pb, Rb, m, T)
-            for j in range(BLOCK):
-                one(T[j], T[ROW + j], T[2 * ROW + j],
-                    T[3 * ROW + j], T[4 * ROW + j], T[5 * ROW + j],
-                    T[6 * ROW + j], T[7 * ROW + j], T[8 * ROW + j],
-                    T[9 * ROW + j], T[10 * ROW + j], T[11 * ROW + j],
-                    g, qmin, qmax, q, st, j)
+            nbad = _load_frames(pb, Rb, m, w, T)
+            legs(T, w, g, qmin, qmax, q, st)
             out = slice(6 * k0, 6 * (k0 + m))
             _store(q, st, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
             if nbad:

@@ -298,13 +298,19 @@ class Mechanism:
         q = np.empty((n, 6))
         st = np.empty((n, 6), dtype=np.int8)
         reason = np.empty(n, dtype=np.int8)
-        g = tuple(self._gparams().tolist())  # a tuple: constants to the compiled loops
+        g = self._ik_geometry
         if R is None:
             euler(np.ascontiguousarray(X_or_p), g, lo, hi, q, st, reason)
         else:
             frames(np.ascontiguousarray(X_or_p), np.ascontiguousarray(R), g, lo, hi, q, st,
                    reason)
         return IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st)
+
+    @cached_property
+    def _ik_geometry(self) -> tuple:
+        """``_gparams()`` as a tuple of floats: the IK drivers' loops see its entries as
+        constants (see :mod:`._kernels`)."""
+        return tuple(self._gparams().tolist())
 
     def jacobian(self, poses: np.ndarray) -> np.ndarray:
         """Analytic velocity Jacobian ``(N, 6, 6)``: ``q̇ = J · [v; ω]``.

@@ -25,6 +25,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from numba.extending import register_jitable
 
 from ..errors import ParameterError
@@ -35,7 +36,7 @@ from .base import Mechanism, as_points, as_positive, as_stroke, as_vector3
 __all__ = ["Luzi3", "pose_to_psi", "psi_to_pose", "reduced_dpa", "ReducedDPAResult"]
 
 
-@register_jitable(inline="always")
+@njit(inline="always")
 def _luzi_chain(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, i):
     """Chain ``i``: lengths ``(q_i1, q_i2)`` of its legs, and False where the chain is degenerate
     (its plane parallel to the platform normal, |k × u_i| ≈ 0; the lengths are then garbage)."""
