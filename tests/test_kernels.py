@@ -92,7 +92,8 @@ def test_euler_path_matches_frames_path(mech):
     X[:10, 3:] = rng.uniform(-1e7, 1e7, (10, 3))        # beyond TRIG_MAX: libm path
     euler = mech.inverse(X)
     frames = mech._run_ik(*as_frames(X), *mech.stroke)
-    # Rounding of sin/cos (numba's vs numpy's) is amplified only near a leg's loss of its root.
+    # 1-ulp differences of _sincos vs libm (used by as_frames) grow only near a leg losing its
+    # real root.
     np.testing.assert_allclose(euler.q, frames.q, rtol=0, atol=1e-10)
     # The large-angle poses take the same libm rotation as ``as_frames``: bit-identical.
     np.testing.assert_array_equal(euler.q[:10], frames.q[:10])
