@@ -257,6 +257,8 @@ def _fingerprint(fn) -> tuple:
     """Identity of ``fn``'s source file (path, size, mtime), part of the drivers' cache key:
     numba invalidates a cached function only when its own file changes."""
     path = inspect.getsourcefile(fn)
+    if path is None or not os.path.exists(path):   # e.g. defined interactively
+        return "", 0, 0
     stat = os.stat(path)
     return path, stat.st_size, stat.st_mtime_ns
 
