@@ -23,7 +23,7 @@ from .units import ANGLE_UNITS, LENGTH_UNITS, parse_angle, parse_length
 
 __all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec", "workspace_spec", "WorkspaceSpec",
            "load_workspace_study", "WorkspaceStudySpec", "load_study", "StudySpec",
-           "study_schema", "set_path", "get_path"]
+           "study_schema", "set_path"]
 
 
 class _Shown(str):
@@ -734,13 +734,6 @@ def _path_parts(path: str) -> list:
         parts.append(m.group(1))
         parts += [int(i) for i in re.findall(r"\[(\d+)\]", m.group(2))]
     return parts
-
-
-def get_path(data: dict, path: str):
-    node = data
-    for p in _path_parts(path):
-        node = node[p]
-    return node
 
 
 def set_path(data: dict, path: str, value) -> dict:

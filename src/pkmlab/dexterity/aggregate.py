@@ -57,6 +57,17 @@ def _voxels(result) -> tuple[np.ndarray, np.ndarray]:
     return idx, centres
 
 
+def orientation_batches(pos: np.ndarray, R: np.ndarray):
+    """Yield ``(m0, n, p, Rr)``: positions ``(V, 3)`` × orientations ``R[m0:m0+n]`` flattened
+    orientation-major into ``p (n·V, 3)``, ``Rr (n·V, 3, 3)``, about ``_CHUNK`` poses each."""
+    V = len(pos)
+    step = max(1, _CHUNK // max(V, 1))
+    for m0 in range(0, len(R), step):
+        Rm = R[m0:m0 + step]
+        n = len(Rm)
+        yield m0, n, np.tile(pos, (n, 1)), np.repeat(Rm, V, axis=0)
+
+
 def _ik_valid(mech, p: np.ndarray, R: np.ndarray) -> np.ndarray:
     ik = mech._run_ik(np.ascontiguousarray(p), np.ascontiguousarray(R), *mech.stroke)
     return ik.valid
@@ -123,14 +134,10 @@ def kappa_grid(mech, result, L: float | None = None) -> KappaGrid:
     kap_e = np.empty((Ve, M))
     step = max(1, _CHUNK // V)                         # V >= Ve poses per orientation
     for m0 in range(0, M, step):
-        Rm = Rs[m0:m0 + step]
-        k = len(Rm)
-        p = np.tile(eval_pos, (k, 1))
-        R = np.repeat(Rm, Ve, axis=0)
-        J = mech._jacobian(p, R)
+        k = len(Rs[m0:m0 + step])
+        J = mech._jacobian(np.tile(eval_pos, (k, 1)), np.repeat(Rs[m0:m0 + step], Ve, axis=0))
         kap_e[:, m0:m0 + k] = condition_number(J, L).reshape(k, Ve).T
-        pv = np.tile(pos, (k, 1))
-        Rv = np.repeat(Rm, V, axis=0)
+    for m0, k, pv, Rv in orientation_batches(pos, Rs):
         valid[:, m0:m0 + k] = _ik_valid(mech, pv, Rv).reshape(k, V).T
     kap = np.where(valid, kap_e[inv], np.inf)
     return KappaGrid(kap, valid, pos, idx, Rs, L)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from .aggregate import _CHUNK, _ik_valid, _voxels
+from .aggregate import _ik_valid, _voxels, orientation_batches
 from .force import max_force_all_directions
 from .metrics import condition_number
 from .stiffness import stiffness
@@ -68,15 +68,10 @@ def metric_map(mech, result, metric: str = "kappa", L: float = 1.0, f_max=150.0,
         raise ParameterError("metric", f"one of {list(METRICS)}", metric)
     idx, pos = _voxels(result)
     R = result.orientations.rotations()
-    V, M = len(pos), len(R)
+    V = len(pos)
     worse_is_larger = METRICS[metric][2]
     worst = np.full(V, -np.inf if worse_is_larger else np.inf)
-    step = max(1, _CHUNK // max(V, 1))
-    for m0 in range(0, M, step):
-        Rm = R[m0:m0 + step]
-        n = len(Rm)
-        p = np.tile(pos, (n, 1))
-        Rr = np.repeat(Rm, V, axis=0)
+    for _, n, p, Rr in orientation_batches(pos, R):
         J = mech._jacobian(p, Rr)
         valid = _ik_valid(mech, p, Rr)
         if metric in ("kappa", "lci"):

@@ -58,6 +58,7 @@ def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
         rep = check_trajectory(mech, t, X)
         q = rep.q[np.all(np.isfinite(rep.q), axis=1)]
         used = (q.max() - q.min()) / (mech.stroke[1] - mech.stroke[0]) if len(q) else math.nan
+        margin = min(rep.margin_low.min(), rep.margin_high.min())
         rows.append({
             "label": label,
             "mechanism": mech,
@@ -69,7 +70,7 @@ def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
             "gci": float(np.mean(1.0 / kap)) if len(kap) else 0.0,
             "kappa_range": f"{kap.min():.2f} … {kap.max():.2f}" if len(kap) else "—",
             "force_N": float(np.nanmin(force)) if len(force) else 0.0,
-            "paper_motion": (f"{100 * used:.0f} % / {min(rep.margin_low.min(), rep.margin_high.min()):.2f} mm"  # noqa: E501
+            "paper_motion": (f"{100 * used:.0f} % / {margin:.2f} mm"
                              + ("" if rep.fits else " (does not fit)")),
             "results": (const, dex),
             "reference": "dexterous" if not dex.empty else "level (dexterous empty)",
