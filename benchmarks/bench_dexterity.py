@@ -67,11 +67,11 @@ def main() -> None:
     i, j, k = np.unravel_index(occ[rng.integers(0, len(occ), SAMPLES)], res.occupancy.shape)
     p = np.stack([res.xs[i], res.ys[j], res.zs[k]], axis=1)
     R = sample_orientations(res.orientations, SAMPLES, rng)
-    J = mech._jacobian(p, R)
+    J = mech.jacobian((p, R))
     stages = {
         "orientation sampling": lambda _: sample_orientations(res.orientations, SAMPLES, rng),
-        "inverse kinematics": lambda _: mech._run_ik(p, R, *mech.stroke),
-        "Jacobian": lambda _: mech._jacobian(p, R),
+        "inverse kinematics": lambda _: mech.inverse((p, R)),
+        "Jacobian": lambda _: mech.jacobian((p, R)),
         "LCI (batched SVD)": lambda _: dx.lci(J, cl.length),
     }
     print("  stages (median ms): " + ", ".join(f"{name} {median_ms(fn)[0]:.2f}"

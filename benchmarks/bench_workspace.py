@@ -48,7 +48,7 @@ def brute_force(mech, R, xs, ys, zs):
     """Plain NumPy: actuator values of every voxel at every orientation; all within stroke."""
     X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
     p = np.stack([X, Y, Z], axis=-1).reshape(-1, 3)
-    u = mech._tool_points()
+    u = mech.tool_points
     B = mech.base_points
     lo, hi = mech.stroke
     ok = np.ones(len(p), dtype=bool)

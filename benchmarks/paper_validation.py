@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 import pkmlab
-from pkmlab.mechanisms import Luzi3
+from pkmlab.mechanisms import NO_STROKE, Luzi3
 from pkmlab.mechanisms.layout import equal_leg_base_angle, paired_layout
 from pkmlab.mechanisms.luzi3 import four_bar_theta, pose_to_psi, psi_to_pose, reduced_dpa
 from pkmlab.poses import euler_to_matrix
@@ -132,7 +132,7 @@ def luzi_row(l: float, q, psi_table):
     phys = red.psi[red.physical]
     dmin = np.min(np.max(np.abs(phys - psi_table), axis=1)) if len(phys) else np.nan
     pose_t = psi_to_pose(mech, psi_table, q[0], q[1])
-    q_back = mech._ik_frames_raw(*pkmlab.poses.as_frames(pose_t)).q[0]
+    q_back = mech.inverse(pkmlab.poses.as_frames(pose_t), stroke=NO_STROKE).q[0]
     return dict(fk_ok=bool(fk.converged[0]), fk_res=float(fk.residual[0]), psi_fk=psi_fk,
                 dpsi_fk=float(np.max(np.abs(psi_fk - psi_table))), n_roots=len(red.psi),
                 n_phys=int(red.physical.sum()), dpsi_dpa=float(dmin),

@@ -14,7 +14,7 @@ from scipy.stats import kstest
 import pkmlab
 from pkmlab import PSU6
 from pkmlab import dexterity as dx
-from pkmlab.mechanisms import LEG_STATUS
+from pkmlab.mechanisms import LEG_STATUS, NO_STROKE
 from pkmlab.poses import as_frames, euler_to_matrix, exp_so3, frames_to_poses, matrix_to_euler
 from pkmlab.workspaces import OrientationSet, workspace
 
@@ -376,13 +376,13 @@ def test_stiffness_symmetric_positive_definite_and_matches_ik_differences():
         np.testing.assert_allclose(st.rotational_min, np.linalg.eigvalsh(K[:, 3:, 3:])[:, 0])
         # restoring wrench of a small displacement twist, from inverse kinematics
         p, R = as_frames(X[:5])
-        q0 = mech._ik_frames_raw(p, R).q
+        q0 = mech.inverse((p, R), stroke=NO_STROKE).q
         h = 1e-5
         for j in range(6):
             d = np.zeros(6)
             d[j] = h
-            qp = mech._ik_frames_raw(p + d[:3], exp_so3(d[3:]) @ R).q
-            qm = mech._ik_frames_raw(p - d[:3], exp_so3(-d[3:]) @ R).q
+            qp = mech.inverse((p + d[:3], exp_so3(d[3:]) @ R), stroke=NO_STROKE).q
+            qm = mech.inverse((p - d[:3], exp_so3(-d[3:]) @ R), stroke=NO_STROKE).q
             dq = (qp - qm) / 2                                          # δq for δx = h·e_j
             w = np.einsum("nij,nj->ni", np.swapaxes(J[:5], 1, 2), k * dq)
             np.testing.assert_allclose(w / h, K[:5, :, j], rtol=1e-6,

@@ -74,8 +74,8 @@ def test_non_finite_poses_are_invalid_and_leave_neighbours_alone(mech, path):
         p, R = as_frames(np.where(np.isfinite(X), X, 0.0))
         p[bad[::2], bad[::2] % 3] = np.nan
         R[bad[1::2], 1, 2] = np.inf
-        ik = mech._run_ik(p, R, *mech.stroke)
-        nominal = mech._run_ik(*as_frames(mech.nominal_pose), *mech.stroke)
+        ik = mech.inverse((p, R))
+        nominal = mech.inverse(as_frames(mech.nominal_pose))
     invalid = np.zeros(len(X), dtype=bool)
     invalid[bad] = True
     assert np.all(ik.reason[invalid] == _kernels.INVALID_INPUT)
@@ -91,7 +91,7 @@ def test_euler_path_matches_frames_path(mech):
         [rng.uniform(-40, 40, (5000, 3)), rng.uniform(-3.2, 3.2, (5000, 3))], axis=1)
     X[:10, 3:] = rng.uniform(-1e7, 1e7, (10, 3))        # beyond TRIG_MAX: libm path
     euler = mech.inverse(X)
-    frames = mech._run_ik(*as_frames(X), *mech.stroke)
+    frames = mech.inverse(as_frames(X))
     # 1-ulp differences of _sincos vs libm (used by as_frames) grow only near a leg losing its
     # real root.
     np.testing.assert_allclose(euler.q, frames.q, rtol=0, atol=1e-10)

@@ -512,7 +512,7 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
     # --- kinematics --------------------------------------------------------------------------
     tol = _positive(stroke_tolerance, "stroke_tolerance", "mm", allow_zero=True)
     qlo, qhi = mech.stroke
-    ik = mech._run_ik(np.ascontiguousarray(X), None, qlo - tol, qhi + tol)
+    ik = mech.inverse(X, stroke=(qlo - tol, qhi + tol))
     q = np.array(ik.q, dtype=float)
     ik_valid = np.asarray(ik.valid, dtype=bool)
     ik_reason = ik.reason_text

@@ -69,7 +69,7 @@ def orientation_batches(pos: np.ndarray, R: np.ndarray):
 
 
 def _ik_valid(mech, p: np.ndarray, R: np.ndarray) -> np.ndarray:
-    ik = mech._run_ik(np.ascontiguousarray(p), np.ascontiguousarray(R), *mech.stroke)
+    ik = mech.inverse((np.ascontiguousarray(p), R))
     return ik.valid
 
 
@@ -135,7 +135,7 @@ def kappa_grid(mech, result, L: float | None = None) -> KappaGrid:
     step = max(1, _CHUNK // V)                         # V >= Ve poses per orientation
     for m0 in range(0, M, step):
         k = len(Rs[m0:m0 + step])
-        J = mech._jacobian(np.tile(eval_pos, (k, 1)), np.repeat(Rs[m0:m0 + step], Ve, axis=0))
+        J = mech.jacobian((np.tile(eval_pos, (k, 1)), np.repeat(Rs[m0:m0 + step], Ve, axis=0)))
         kap_e[:, m0:m0 + k] = condition_number(J, L).reshape(k, Ve).T
     for m0, k, pv, Rv in orientation_batches(pos, Rs):
         valid[:, m0:m0 + k] = _ik_valid(mech, pv, Rv).reshape(k, V).T
@@ -283,7 +283,7 @@ def gci_monte_carlo(mech, result, L: float | None = None, samples: int = 2000,
         return _summarise(np.empty(0), samples, "monte-carlo", L)
     p, R = sample_poses(result, samples, rng)
     valid = _ik_valid(mech, p, R)
-    J = mech._jacobian(p[valid], R[valid])
+    J = mech.jacobian((p[valid], R[valid]))
     vals = lci(J, L)
     finite_J = np.all(np.isfinite(J), axis=(1, 2))
     vals = vals[finite_J]

@@ -72,7 +72,7 @@ def metric_map(mech, result, metric: str = "kappa", L: float = 1.0, f_max=150.0,
     worse_is_larger = METRICS[metric][2]
     worst = np.full(V, -np.inf if worse_is_larger else np.inf)
     for _, n, p, Rr in orientation_batches(pos, R):
-        J = mech._jacobian(p, Rr)
+        J = mech.jacobian((p, Rr))
         valid = _ik_valid(mech, p, Rr)
         if metric in ("kappa", "lci"):
             val = condition_number(J, L)

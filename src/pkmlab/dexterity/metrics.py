@@ -81,7 +81,7 @@ def default_length(mech) -> float:
     length of :func:`pkmlab.dexterity.singularity_flags` (the workspace constraint
     ``kappa_max`` uses the same default).
     """
-    return float(np.linalg.norm(mech._tool_points(), axis=1).mean())
+    return float(np.linalg.norm(mech.tool_points, axis=1).mean())
 
 
 def homogenised_jacobian(J: np.ndarray, L: float) -> np.ndarray:
@@ -221,7 +221,7 @@ def characteristic_length(mech, pose=None) -> CharacteristicLength:
     p, R = as_frames(X, "pose")
     if len(p) != 1:
         raise ParameterError("pose", "a single pose, shape (6,) or (4, 4)", np.shape(X))
-    J = mech._jacobian(p, R)[0]
+    J = mech.jacobian((p, R))[0]
     r = default_length(mech)
     if not np.all(np.isfinite(J)):
         log.warning("characteristic_length: Jacobian undefined at pose %s", np.asarray(X))

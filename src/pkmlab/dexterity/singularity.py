@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..mechanisms import _kernels
+from ..mechanisms import NO_STROKE, _kernels
 from ..poses import as_frames
 from .metrics import _as_length, default_length, lci
 
@@ -56,7 +56,7 @@ def as_pose_frames(poses) -> tuple[np.ndarray, np.ndarray]:
 
 def _defined(mech, p, R) -> np.ndarray:
     """``(N,)`` every leg has a real solution (stroke ignored); degenerate legs count."""
-    st = mech._ik_frames_raw(p, R).leg_status
+    st = mech.inverse((p, R), stroke=NO_STROKE).leg_status
     return ~np.any((st == _kernels.NO_SOLUTION) | (st == _kernels.INVALID_INPUT), axis=1)
 
 
@@ -89,7 +89,7 @@ def direct_kinematic_matrix(mech, poses) -> np.ndarray:
         a, r = link_vectors(mech, (p, R))
         u = a / np.asarray(mech.link_length)[:, None]
         return np.concatenate([u, np.cross(r, u)], axis=-1)
-    return mech._jacobian(p, R)
+    return mech.jacobian((p, R))
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ one entry in :data:`REGISTRY` (plus its YAML model in :mod:`pkmlab.config`).
 
 from __future__ import annotations
 
-from .base import LEG_STATUS, AssemblyModes, FKResult, IKResult, Mechanism
+from .base import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult, Mechanism
 from .luzi3 import Luzi3
 from .psu6 import PSU6
 from .ups6 import UPS6
@@ -14,5 +14,5 @@ from .ups6 import UPS6
 #: family name → mechanism class
 REGISTRY: dict[str, type[Mechanism]] = {cls.family: cls for cls in (PSU6, UPS6, Luzi3)}
 
-__all__ = ["REGISTRY", "Mechanism", "IKResult", "FKResult", "AssemblyModes", "LEG_STATUS",
-           "PSU6", "UPS6", "Luzi3"]
+__all__ = ["REGISTRY", "NO_STROKE", "Mechanism", "IKResult", "FKResult", "AssemblyModes",
+           "LEG_STATUS", "PSU6", "UPS6", "Luzi3"]

@@ -1,22 +1,45 @@
-"""What every mechanism family shares: result types, validation helpers and generic solvers.
+"""The mechanism protocol: what every family provides, result types and generic solvers.
 
-A family module defines a frozen dataclass subclassing :class:`Mechanism` that supplies
-geometry plus four family-specific pieces:
+Public protocol (what the rest of pkmlab uses; nothing outside :mod:`pkmlab.mechanisms` calls a
+method whose name starts with ``_``):
 
+* ``family``, ``actuator_names``, ``name``, ``stroke``, ``actuator_limits``, ``scale``;
+* ``base_points``, ``platform_points``, ``tool_offset`` and ``tool_points`` (mm);
+* ``nominal_pose`` — level, centred, mid-stroke unless given;
+* ``inverse(poses, stroke=None)`` and ``jacobian(poses)``: ``poses`` is ``(N, 6)`` Euler
+  (mm, rad, R = Rz·Ry·Rx), ``(N, 4, 4)`` transforms, or a tuple ``(p (N, 3), R (N, 3, 3))``;
+  ``stroke`` overrides the actuator window (:data:`NO_STROKE` for geometry only);
+* ``forward(q)``, ``assembly_modes(q)``;
+* ``footprint()`` — base and platform radii measured from their centres;
+* ``leg_segments(p, R)`` — each leg's moving link, for interference and drawing;
+* workspace hooks: ``position_bounds(R)``, and for families with exact column intervals
+  ``column_method``, ``column_leg``, ``column_params()``, ``leg_offsets(R)`` and
+  ``column_intervals(xs, ys, R, mode)``;
+* equality and hashing by geometry (two mechanisms with the same family, joints, stroke, tool
+  offset and nominal pose are equal, whatever their names).
+
+What a new family implements (one module and a :data:`pkmlab.mechanisms.REGISTRY` entry; the
+contract suite in ``tests/test_contract.py`` then runs on it):
+
+* a frozen dataclass subclassing :class:`Mechanism`, declared with ``eq=False`` so that the
+  geometric equality and hash defined here are kept, holding ``base_points``,
+  ``platform_points``, ``stroke_window`` and ``tool_offset``, validated in ``__post_init__``;
 * ``_ik_one`` — a numba per-pose inverse kinematics function (see :mod:`._kernels`);
 * ``_gparams()`` — the geometry packed as one float array for that function;
 * ``_jacobian(p, R)`` — the analytic velocity Jacobian ``(N, 6, 6)``;
 * ``_closure(p, R, q)`` — loop-closure residuals ``(N, 6)`` in mm and their derivative with
-  respect to the tool twist ``(N, 6, 6)``, used by Newton's method.
+  respect to the tool twist ``(N, 6, 6)``, used by Newton's method;
+* ``scale`` and ``leg_segments``; optionally the column hooks above.
 
 Forward kinematics, the assembly-mode search and the nominal-pose search are generic and live
-here, so a new family adds one module and a registry entry, nothing else.
+here and in :mod:`.solvers`.
 """
 
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, field
+import math
+from dataclasses import dataclass, field, fields
 from functools import cached_property
 from typing import Any, ClassVar
 
@@ -30,7 +53,11 @@ from . import _kernels
 
 log = logging.getLogger(__name__)
 
+#: Stroke override of :meth:`Mechanism.inverse` that checks geometry only.
+NO_STROKE = (-math.inf, math.inf)
+
 __all__ = [
+    "NO_STROKE",
     "LEG_STATUS",
     "IKResult",
     "FKResult",
@@ -171,7 +198,7 @@ def as_vector3(value: Any, field: str) -> np.ndarray:
 # ---------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Mechanism:
     """Base of every mechanism family (geometry lives in the subclass)."""
 
@@ -192,18 +219,18 @@ class Mechanism:
 
     #: numba per-leg column interval ``leg(x, y, wx, wy, wz, p0, p1, p2) -> (a, b, ok)`` (see
     #: :func:`._kernels.make_column_kernels`); families with it set ``column_method``.
-    _column_leg: ClassVar[Any] = None
+    column_leg: ClassVar[Any] = None
 
-    def _column_params(self) -> np.ndarray:  # pragma: no cover - optional
-        """``(6, 3)`` per-leg parameters of ``_column_leg``."""
+    def column_params(self) -> np.ndarray:  # pragma: no cover - optional
+        """``(6, 3)`` per-leg parameters of ``column_leg``."""
         raise NotImplementedError
 
-    def _leg_offsets(self, R: np.ndarray) -> np.ndarray:
+    def leg_offsets(self, R: np.ndarray) -> np.ndarray:
         """``(M, 6, 3)`` offsets ``w_i = R·u_i - b_i`` (u_i platform joints about the tool)."""
-        return np.ascontiguousarray(self._tool_points() @ R.transpose(0, 2, 1)
+        return np.ascontiguousarray(self.tool_points @ R.transpose(0, 2, 1)
                                     - self.base_points)
 
-    def _columns(self, xs, ys, R, mode, allowed=None, K=8):
+    def column_intervals(self, xs, ys, R, mode, allowed=None, K=8):
         """Stroke-feasible z sets of the columns ``xs × ys``: ``(lo, hi, overflow)``.
 
         ``lo, hi`` are ``(nx, ny, K)`` sorted disjoint intervals (empty slots ``inf, -inf``);
@@ -211,9 +238,9 @@ class Mechanism:
         unites the orientations that ``allowed (nx, ny, M)`` permits. ``overflow`` counts
         columns whose union needed more than ``K`` pieces.
         """
-        columns_all, columns_any = _kernels.make_column_kernels(type(self)._column_leg)
-        W = self._leg_offsets(R)
-        P = np.ascontiguousarray(self._column_params(), dtype=float)
+        columns_all, columns_any = _kernels.make_column_kernels(type(self).column_leg)
+        W = self.leg_offsets(R)
+        P = np.ascontiguousarray(self.column_params(), dtype=float)
         nx, ny = len(xs), len(ys)
         if mode == "all":
             if allowed is not None:
@@ -230,7 +257,7 @@ class Mechanism:
         columns_any(xs, ys, W, P, allowed, lo, hi, count)
         return lo, hi, int(np.sum(count > K))
 
-    def _position_bounds(self, R: np.ndarray) -> np.ndarray:
+    def position_bounds(self, R: np.ndarray) -> np.ndarray:
         """``(M, 2, 3)`` per-orientation box [min; max] that contains every feasible position."""
         p = self.nominal_pose[:3]
         S = 2.0 * self.scale
@@ -257,9 +284,40 @@ class Mechanism:
         """Actuator window (min, max) in mm (every family stores it as ``stroke_window``)."""
         return self.stroke_window
 
-    def _tool_points(self) -> np.ndarray:
+    @property
+    def tool_points(self) -> np.ndarray:
         """Platform joint centres in the tool frame (same orientation, origin at the offset)."""
         return self.platform_points - self.tool_offset
+
+    def footprint(self) -> dict:
+        """Footprint in mm: ``base_radius`` (largest horizontal distance of a base joint from
+        the base z axis) and ``platform_radius`` (largest distance of a platform joint from the
+        platform joints' centroid, in the platform frame)."""
+        P = self.platform_points
+        return {"base_radius": float(np.max(np.linalg.norm(self.base_points[:, :2], axis=1))),
+                "platform_radius": float(np.max(np.linalg.norm(P - P.mean(axis=0), axis=1)))}
+
+    # ---- equality and hashing by geometry ----------------------------------------------------
+    def _key(self) -> tuple:
+        parts: list = [self.family]
+        for f in fields(self):
+            if not f.compare or f.name == "name":
+                continue
+            v = getattr(self, f.name)
+            if v is None:
+                parts.append(None)
+            else:
+                a = np.asarray(v, dtype=float)
+                parts.append((a.shape, a.tobytes()))
+        return tuple(parts)
+
+    def __eq__(self, other) -> bool:
+        if not isinstance(other, Mechanism):
+            return NotImplemented
+        return type(self) is type(other) and self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
 
     @property
     def scale(self) -> float:
@@ -284,13 +342,24 @@ class Mechanism:
             return np.array(self.nominal, dtype=float)
         return self._mid_stroke_pose()
 
-    def inverse(self, poses: np.ndarray) -> IKResult:
-        """Actuator values of poses ``(N, 6)`` / ``(N, 4, 4)`` → :class:`IKResult`."""
+    def inverse(self, poses, *, stroke: tuple[float, float] | None = None) -> IKResult:
+        """Actuator values of poses → :class:`IKResult`.
+
+        Args:
+            poses: ``(N, 6)`` Euler poses (mm, rad), ``(N, 4, 4)`` transforms, or a tuple
+                ``(p (N, 3), R (N, 3, 3))`` of positions and rotation matrices.
+            stroke: actuator window ``(min, max)`` in mm to check instead of the mechanism's;
+                :data:`NO_STROKE` checks the geometry only.
+        """
+        lo, hi = self.stroke if stroke is None else (float(stroke[0]), float(stroke[1]))
+        if isinstance(poses, tuple):
+            p, R = _frames_tuple(poses)
+            return self._run_ik(p, R, lo, hi)
         X = np.asarray(poses, dtype=float)
         if X.ndim <= 2 and X.shape[-1] == 6:
-            return self._run_ik(np.ascontiguousarray(X.reshape(-1, 6)), None, *self.stroke)
+            return self._run_ik(np.ascontiguousarray(X.reshape(-1, 6)), None, lo, hi)
         p, R = as_frames(X)
-        return self._run_ik(p, R, *self.stroke)
+        return self._run_ik(p, R, lo, hi)
 
     def _run_ik(self, X_or_p, R, lo: float, hi: float) -> IKResult:
         euler, frames = _kernels.make_drivers(type(self)._ik_one)
@@ -312,14 +381,14 @@ class Mechanism:
         constants (see :mod:`._kernels`)."""
         return tuple(self._gparams().tolist())
 
-    def jacobian(self, poses: np.ndarray) -> np.ndarray:
+    def jacobian(self, poses) -> np.ndarray:
         """Analytic velocity Jacobian ``(N, 6, 6)``: ``q̇ = J · [v; ω]``.
 
-        ``v`` (mm/s) is the velocity of the tool-frame origin and ``ω`` (rad/s) the angular
-        velocity, both in the base frame. Rows of legs with no real solution are NaN; use
-        :meth:`inverse` for the mask and reason.
+        ``poses`` as for :meth:`inverse`. ``v`` (mm/s) is the velocity of the tool-frame origin
+        and ``ω`` (rad/s) the angular velocity, both in the base frame. Rows of legs with no
+        real solution are NaN; use :meth:`inverse` for the mask and reason.
         """
-        p, R = as_frames(poses)
+        p, R = _frames_tuple(poses) if isinstance(poses, tuple) else as_frames(poses)
         return self._jacobian(p, R)
 
     def forward(self, q: np.ndarray, guess: np.ndarray | None = None, *, tol: float = 1e-9,
@@ -359,10 +428,6 @@ class Mechanism:
                 "platform_points_mm": np.asarray(self.platform_points).tolist()}
 
     # ---- helpers -----------------------------------------------------------------------------
-    def _ik_frames_raw(self, p: np.ndarray, R: np.ndarray) -> IKResult:
-        """Inverse kinematics ignoring the stroke window (geometry only)."""
-        return self._run_ik(p, R, -np.inf, np.inf)
-
     def _level_yaw(self) -> float:
         """Rotation about z (rad) of the platform frame at the symmetric, level pose."""
         return 0.0
@@ -376,13 +441,13 @@ class Mechanism:
                         [0.0, 0.0, 1.0]]])
 
         def mean_q(z: float) -> float:
-            r = self._ik_frames_raw(np.array([[0.0, 0.0, z]]), Rz)
+            r = self._run_ik(np.array([[0.0, 0.0, z]]), Rz, *NO_STROKE)
             return float(np.mean(r.q[0])) - mid if r.valid[0] else np.nan
 
         S = self.scale
         zs = np.linspace(3.0 * S + hi, -S, 801)
-        scan = self._ik_frames_raw(np.stack([np.zeros(801), np.zeros(801), zs], axis=1),
-                                   np.ascontiguousarray(np.broadcast_to(Rz, (801, 3, 3))))
+        scan = self._run_ik(np.stack([np.zeros(801), np.zeros(801), zs], axis=1),
+                            np.ascontiguousarray(np.broadcast_to(Rz, (801, 3, 3))), *NO_STROKE)
         vals = np.where(scan.valid, scan.q.mean(axis=1) - mid, np.nan)
         for k in range(len(zs) - 1):
             a, b = vals[k], vals[k + 1]
@@ -404,6 +469,18 @@ class Mechanism:
         pn, Rn = as_frames(self.nominal_pose)
         rot = np.linalg.norm(log_so3(np.einsum("ji,njk->nik", Rn[0], R)), axis=-1)
         return np.linalg.norm(p - pn, axis=-1) + self.scale * rot
+
+
+def _frames_tuple(frames) -> tuple[np.ndarray, np.ndarray]:
+    """Validate a ``(p, R)`` tuple: positions ``(N, 3)`` (or ``(3,)``) and rotations
+    ``(N, 3, 3)`` (or ``(3, 3)``), C-contiguous float64."""
+    if len(frames) != 2:
+        raise ParameterError("poses", "a tuple (p (N, 3), R (N, 3, 3))", f"{len(frames)} items")
+    p = np.ascontiguousarray(frames[0], dtype=float).reshape(-1, 3)
+    R = np.ascontiguousarray(frames[1], dtype=float).reshape(-1, 3, 3)
+    if len(p) != len(R):
+        raise ParameterError("poses", "as many positions as rotations", f"{len(p)} and {len(R)}")
+    return p, R
 
 
 def step_frames(p: np.ndarray, R: np.ndarray, twist: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

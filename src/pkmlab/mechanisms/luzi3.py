@@ -31,7 +31,7 @@ from numba.extending import register_jitable
 from ..errors import ParameterError
 from ..poses import as_frames, frames_to_poses, skew
 from . import _kernels
-from .base import Mechanism, as_points, as_positive, as_stroke, as_vector3
+from .base import NO_STROKE, Mechanism, as_points, as_positive, as_stroke, as_vector3
 
 __all__ = ["Luzi3", "pose_to_psi", "psi_to_pose", "reduced_dpa", "ReducedDPAResult"]
 
@@ -85,7 +85,7 @@ def _luzi_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, 
         st[k] = _kernels.stroke_status(v2, qmin, qmax) if ok else _kernels.DEGENERATE
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Luzi3(Mechanism):
     """Three-chain over-constrained Gough–Stewart geometry.
 
@@ -164,7 +164,7 @@ class Luzi3(Mechanism):
                      + self.stroke[1])
 
     def _gparams(self) -> np.ndarray:
-        return np.concatenate([self.base_points.ravel(), self._tool_points().ravel(),
+        return np.concatenate([self.base_points.ravel(), self.tool_points.ravel(),
                                [self.upper_link]])
 
     def _level_yaw(self) -> float:
@@ -178,7 +178,7 @@ class Luzi3(Mechanism):
         n_pose = p.shape[0]
         A1, A2 = self.base_points[0::2], self.base_points[1::2]            # (3, 3)
         r = A2 - A1
-        rho = np.einsum("nij,kj->nki", R, self._tool_points())            # (N, 3, 3)
+        rho = np.einsum("nij,kj->nki", R, self.tool_points)            # (N, 3, 3)
         C = p[:, None, :] + rho
         k = R[:, :, 2]                                                      # (N, 3)
         eye = np.broadcast_to(np.eye(3), (n_pose, 3, 3, 3))
@@ -218,9 +218,9 @@ class Luzi3(Mechanism):
         return d
 
     # ---- workspace hooks -------------------------------------------------------------------
-    def _position_bounds(self, R):
+    def position_bounds(self, R):
         """Each C_i lies within qmax + l/2 of both its base points: ``(M, 2, 3)``."""
-        rho = np.einsum("mij,kj->mki", R, self._tool_points())             # (M, 3, 3)
+        rho = np.einsum("mij,kj->mki", R, self.tool_points)             # (M, 3, 3)
         A = self.base_points.reshape(3, 2, 3)
         reach = self.stroke[1] + 0.5 * self.upper_link
         centre = A[None, :, :, :] - rho[:, :, None, :]                      # (M, 3, 2, 3)
@@ -230,7 +230,7 @@ class Luzi3(Mechanism):
 
     def leg_segments(self, p, R):
         """Actuated legs ``A_ij → B_ij`` as end points ``(N, 6, 3)`` each."""
-        rho = np.einsum("nij,kj->nki", R, self._tool_points())
+        rho = np.einsum("nij,kj->nki", R, self.tool_points)
         C = p[:, None, :] + rho
         A1, A2 = self.base_points[0::2], self.base_points[1::2]
         n = np.cross(R[:, None, :, 2], np.cross(A2 - A1, C - A1))
@@ -447,7 +447,7 @@ def reduced_dpa(mech: Luzi3, q, *, grid: int = 9, tol: float = 1e-9, max_iter: i
                 continue
         keep.append(int(i))
     psi, res, branch, pose, p, R = (a[keep] for a in (psi, res, branch, pose, p, R))
-    ik = mech._ik_frames_raw(p, R)
+    ik = mech.inverse((p, R), stroke=NO_STROKE)
     with np.errstate(invalid="ignore"):
         err = np.max(np.abs(ik.q - q), axis=1) if pose.size else np.zeros(0)
     physical = np.isfinite(err) & (err < 1e-6)

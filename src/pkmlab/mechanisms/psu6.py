@@ -24,7 +24,7 @@ from numba.extending import register_jitable
 
 from ..errors import ParameterError
 from . import _kernels
-from .base import Mechanism, as_points, as_positive, as_stroke, as_vector3
+from .base import NO_STROKE, Mechanism, as_points, as_positive, as_stroke, as_vector3
 from .layout import build_paired
 
 __all__ = ["PSU6"]
@@ -59,7 +59,7 @@ def _psu_column_leg(x, y, wx, wy, wz, l2, qmin, qmax):
     return qmin - wz + s, qmax - wz + s, h2 >= 0.0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class PSU6(Mechanism):
     """6-PSU geometry.
 
@@ -130,14 +130,14 @@ class PSU6(Mechanism):
                      + np.max(self.link_length) + (self.stroke[1] - self.stroke[0]))
 
     def _level_joints(self) -> np.ndarray:
-        return self._tool_points()  # level, centred: horizontal positions are the points' own
+        return self.tool_points  # level, centred: horizontal positions are the points' own
 
     def _gparams(self) -> np.ndarray:
-        return np.concatenate([self.base_points.ravel(), self._tool_points().ravel(),
+        return np.concatenate([self.base_points.ravel(), self.tool_points.ravel(),
                                self.link_length])
 
     def _jacobian(self, p, R):
-        r = np.einsum("nij,kj->nki", R, self._tool_points())          # (N, 6, 3)
+        r = np.einsum("nij,kj->nki", R, self.tool_points)          # (N, 6, 3)
         a = p[:, None, :] + r - self.base_points
         with np.errstate(invalid="ignore"):
             a[..., 2] = np.sqrt(self.link_length**2 - a[..., 0] ** 2 - a[..., 1] ** 2)
@@ -145,7 +145,7 @@ class PSU6(Mechanism):
             return np.concatenate([a, np.cross(r, a)], axis=-1) / a[..., 2:3]
 
     def _closure(self, p, R, q):
-        r = np.einsum("nij,kj->nki", R, self._tool_points())
+        r = np.einsum("nij,kj->nki", R, self.tool_points)
         a = p[:, None, :] + r - self.base_points
         a[..., 2] -= q
         norm = np.linalg.norm(a, axis=-1)
@@ -161,15 +161,15 @@ class PSU6(Mechanism):
     column_method = "linear"
     column_invariant = True   # link vectors, joint angles and J do not depend on z
 
-    _column_leg = _psu_column_leg
+    column_leg = _psu_column_leg
 
-    def _column_params(self) -> np.ndarray:
+    def column_params(self) -> np.ndarray:
         lo, hi = self.stroke
         return np.stack([self.link_length**2, np.full(6, lo), np.full(6, hi)], axis=1)
 
-    def _position_bounds(self, R):
+    def position_bounds(self, R):
         """Per orientation, the box each leg's reach and stroke allow: ``(M, 2, 3)``."""
-        W = self._leg_offsets(R)
+        W = self.leg_offsets(R)
         l = self.link_length
         lo = np.stack([-W[..., 0] - l, -W[..., 1] - l, self.stroke[0] - W[..., 2]], axis=-1)
         hi = np.stack([-W[..., 0] + l, -W[..., 1] + l, self.stroke[1] - W[..., 2] + l],
@@ -178,8 +178,8 @@ class PSU6(Mechanism):
 
     def leg_segments(self, p, R):
         """Link end points ``(N, 6, 3)`` each: slider S joint → platform U joint."""
-        W = p[:, None, :] + np.einsum("nij,kj->nki", R, self._tool_points())
-        r = self._ik_frames_raw(p, R)
+        W = p[:, None, :] + np.einsum("nij,kj->nki", R, self.tool_points)
+        r = self.inverse((p, R), stroke=NO_STROKE)
         start = self.base_points + r.q[..., None] * np.array([0.0, 0.0, 1.0])
         return start, W
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..poses import as_frames, frames_to_poses, log_so3
-from .base import AssemblyModes, FKResult, step_frames
+from .base import NO_STROKE, AssemblyModes, FKResult, step_frames
 
 
 def _solve(G: np.ndarray, f: np.ndarray) -> np.ndarray:
@@ -62,7 +62,7 @@ def newton(mech, p, R, q, *, tol: float, max_iter: int, polish: int = 2):
 
 def _working_mode(mech, p, R, q, tol_mode: float) -> np.ndarray:
     """True where the family's inverse kinematics at (p, R) reproduces q."""
-    ik = mech._ik_frames_raw(p, R)
+    ik = mech.inverse((p, R), stroke=NO_STROKE)
     with np.errstate(invalid="ignore"):
         err = np.max(np.abs(ik.q - q), axis=1)
     return np.isfinite(err) & (err <= tol_mode)
@@ -88,7 +88,7 @@ def forward_newton(mech, q, guess=None, *, tol: float = 1e-9, max_iter: int = 50
     if bad.size:
         # Continuation from the nominal pose keeps the nominal assembly mode.
         pn, Rn = as_frames(mech.nominal_pose)
-        qn = mech._ik_frames_raw(pn, Rn).q[0]
+        qn = mech.inverse((pn, Rn), stroke=NO_STROKE).q[0]
         pc, Rc = np.repeat(pn, bad.size, axis=0), np.repeat(Rn, bad.size, axis=0)
         itc = np.zeros(bad.size, dtype=int)
         for k in range(1, continuation_steps + 1):

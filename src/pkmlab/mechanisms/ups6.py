@@ -62,7 +62,7 @@ def _ups_column_leg(x, y, wx, wy, wz, side, qmin2, qmax2):
     return -wz - ro, -wz - ri, A >= 0.0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class UPS6(Mechanism):
     """6-UPS geometry.
 
@@ -117,7 +117,7 @@ class UPS6(Mechanism):
                      + np.max(np.linalg.norm(self.platform_points, axis=1)) + self.stroke[1])
 
     def _gparams(self) -> np.ndarray:
-        return np.concatenate([self.base_points.ravel(), self._tool_points().ravel(),
+        return np.concatenate([self.base_points.ravel(), self.tool_points.ravel(),
                                self._sides])
 
     @cached_property
@@ -133,11 +133,11 @@ class UPS6(Mechanism):
             return np.ones(6)
         pose = np.asarray(self.nominal, dtype=float)
         R = euler_to_matrix(pose[3:])
-        sz = pose[2] + self._tool_points() @ R[2] - self.base_points[:, 2]
+        sz = pose[2] + self.tool_points @ R[2] - self.base_points[:, 2]
         return np.where(sz < 0, -1.0, 1.0)
 
     def _legs(self, p, R):
-        r = np.einsum("nij,kj->nki", R, self._tool_points())
+        r = np.einsum("nij,kj->nki", R, self.tool_points)
         s = p[:, None, :] + r - self.base_points
         length = np.linalg.norm(s, axis=-1)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -155,15 +155,15 @@ class UPS6(Mechanism):
     # ---- workspace hooks -------------------------------------------------------------------
     column_method = "quadratic"
 
-    _column_leg = _ups_column_leg
+    column_leg = _ups_column_leg
 
-    def _column_params(self) -> np.ndarray:
+    def column_params(self) -> np.ndarray:
         lo, hi = self.stroke
         return np.stack([self._sides, np.full(6, lo * lo), np.full(6, hi * hi)], axis=1)
 
-    def _position_bounds(self, R):
+    def position_bounds(self, R):
         """Per orientation: each leg within qmax, on its working-mode side: ``(M, 2, 3)``."""
-        W = self._leg_offsets(R)
+        W = self.leg_offsets(R)
         qmax = self.stroke[1]
         lo, hi = -W - qmax, -W + qmax
         up = self._sides > 0
@@ -173,5 +173,5 @@ class UPS6(Mechanism):
 
     def leg_segments(self, p, R):
         """Leg end points ``(N, 6, 3)`` each: base U joint → platform S joint."""
-        W = p[:, None, :] + np.einsum("nij,kj->nki", R, self._tool_points())
+        W = p[:, None, :] + np.einsum("nij,kj->nki", R, self.tool_points)
         return np.broadcast_to(self.base_points, W.shape).copy(), W

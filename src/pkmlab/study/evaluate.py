@@ -104,8 +104,8 @@ def _metrics(mech, ev: dict, seed: int) -> dict:
                     else None
                 rng = np.random.default_rng(seed)
                 p, R = dx.aggregate.sample_poses(res, d["gci_samples"], rng)
-                valid = mech._run_ik(p, np.ascontiguousarray(R), *mech.stroke).valid
-                F = dx.max_force_all_directions(mech._jacobian(p[valid], R[valid]),
+                valid = mech.inverse((p, R)).valid
+                F = dx.max_force_all_directions(mech.jacobian((p[valid], R[valid])),
                                                 d["force_limit"])
                 m["min_force"] = float(np.nanmin(F)) if len(F) else 0.0
     if ev.get("trajectory"):

@@ -118,7 +118,7 @@ class Constraints:
 
 def default_characteristic_length(mech) -> float:
     """Mean distance of the platform joints from the tool point (mm)."""
-    return float(np.mean(np.linalg.norm(mech._tool_points(), axis=1)))
+    return float(np.mean(np.linalg.norm(mech.tool_points, axis=1)))
 
 
 def kappa(mech, p: np.ndarray, R: np.ndarray, characteristic_length: float) -> np.ndarray:
@@ -126,7 +126,7 @@ def kappa(mech, p: np.ndarray, R: np.ndarray, characteristic_length: float) -> n
 
     ``inf`` where the Jacobian is singular or undefined (no real leg solution).
     """
-    J = mech._jacobian(p, R).copy()
+    J = mech.jacobian((p, R)).copy()
     J[..., 3:] /= characteristic_length
     out = np.full(len(p), np.inf)
     ok = np.all(np.isfinite(J), axis=(1, 2))

@@ -21,6 +21,7 @@ from scipy import ndimage
 
 from .._intervals import label_pieces
 from ..errors import ParameterError
+from ..mechanisms import NO_STROKE
 from ..poses import as_frames, matrix_to_euler
 from .constraints import Constraints, check
 from .orientations import OrientationSet
@@ -95,7 +96,7 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
     p_nom = mech.nominal_pose[:3]
     if use_columns and len(xs) and len(ys):
         t = time.perf_counter()
-        lo, hi, overflow = mech._columns(xs, ys, R, mode)
+        lo, hi, overflow = mech.column_intervals(xs, ys, R, mode)
         timings["columns_s"] = time.perf_counter() - t
         if refine and mode == "all" and oset.kind != "fixed":
             t = time.perf_counter()
@@ -189,7 +190,7 @@ def orientation_convergence(mech, kind: str, orientations: OrientationSet,
 
 
 def _grid_xy(mech, R, mode, h):
-    b = mech._position_bounds(R)                           # (M, 2, 3)
+    b = mech.position_bounds(R)                           # (M, 2, 3)
     if mode == "all":
         lo, hi = b[:, 0].max(axis=0), b[:, 1].min(axis=0)
     else:
@@ -249,7 +250,7 @@ def _column_extras(mech, xs, ys, R, mode, cons, lo, hi, overflow):
     allowed = np.zeros((len(xs), len(ys), M), dtype=np.bool_)
     for m in range(M):
         allowed[ix, iy, m] = check(mech, p, np.broadcast_to(R[m], (len(ix), 3, 3)), cons)
-    return mech._columns(xs, ys, R, "any", allowed)
+    return mech.column_intervals(xs, ys, R, "any", allowed)
 
 
 def _voxel_extras(mech, xs, ys, zs, R, mode, cons, field, h):
@@ -272,7 +273,7 @@ def _voxel_extras(mech, xs, ys, zs, R, mode, cons, field, h):
             if len(todo) == 0:
                 break
             Rm = np.broadcast_to(R[m], (len(todo), 3, 3))
-            ik = mech._run_ik(p[todo], np.ascontiguousarray(Rm), lo_q, hi_q)
+            ik = mech.inverse((p[todo], Rm), stroke=(lo_q, hi_q))
             sel = todo[ik.valid]
             ok[sel] = check(mech, p[sel], np.broadcast_to(R[m], (len(sel), 3, 3)), cons)
     out = field.copy()
@@ -300,7 +301,7 @@ def _sampled_field(mech, xs, ys, zs, R, mode, cons, h):
         for s in range(0, len(live), _CHUNK):
             sl = live[s:s + _CHUNK]
             Rm = np.ascontiguousarray(np.broadcast_to(R[m], (len(sl), 3, 3)))
-            ik = mech._ik_frames_raw(p[sl], Rm)
+            ik = mech.inverse((p[sl], Rm), stroke=NO_STROKE)
             with np.errstate(invalid="ignore"):
                 mg = np.min(np.minimum(ik.q - lo_q, hi_q - ik.q), axis=1)
             # raw IK (no stroke): any other status is a geometric failure or another mode

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from ..mechanisms import NO_STROKE
 from .constraints import check
 
 log = logging.getLogger(__name__)
@@ -118,7 +119,7 @@ def points_feasible(result, points: np.ndarray) -> np.ndarray:
         if len(todo) == 0:
             break
         Rb = np.ascontiguousarray(np.broadcast_to(Rm, (len(todo), 3, 3)))
-        good = mech._run_ik(np.ascontiguousarray(points[todo]), Rb, lo, hi).valid
+        good = mech.inverse((points[todo], Rb), stroke=(lo, hi)).valid
         if result.constraints.extra:
             sel = np.nonzero(good)[0]
             good[sel] = check(mech, points[todo[sel]], Rb[sel], result.constraints)
@@ -183,8 +184,8 @@ def _linearise(mech, pts, R):
     P, M = len(pts), len(R)
     p = np.repeat(pts, M, axis=0)
     Rr = np.ascontiguousarray(np.tile(R, (P, 1, 1)))
-    q = mech._ik_frames_raw(p, Rr).q.reshape(P, M, 6)
-    G = mech._jacobian(p, Rr)[..., :3].reshape(P, M, 6, 3)
+    q = mech.inverse((p, Rr), stroke=NO_STROKE).q.reshape(P, M, 6)
+    G = mech.jacobian((p, Rr))[..., :3].reshape(P, M, 6, 3)
     return q, G
 
 

@@ -54,10 +54,10 @@ def refine_columns(mech, xs, ys, oset, lo, hi, iterations: int = 14):
         return lo, hi, 0
     params = oset.parameters()
     R = oset.rotations()
-    W = mech._leg_offsets(R)                                 # (M, 6, 3)
-    P = np.asarray(mech._column_params(), dtype=float)       # (6, 3)
-    U, B = mech._tool_points(), mech.base_points
-    ev = make_leg_eval(type(mech)._column_leg)
+    W = mech.leg_offsets(R)                                 # (M, 6, 3)
+    P = np.asarray(mech.column_params(), dtype=float)       # (6, 3)
+    U, B = mech.tool_points, mech.base_points
+    ev = make_leg_eval(type(mech).column_leg)
     bounds = oset.bounds()
     step0 = _initial_steps(oset)
     changed = 0
