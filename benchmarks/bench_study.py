@@ -16,9 +16,7 @@ from pathlib import Path
 
 from scipy.stats import qmc
 
-from pkmlab.config import load_study
-from pkmlab.study.evaluate import candidate_mapping, evaluate_candidate
-from pkmlab.study.optimisers import DesignSpace
+from pkmlab.study import evaluate_design, load_study
 from pkmlab.study.runners import JoblibRunner
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -26,19 +24,19 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def main() -> None:
     n = 5000 if "--full" in sys.argv else 400
-    _, res = load_study(ROOT / "studies/hopkins-6psu-redesign.yaml")
-    space = DesignSpace(res["variables"])
+    study = load_study(ROOT / "studies/hopkins-6psu-redesign.yaml")
+    space = study.space
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)        # n need not be a power of 2
         u = qmc.Sobol(d=len(space.variables), scramble=True, seed=0).random(n + 16)
-    tasks = [(i, (candidate_mapping(res["mechanism"], space.variables, space.from_unit(r)),
-                  res["evaluate"], res["seed"])) for i, r in enumerate(u)]
+    tasks = [(i, (space, space.from_unit(r), study.evaluation, study.seed))
+             for i, r in enumerate(u)]
     runner = JoblibRunner(2)
     t0 = time.perf_counter()
-    list(runner.map(evaluate_candidate, tasks[:16]))          # warm-up: compile in workers
+    list(runner.map(evaluate_design, tasks[:16]))          # warm-up: compile in workers
     warm = time.perf_counter() - t0
     t0 = time.perf_counter()
-    results = [r for _, r in runner.map(evaluate_candidate, tasks[16:])]
+    results = [r for _, r in runner.map(evaluate_design, tasks[16:])]
     dt = time.perf_counter() - t0
     ok = sum(r["status"] == "ok" for r in results)
     rate = n / dt

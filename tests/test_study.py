@@ -18,9 +18,8 @@ from conftest import MECH_DIR
 from typer.testing import CliRunner
 
 from pkmlab.cli import app
-from pkmlab.config import load_study
 from pkmlab.errors import ParameterError
-from pkmlab.study import SerialRunner, pareto_mask, pareto_records, run_study
+from pkmlab.study import SerialRunner, load_study, pareto_mask, pareto_records, run_study
 from pkmlab.study.runners import DaskRunner, JoblibRunner
 
 HOPKINS = MECH_DIR / "hopkins-williams-6psu.yaml"
@@ -110,12 +109,13 @@ def test_missing_section_and_schema(tmp_path):
         schema["properties"])
 
 
-def test_resolved_study_converts_units_once(tmp_path):
-    _, res = load_study(write(tmp_path, small_study(tmp_path)))
-    v = {x["name"]: x for x in res["variables"]}
-    assert v["platform_rotation"]["low"] == pytest.approx(np.radians(10))
-    assert v["link_length"]["high"] == 260.0
-    assert res["objectives"][0] == {"metric": "dexterous_volume", "sense": "maximize"}
+def test_study_converts_units_once(tmp_path):
+    study = load_study(write(tmp_path, small_study(tmp_path)))
+    v = {x.name: x for x in study.variables}
+    assert v["platform_rotation"].low == pytest.approx(np.radians(10))
+    assert v["link_length"].high == 260.0
+    assert (study.objectives[0].metric, study.objectives[0].sense) == ("dexterous_volume",
+                                                                       "maximize")
 
 
 # ---- Pareto ----------------------------------------------------------------------------------
@@ -143,11 +143,11 @@ def _snapshot(store_path: Path) -> dict:
 @pytest.fixture(scope="module")
 def serial_run(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("serial")
-    _, res = load_study(write(tmp, small_study(tmp)))
+    res = load_study(write(tmp, small_study(tmp)))
     store = run_study(res, SerialRunner())
     records = store.all()
     store.close()
-    return res, records, _snapshot(Path(res["output"]) / "evaluations.sqlite")
+    return res, records, _snapshot(Path(res.output) / "evaluations.sqlite")
 
 
 def test_serial_run_records_every_candidate(serial_run):
@@ -155,6 +155,7 @@ def test_serial_run_records_every_candidate(serial_run):
     assert len(records) == 9                                 # 8 sobol + the baseline
     assert sum(r["role"] == "baseline" for r in records) == 1
     assert all(r["status"] in ("ok", "invalid", "failed") for r in records)
+    assert all(r["status"] == "ok" or r["reason"] for r in records)
     front = pareto_records(res, records)
     assert front and all(r["status"] == "ok" for r in front)
 
@@ -164,7 +165,7 @@ def test_joblib_and_dask_give_the_same_store(serial_run, tmp_path):
 
     res, _, snap = serial_run
     for name in ("joblib", "dask"):
-        r2 = dict(res, output=str(tmp_path / name))
+        r2 = res.with_output(tmp_path / name)
         if name == "joblib":
             runner = JoblibRunner(2)
             run_study(r2, runner).close()
@@ -205,7 +206,7 @@ def test_resume_after_kill_loses_and_repeats_nothing(tmp_path):
     before = _snapshot(db)
     assert 6 <= len(before), "the run was killed before it stored anything"
 
-    _, res = load_study(path)
+    res = load_study(path)
     done = []
     store = run_study(res, SerialRunner(), resume=True, progress=done.append)
     after = store.all()
@@ -218,7 +219,7 @@ def test_resume_after_kill_loses_and_repeats_nothing(tmp_path):
     assert len(done) == len(after) - len(before)
     # the same result as an uninterrupted run with the same seed
     data["output"] = str(tmp_path / "straight")
-    _, res2 = load_study(write(tmp_path, data, "straight.yaml"))
+    res2 = load_study(write(tmp_path, data, "straight.yaml"))
     store2 = run_study(res2, SerialRunner())
     straight = store2.all()
     store2.close()
@@ -229,10 +230,10 @@ def test_resume_after_kill_loses_and_repeats_nothing(tmp_path):
 
 def test_resume_refuses_a_changed_study(tmp_path):
     data = small_study(tmp_path)
-    _, res = load_study(write(tmp_path, data))
+    res = load_study(write(tmp_path, data))
     run_study(res, SerialRunner()).close()
     data["seed"] = 99
-    _, res2 = load_study(write(tmp_path, data))
+    res2 = load_study(write(tmp_path, data))
     with pytest.raises(ParameterError, match="--resume"):
         run_study(res2, SerialRunner(), resume=True)
 
@@ -269,7 +270,7 @@ def test_compare_files_and_pareto_rows(tmp_path, serial_run):
     res, records, _ = serial_run
     from pkmlab.study.report import write_report
 
-    out = Path(res["output"])
+    out = Path(res.output)
     write_report(out, res, records)
     r = CliRunner().invoke(app, ["compare", str(HOPKINS), "--pareto", str(out / "pareto.csv"),
                                  "--rows", "1", "--box", "10", "--resolution", "5",
@@ -278,12 +279,10 @@ def test_compare_files_and_pareto_rows(tmp_path, serial_run):
     d = json.loads(r.stdout)["designs"]
     assert [x["label"] for x in d] == ["hopkins-williams-6psu", "tiny #1"]
     # the Pareto row is the study's rank-1 candidate, evaluated with the compare protocol
-    from pkmlab import OrientationSet, load_mechanism, workspace
-    from pkmlab.study import candidate_mapping
+    from pkmlab import OrientationSet, workspace
 
     front = pareto_records(res, records)
-    mech = load_mechanism(candidate_mapping(res["mechanism"], res["variables"],
-                                            front[0]["params"]))
+    mech = res.space.decode(front[0]["params"])
     ref = workspace(mech, "dexterous", OrientationSet.box(np.radians([10.0] * 3), samples=5),
                     5.0)
     assert d[1]["dexterous_volume_cm3"] == pytest.approx(ref.volume / 1e3)
@@ -310,7 +309,7 @@ def test_other_optimisers_and_inline_mechanism(tmp_path, optimizer, n):
         data["design"]["pairing"] = {"choices": ["same", "crossed"]}
     if optimizer["method"] == "de":
         data["objectives"] = [{"maximize": "dexterous_volume"}]
-    _, res = load_study(write(tmp_path, data))
+    res = load_study(write(tmp_path, data))
     store = run_study(res, SerialRunner())
     recs = store.all()
     store.close()

@@ -19,6 +19,7 @@ import sys
 from pathlib import Path
 from typing import Annotated
 
+import click
 import numpy as np
 import typer
 from rich.console import Console
@@ -30,7 +31,7 @@ from .errors import ParameterError
 from .mechanisms import Mechanism
 from .units import parse_angle, parse_length
 
-app = typer.Typer(add_completion=False, no_args_is_help=True,
+app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="pkmlab: design-optimisation workbench for parallel manipulators.")
 out = Console()
 err = Console(stderr=True)
@@ -757,7 +758,7 @@ StudyArg = Annotated[Path, typer.Argument(help="Study YAML file.")]
 
 
 def _load_study(path: Path):
-    from .config import load_study
+    from .study import load_study
 
     try:
         return load_study(path)
@@ -767,24 +768,61 @@ def _load_study(path: Path):
 
 
 @app.command()
-def validate(study_file: StudyArg) -> None:
+def validate(study_file: StudyArg, as_json: JsonOpt = False,
+             check_space: Annotated[int, typer.Option(
+                 help="designs sampled to estimate how much of the design box is "
+                      "geometrically invalid (0: skip)", min=0, max=4096)] = 128) -> None:
     """Check a study file (exit 2 with the offending field on error; writes nothing)."""
-    _, resolved = _load_study(study_file)
-    from .study.run import expected_evaluations
+    from .study.optimisers import expected_evaluations
 
-    out.print(f"{escape(str(study_file))}: valid — {len(resolved['variables'])} design "
-              f"variables, {len(resolved['objectives'])} objectives, "
-              f"{len(resolved['constraints'])} constraints, {resolved['optimizer']['method']} "
-              f"(~{expected_evaluations(resolved)} evaluations), output "
-              f"{escape(resolved['output'])}")
+    study = _load_study(study_file)
+    info = {"study": study.name, "file": str(study_file), "valid": True,
+            "variables": [v.name for v in study.variables],
+            "derived": [d.name for d in study.space.derived],
+            "objectives": [f"{o.sense} {o.metric}" for o in study.objectives],
+            "constraints": [c.describe() for c in study.constraints],
+            "metrics": list(study.evaluation.metrics),
+            "optimizer": study.optimizer.method,
+            "evaluations": expected_evaluations(study.space, study.optimizer),
+            "output": str(study.output), "warnings": []}
+    if check_space:
+        bad, reasons = study.space.validity(check_space, study.seed)
+        info["invalid_fraction"] = bad
+        if bad >= 0.2:
+            info["warnings"].append(
+                f"{100 * bad:.0f} % of {check_space} sampled designs are geometrically "
+                "invalid (" + "; ".join(f"{n}× {r}" for r, n in reasons) + "): the optimiser "
+                "will spend that share of its budget on them; narrow the ranges or "
+                "parametrise coupled variables with 'derived' (docs/studies.md)")
+    if as_json:
+        _emit(info)
+        return
+    out.print(escape(f"{study_file}: valid — {len(info['variables'])} design variables, "
+                     f"{len(info['objectives'])} objectives, {len(info['constraints'])} "
+                     f"constraints, {info['optimizer']} (~{info['evaluations']} evaluations), "
+                     f"output {info['output']}"), highlight=False)
+    for w in info["warnings"]:
+        err.print(escape(f"warning: {w}"), highlight=False)
 
 
 @app.command()
 def schema() -> None:
     """Print the JSON Schema of study files (for editors)."""
-    from .config import study_schema
+    from .study import study_schema
 
     _emit(study_schema())
+
+
+@app.command()
+def metrics(as_json: JsonOpt = False) -> None:
+    """List every study metric: unit, evaluate block, kind of number, meaning."""
+    from .study.metrics import METRICS, metrics_markdown
+
+    if as_json:
+        _emit({m.name: {"unit": m.unit, "evaluator": m.evaluator, "statistic": m.statistic,
+                        "description": m.description} for m in METRICS.values()})
+        return
+    sys.stdout.write(metrics_markdown())
 
 
 def _progress_bar(total: int):
@@ -820,6 +858,8 @@ def run(
     resume: Annotated[bool, typer.Option(
         "--resume", help="continue the study in its output folder without repeating work")]
     = False,
+    overwrite: Annotated[bool, typer.Option(
+        "--overwrite", help="replace an earlier run in the output folder")] = False,
     backend: Annotated[str, typer.Option(help="loky | dask")] = "loky",
     scheduler: Annotated[str | None, typer.Option(help="Dask scheduler address")] = None,
     out_dir: Annotated[Path | None, typer.Option(
@@ -829,23 +869,26 @@ def run(
     """Run a design study: evaluate candidates, keep every result, report the Pareto set."""
     import time
 
+    from .study.optimisers import expected_evaluations
     from .study.report import export_designs, pareto_records, write_report
-    from .study.run import expected_evaluations, run_study
+    from .study.run import run_study
     from .study.runners import make_runner
 
-    _, resolved = _load_study(study_file)
+    study = _load_study(study_file)
     if out_dir is not None:
-        resolved["output"] = str(out_dir)
+        study = study.with_output(out_dir)
+    if resume and overwrite:
+        _fail(ParameterError("--resume / --overwrite", "one of them", "both"))
     try:
         runner = make_runner(backend, jobs, scheduler)
     except ParameterError as exc:
         _fail(exc)
-    prog, advance = _progress_bar(expected_evaluations(resolved))
+    prog, advance = _progress_bar(expected_evaluations(study.space, study.optimizer))
     t0 = time.perf_counter()
     try:
         if prog is not None:
             prog.start()
-        store = run_study(resolved, runner, resume=resume, progress=advance)
+        store = run_study(study, runner, resume=resume, overwrite=overwrite, progress=advance)
     except ParameterError as exc:
         _fail(exc)
     finally:
@@ -855,40 +898,56 @@ def run(
     elapsed = time.perf_counter() - t0
     records = store.all()
     store.close()
-    outp = Path(resolved["output"])
-    info = write_report(outp, resolved, records)
-    front = pareto_records(resolved, records)
-    export_designs(outp, resolved, front)
-    info.update(seconds=elapsed, output=str(outp))
+    outp = Path(study.output)
+    info = write_report(outp, study, records)
+    _, problems = export_designs(outp, study, pareto_records(study, records))
+    info.update(seconds=elapsed, output=str(outp), export_problems=problems)
     if as_json:
         _emit(info)
         return
-    out.print(f"[bold]{escape(resolved['study'])}[/]: {info['evaluations']} evaluations "
-              f"({info['failed']} invalid or failed) in {elapsed:.1f} s, "
-              f"{info['pareto']} Pareto designs")
-    out.print((outp / "summary.md").read_text())
-    out.print(f"results in {escape(str(outp))}/ (summary.md, pareto.csv, pareto.png, "
-              "evaluations.csv, designs/)")
+    out.print(escape(f"{study.name}: {info['evaluations']} evaluations ({info['failed']} "
+                     f"invalid or failed) in {elapsed:.1f} s, {info['pareto']} Pareto designs"),
+              highlight=False)
+    out.print(escape((outp / "summary.md").read_text()), highlight=False)
+    for p in problems:
+        err.print(escape(f"warning: export skipped: {p}"), highlight=False)
+    out.print(escape(f"results in {outp}/ (summary.md, pareto.csv, pareto.png, "
+                     "evaluations.csv, designs/)"), highlight=False)
 
 
-@app.command()
-def report(results_dir: Annotated[Path, typer.Argument(help="a study's results folder")]
-           ) -> None:
-    """Rebuild the tables, Pareto plot and summary from the store (no re-evaluation)."""
-    from .study.report import write_report
+def _open_results(results_dir: Path):
+    """A results folder → ``(study, records)``, read-only."""
+    from .study import study_from_mapping
     from .study.store import Store
 
     path = results_dir / "evaluations.sqlite"
     if not path.is_file():
         _fail(ParameterError("RESULTS_DIR", "a study results folder with evaluations.sqlite",
                              str(results_dir)))
-    store = Store(path)
-    resolved = store.get_meta("resolved")
-    records = store.all()
-    store.close()
-    info = write_report(results_dir, resolved, records)
-    out.print(f"rebuilt {escape(str(results_dir))}: {info['evaluations']} evaluations, "
-              f"{info['pareto']} Pareto designs")
+    try:
+        store = Store(path, read_only=True)
+        resolved, records = store.get_meta("resolved"), store.all()
+        store.close()
+        study = study_from_mapping(resolved)
+    except ParameterError as exc:
+        _fail(exc)
+    return study.with_output(results_dir), records
+
+
+@app.command()
+def report(results_dir: Annotated[Path, typer.Argument(help="a study's results folder")],
+           as_json: JsonOpt = False) -> None:
+    """Rebuild the tables, Pareto plot and summary from the store (no re-evaluation)."""
+    from .study.report import write_report
+
+    study, records = _open_results(results_dir)
+    info = write_report(results_dir, study, records)
+    info["output"] = str(results_dir)
+    if as_json:
+        _emit(info)
+        return
+    out.print(escape(f"rebuilt {results_dir}: {info['evaluations']} evaluations, "
+                     f"{info['pareto']} Pareto designs"), highlight=False)
 
 
 @app.command()
@@ -908,34 +967,29 @@ def compare(
     stroke use on the paper's motion; writes compare.md and overlaid slice plots."""
     import csv as csv_mod
 
-    from .config import load_mechanism as load_map
     from .study.compare import compare_designs, comparison_markdown, plot_overlaid_slices
-    from .study.evaluate import candidate_mapping
-    from .study.store import Store
 
     loaded = [_load(f) for f in (mech_files or [])]
     designs = [(m.name or f.stem, m) for f, m in zip(mech_files or [], loaded)]
     if pareto is not None:
-        store_path = pareto.parent / "evaluations.sqlite"
-        if not pareto.is_file() or not store_path.is_file():
+        if not pareto.is_file() or not (pareto.parent / "evaluations.sqlite").is_file():
             _fail(ParameterError("--pareto", "a study's pareto.csv next to its "
                                  "evaluations.sqlite", str(pareto)))
         with open(pareto) as fh:
             table = list(csv_mod.DictReader(fh))
         wanted = [r.strip() for r in (rows or "1").split(",")]
-        store = Store(store_path)
-        resolved = store.get_meta("resolved")
-        records = {str(r["seq"]): r for r in store.all()}
-        store.close()
+        study, all_records = _open_results(pareto.parent)
+        records = {str(r["seq"]): r for r in all_records}
         by_rank = {row["rank"]: row for row in table}
         for w in wanted:
             if w not in by_rank:
                 _fail(ParameterError("--rows", f"ranks present in {pareto.name} "
                                      f"(1..{len(table)})", w))
             rec = records[by_rank[w]["seq"]]
-            data = candidate_mapping(resolved["mechanism"], resolved["variables"],
-                                     rec["params"])
-            designs.append((f"{resolved['study']} #{w}", load_map(data)))
+            try:
+                designs.append((f"{study.name} #{w}", study.space.decode(rec["params"])))
+            except ParameterError as exc:
+                _fail(exc)
     if len(designs) < 1:
         _fail(ParameterError("MECH_FILES / --pareto", "at least one design", "none"))
     try:
@@ -961,8 +1015,60 @@ def compare(
     out.print(f"wrote {escape(str(out_dir))}/compare.md and overlaid slice plots")
 
 
+_DEBUG = {"on": False}
+
+
+def _version(value: bool) -> None:
+    if value:
+        from . import __version__
+
+        sys.stdout.write(f"pkmlab {__version__}\n")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    debug: Annotated[bool, typer.Option(
+        "--debug", help="show the full traceback of an unexpected error")] = False,
+    version: Annotated[bool | None, typer.Option(
+        "--version", callback=_version, is_eager=True, help="print the version and exit")]
+    = None,
+) -> None:
+    """pkmlab: design-optimisation workbench for parallel manipulators."""
+    _DEBUG["on"] = debug
+
+
 def main() -> None:
-    app()
+    """Console entry point: input errors exit 2 (one line); a file-system error exits 2 with
+    its path; a candidate's programming error exits 1 with its traceback and parameters; any
+    other unexpected error exits 1 with one line (``--debug``: the traceback)."""
+    from .study.run import CandidateError
+
+    try:
+        app(standalone_mode=False)
+    except click.exceptions.Exit as exc:
+        raise SystemExit(exc.exit_code) from None
+    except click.ClickException as exc:
+        exc.show()
+        raise SystemExit(2) from None
+    except (click.exceptions.Abort, KeyboardInterrupt):
+        sys.stderr.write("interrupted\n")
+        raise SystemExit(130) from None
+    except CandidateError as exc:
+        sys.stderr.write(f"error: {exc}\n")
+        raise SystemExit(1) from None
+    except OSError as exc:
+        if _DEBUG["on"]:
+            raise
+        where = f" ({exc.filename})" if getattr(exc, "filename", None) else ""
+        sys.stderr.write(f"error: file system: {exc.strerror or exc}{where}\n")
+        raise SystemExit(2) from None
+    except Exception as exc:  # noqa: BLE001 - last resort: one line unless --debug
+        if _DEBUG["on"]:
+            raise
+        sys.stderr.write(f"error: {type(exc).__name__}: {exc} (this is a bug in pkmlab; run "
+                         "with --debug for the traceback)\n")
+        raise SystemExit(1) from None
 
 
 if __name__ == "__main__":

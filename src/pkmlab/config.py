@@ -8,22 +8,30 @@ is a :class:`~pkmlab.errors.ParameterError` reading ``<field path>: must be …;
 
 from __future__ import annotations
 
-import copy
-import re
+import typing
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
 import yaml
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, TypeAdapter, ValidationError
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    TypeAdapter,
+    ValidationError,
+    WithJsonSchema,
+)
 
+from . import limits
 from .errors import ParameterError, format_value
 from .mechanisms import PSU6, UPS6, Luzi3, Mechanism
 from .units import ANGLE_UNITS, LENGTH_UNITS, parse_angle, parse_length
 
 __all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec", "workspace_spec", "WorkspaceSpec",
-           "load_workspace_study", "WorkspaceStudySpec", "load_study", "StudySpec",
-           "study_schema", "set_path"]
+           "load_workspace_study", "WorkspaceStudySpec", "to_display", "read_yaml",
+           "validate_model"]
 
 
 class _Shown(str):
@@ -107,16 +115,36 @@ def _auto_angle(v: Any) -> float | None:
     return None if v == "auto" else _angle(v)
 
 
-Length = Annotated[float, BeforeValidator(_length)]
-PositiveLength = Annotated[float, BeforeValidator(_positive_length)]
-Angle = Annotated[float, BeforeValidator(_angle)]
-AutoAngle = Annotated[float | None, BeforeValidator(_auto_angle)]
-Radii = Annotated[list[float], BeforeValidator(_length_list(2))]
-Stroke = Annotated[list[float], BeforeValidator(_stroke)]
-Points = Annotated[list[list[float]], BeforeValidator(_points)]
-Vector3 = Annotated[list[float], BeforeValidator(_length_list(3))]
-Pose = Annotated[list[float], BeforeValidator(_pose)]
-LinkLengths = Annotated[float | list[float], BeforeValidator(_link_lengths)]
+# JSON Schema of the quantity types: a bare number (in the documented unit) or a string with
+# its unit, so that editors accept what the loader accepts.
+_NUMBER_OR_UNIT = {"anyOf": [{"type": "number"}, {"type": "string"}]}
+
+
+def _json_list(n: int | None, item: dict = _NUMBER_OR_UNIT) -> WithJsonSchema:
+    schema: dict = {"type": "array", "items": item}
+    if n is not None:
+        schema.update(minItems=n, maxItems=n)
+    return WithJsonSchema(schema)
+
+
+_LENGTH_JSON = WithJsonSchema({**_NUMBER_OR_UNIT, "description": "mm, or a string with units "
+                               "('225 mm', '4 in')"})
+_ANGLE_JSON = WithJsonSchema({**_NUMBER_OR_UNIT, "description": "deg, or a string with units "
+                              "('33.7 deg', '0.5 rad')"})
+
+Length = Annotated[float, BeforeValidator(_length), _LENGTH_JSON]
+PositiveLength = Annotated[float, BeforeValidator(_positive_length), _LENGTH_JSON]
+Angle = Annotated[float, BeforeValidator(_angle), _ANGLE_JSON]
+AutoAngle = Annotated[float | None, BeforeValidator(_auto_angle), _ANGLE_JSON]
+Radii = Annotated[list[float], BeforeValidator(_length_list(2)), _json_list(2)]
+Stroke = Annotated[list[float], BeforeValidator(_stroke), _json_list(2)]
+Points = Annotated[list[list[float]], BeforeValidator(_points),
+                   _json_list(None, {"type": "array", "items": _NUMBER_OR_UNIT})]
+Vector3 = Annotated[list[float], BeforeValidator(_length_list(3)), _json_list(3)]
+Pose = Annotated[list[float], BeforeValidator(_pose), _json_list(6)]
+LinkLengths = Annotated[float | list[float], BeforeValidator(_link_lengths),
+                        WithJsonSchema({"anyOf": [_NUMBER_OR_UNIT,
+                                                  {"type": "array", "items": _NUMBER_OR_UNIT}]})]
 
 
 class _Model(BaseModel):
@@ -255,7 +283,7 @@ def _angle_triple(v: Any) -> list[float]:
     return [_angle(x) for x in v]
 
 
-AngleTriple = Annotated[list[float], BeforeValidator(_angle_triple)]
+AngleTriple = Annotated[list[float], BeforeValidator(_angle_triple), _json_list(3)]
 
 
 class JointLimitsSpec(_Model):
@@ -276,8 +304,13 @@ def _stroke_choice(v: Any) -> bool | list[float]:
     return _stroke(v)
 
 
+StrokeChoice = Annotated[bool | list[float], BeforeValidator(_stroke_choice),
+                         WithJsonSchema({"anyOf": [{"type": "boolean"},
+                                                   {"type": "array", "items": _NUMBER_OR_UNIT}]})]
+
+
 class ConstraintsSpec(_Model):
-    stroke: Annotated[bool | list[float], BeforeValidator(_stroke_choice)] = Field(
+    stroke: StrokeChoice = Field(
         True, description="true (the mechanism's window) or [min, max] to try another")
     joint_limits: JointLimitsSpec | None = None
     link_diameter: PositiveLength | None = Field(None, description="leg diameter (mm)")
@@ -296,7 +329,8 @@ class WorkspaceSpec(_Model):
     semantics: Literal["simultaneous", "single-axis"] = "simultaneous"
     tilt: Angle | None = Field(None, description="tilt-and-torsion set: largest tilt (deg)")
     torsion: Angle = Field(0.0, description="tilt-and-torsion set: torsion half-range (deg)")
-    samples: int = Field(7, ge=1, le=101, description="orientation samples per angle")
+    samples: int = Field(7, ge=limits.SAMPLES_PER_ANGLE[0], le=limits.SAMPLES_PER_ANGLE[1],
+                         description="orientation samples per angle")
     resolution: PositiveLength = Field(2.5, description="grid spacing (mm)")
     constraints: ConstraintsSpec = ConstraintsSpec()
     slice_window: PositiveLength = Field(152.4, description="slice plot window edge (mm)")
@@ -318,9 +352,14 @@ class WorkspaceSpec(_Model):
         if self.orientation is not None and self.kind != "constant":
             raise ParameterError("orientation", "only given for kind 'constant'",
                                  self.orientation)
+        lo_h, hi_h = limits.RESOLUTION_MM
+        if not lo_h <= self.resolution <= hi_h:
+            raise ParameterError("resolution", f"a grid spacing in [{lo_h:g}, {hi_h:g}] mm",
+                                 _Shown(f"{self.resolution:g} mm"))
+        lo_a, hi_a = limits.EULER_HALF_RANGE_DEG
         if self.box is not None:
-            if any(not 0 <= a <= np.pi for a in self.box):
-                raise ParameterError("box", "half-ranges in [0, 180] deg",
+            if any(not np.radians(lo_a) <= a <= np.radians(hi_a) for a in self.box):
+                raise ParameterError("box", f"half-ranges in [{lo_a:g}, {hi_a:g}] deg",
                                      [float(np.degrees(a)) for a in self.box])
             oset = OrientationSet.box(tuple(self.box), self.semantics, self.samples)
         elif self.tilt is not None:
@@ -441,312 +480,69 @@ UNITS_HELP = (f"lengths: bare numbers in mm or strings with {sorted(LENGTH_UNITS
               f"angles: bare numbers in deg or strings with {sorted(ANGLE_UNITS)}")
 
 
-# ---- design studies -----------------------------------------------------------------------------
-
-#: named design variables → (path in the mechanism mapping, quantity), per family
-DESIGN_ALIASES: dict[str, dict[str, tuple[str, str]]] = {
-    fam: {
-        "base_inner_radius": ("generator.base_radii[0]", "length"),
-        "base_outer_radius": ("generator.base_radii[1]", "length"),
-        "platform_inner_radius": ("generator.platform_radii[0]", "length"),
-        "platform_outer_radius": ("generator.platform_radii[1]", "length"),
-        "platform_rotation": ("generator.platform_rotation", "angle"),
-        "base_pair_angle": ("generator.base_pair_angle", "angle"),
-        "base_pair_separation": ("generator.base_pair_separation", "angle"),
-        "platform_pair_separation": ("generator.platform_pair_separation", "angle"),
-        "stroke_min": ("stroke[0]", "length"),
-        "stroke_max": ("stroke[1]", "length"),
-        "tool_offset_z": ("tool_offset[2]", "length"),
-        "pairing": ("generator.pairing", "text"),
-        **({"link_length": ("link_length", "length")} if fam == "psu6" else {}),
-    } for fam in ("psu6", "ups6")
-}
-DESIGN_ALIASES["luzi3"] = {
-    "base_diameter": ("generator.base_diameter", "length"),
-    "platform_diameter": ("generator.platform_diameter", "length"),
-    "phi": ("generator.phi", "angle"),
-    "upper_link": ("upper_link", "length"),
-    "stroke_min": ("stroke[0]", "length"),
-    "stroke_max": ("stroke[1]", "length"),
-}
-_QUANTITY = {"length": (parse_length, "mm"), "angle": (parse_angle, "deg"),
-             "number": (None, ""), "text": ("text", "")}
+# ---- display form: typed specs back to YAML with explicit units --------------------------------
 
 
-class DesignVariableSpec(_Model):
-    """One design variable: a continuous or integer range, or a list of choices."""
-
-    low: Any = None
-    high: Any = None
-    choices: list[Any] | None = None
-    type: Literal["continuous", "integer", "choice"] | None = None
-    path: str | None = Field(None, description="mechanism field, e.g. generator.base_radii[1]")
-    quantity: Literal["length", "angle", "number", "text"] | None = None
-    levels: int = Field(5, ge=2, le=1000, description="grid optimiser: values per variable")
+def _fmt_length(v: float) -> str:
+    return f"{v:.12g} mm"
 
 
-class DexteritySpec(_Model):
-    characteristic_length: Any = Field("auto", description="'auto' (Angeles) or a length")
-    gci_samples: int = Field(2000, ge=10, le=1_000_000)
-    force_limit: float = Field(150.0, gt=0, description="actuator force limit (N)")
+def _fmt_angle(v: float) -> str:
+    return f"{np.degrees(v):.12g} deg"
 
 
-class TrajectorySpec(_Model):
-    paper_motion: Literal[True] = True
-    segment_time: float = Field(1.0, gt=0, description="s per cubic segment")
-    payload: float = Field(0.0, ge=0, description="payload mass (kg)")
+def _display_of(validator):
+    """Formatter of a field's parsed value, by the validator that parsed it (None: as is)."""
+    table = {_length: _fmt_length, _positive_length: _fmt_length, _angle: _fmt_angle,
+             _stroke: lambda v: [_fmt_length(x) for x in v],
+             _angle_triple: lambda v: [_fmt_angle(x) for x in v],
+             _points: lambda v: [[_fmt_length(x) for x in row] for row in v],
+             _pose: lambda v: [_fmt_length(x) for x in v[:3]] + [_fmt_angle(x) for x in v[3:]],
+             _auto_angle: lambda v: "auto" if v is None else _fmt_angle(v),
+             _link_lengths: lambda v: ([_fmt_length(x) for x in v] if isinstance(v, list)
+                                       else _fmt_length(v)),
+             _stroke_choice: lambda v: v if v is True else [_fmt_length(x) for x in v]}
+    if validator in table:
+        return table[validator]
+    if getattr(validator, "__qualname__", "").startswith("_length_list"):
+        return lambda v: [_fmt_length(x) for x in v]
+    return None
 
 
-class EvaluateSpec(_Model):
-    workspace: WorkspaceSpec | None = None
-    inscribed: bool = False
-    orientation_capability: bool = False
-    dexterity: DexteritySpec | None = None
-    trajectory: TrajectorySpec | None = None
+def to_display(model: BaseModel) -> dict:
+    """A validated spec as a YAML mapping with every default filled in and every quantity
+    written with its unit (``"225 mm"``, ``"33.7 deg"``); loading it gives the same spec."""
+    out: dict = {}
+    for name, info in type(model).model_fields.items():
+        value = getattr(model, name)
+        metadata = list(info.metadata)
+        for arg in typing.get_args(info.annotation):       # Optional[Annotated[...]]
+            metadata += list(getattr(arg, "__metadata__", ()))
+        validator = next((m.func for m in metadata if isinstance(m, BeforeValidator)), None)
+        fmt = _display_of(validator)
+        if value is None:
+            out[name] = "auto" if validator is _auto_angle else None
+        elif isinstance(value, BaseModel):
+            out[name] = to_display(value)
+        elif isinstance(value, dict):
+            out[name] = {k: to_display(v) if isinstance(v, BaseModel) else v
+                         for k, v in value.items()}
+        elif fmt is not None and not isinstance(value, str):
+            out[name] = fmt(value)
+        else:
+            out[name] = value
+    return out
 
 
-class OptimizerSpec(_Model):
-    method: Literal["grid", "sobol", "lhs", "nsga2", "de"]
-    samples: int = Field(64, ge=1, le=10_000_000, description="sobol / lhs designs")
-    population: int = Field(32, ge=4, le=100_000)
-    generations: int = Field(10, ge=1, le=100_000)
+def read_yaml(path: Path, what: str) -> Any:
+    """The YAML file ``path`` (a ``what`` file), parsed; errors as :class:`ParameterError`."""
+    return _read_yaml(path, what)
 
 
-class MechanismSource(_Model):
-    """A mechanism file plus overrides, or (``inline``) the mechanism mapping itself."""
-
-    file: str | None = Field(None, description="mechanism YAML, relative to the study file")
-    overrides: dict[str, Any] = Field(default_factory=dict)
-    inline: dict[str, Any] | None = Field(None, description="a mechanism mapping (family, "
-                                          "generator, ...) instead of a file")
-
-
-class StudySpec(_Model):
-    """A design study file (see README): what to vary, evaluate, optimise and keep."""
-
-    study: str = Field(pattern=r"^[A-Za-z0-9._-]+$")
-    description: str = ""
-    mechanism: MechanismSource
-    design: dict[str, DesignVariableSpec] = Field(min_length=1)
-    evaluate: EvaluateSpec
-    objectives: list[dict[Literal["maximize", "minimize"], str]] = Field(min_length=1)
-    constraints: list[dict[str, Any]] = Field(default_factory=list)
-    optimizer: OptimizerSpec
-    seed: int = 0
-    output: str | None = Field(None, description="output folder (default results/<study>)")
-    top: int = Field(5, ge=0, le=100, description="Pareto designs exported in full")
-
-
-def _design_variable(name: str, v: DesignVariableSpec, family: str) -> dict:
-    field = f"design.{name}"
-    alias = DESIGN_ALIASES[family].get(name)
-    path = v.path or (alias[0] if alias else None)
-    quantity = v.quantity or (alias[1] if alias else None)
-    if path is None:
-        raise ParameterError(field, f"a known variable of family {family!r} "
-                             f"{sorted(DESIGN_ALIASES[family])} or one with 'path' and "
-                             "'quantity'", name)
-    if quantity is None:
-        raise ParameterError(f"{field}.quantity", "one of ['length', 'angle', 'number']", None)
-    kind = v.type or ("choice" if v.choices is not None else "continuous")
-    parse, unit = _QUANTITY[quantity]
-
-    if quantity == "text" and kind != "choice":
-        raise ParameterError(f"{field}.choices", "a list of choices (a text variable has no "
-                             "range)", None)
-
-    def conv(x, which):
-        if parse == "text":
-            if not isinstance(x, str):
-                raise ParameterError(f"{field}.{which}", "a text choice", x)
-            return x
-        try:
-            if parse is None:
-                if isinstance(x, bool) or not isinstance(x, int | float):
-                    raise ParameterError("", "a number", x)
-                return float(x)
-            return parse(x, "")
-        except ParameterError as exc:
-            raise ParameterError(f"{field}.{which}", exc.allowed if parse else "a number",
-                                 x) from None
-
-    if kind == "choice":
-        if not v.choices:
-            raise ParameterError(f"{field}.choices", "a non-empty list", v.choices)
-        return {"name": name, "path": path, "quantity": quantity, "type": "choice",
-                "choices": [conv(c, "choices") for c in v.choices], "unit": unit}
-    if v.low is None or v.high is None:
-        raise ParameterError(f"{field}.{'low' if v.low is None else 'high'}",
-                             "given (a bound of the range)", None)
-    lo, hi = conv(v.low, "low"), conv(v.high, "high")
-    if not lo < hi:
-        raise ParameterError(field, "low < high", f"low {v.low!r}, high {v.high!r}")
-    if kind == "integer" and (lo != int(lo) or hi != int(hi)):
-        raise ParameterError(field, "integer bounds for an integer variable", [v.low, v.high])
-    return {"name": name, "path": path, "quantity": quantity, "type": kind, "low": lo,
-            "high": hi, "levels": v.levels, "unit": unit}
-
-
-def load_study(source: str | Path):
-    """Validate a study file → ``(spec, resolved)``.
-
-    ``resolved`` is a plain dict with every default filled in and every quantity converted
-    (mm, rad): ``mechanism`` (the mechanism mapping with overrides applied), ``variables``,
-    ``evaluate`` (workspace request, flags), ``objectives``, ``constraints``, ``optimizer``,
-    ``seed``, ``output``.
-    """
-    from .study.metrics import ALIASES, METRICS, needs_of
-
-    path = Path(source)
-    data = _read_yaml(path, "study")
-    if not isinstance(data, dict):
-        raise ParameterError("(study)", "a mapping with study, mechanism, design, evaluate, "
-                             "objectives, optimizer", type(data).__name__)
+def validate_model(model: type[BaseModel], data: Any, prefix: str = ""):
+    """``model.model_validate(data)`` with errors as :class:`ParameterError` (field path
+    prefixed with ``prefix``)."""
     try:
-        spec = StudySpec.model_validate(data)
+        return model.model_validate(data)
     except ValidationError as exc:
-        raise _translate(exc) from None
-    src = spec.mechanism
-    if (src.file is None) == (src.inline is None):
-        raise ParameterError("mechanism", "exactly one of 'file' (with optional 'overrides') "
-                             "or 'inline'", sorted(k for k in ("file", "inline")
-                                                   if getattr(src, k) is not None))
-    if src.file is not None:
-        mech_path = (path.parent / src.file).resolve()
-        mech_data = _read_yaml(mech_path, "mechanism") if mech_path.is_file() else None
-        if not isinstance(mech_data, dict):
-            raise ParameterError("mechanism.file", "an existing mechanism YAML file", src.file)
-    else:
-        mech_path, mech_data = path, dict(src.inline)
-    mech_data = _merge(mech_data, src.overrides)
-    try:
-        mech = load_mechanism(mech_data)
-    except ParameterError as exc:
-        raise ParameterError(f"mechanism.{exc.field}", exc.allowed, exc.got) from None
-    variables = [_design_variable(n, v, mech.family) for n, v in spec.design.items()]
-    for var in variables:            # the path's parent must exist in the mechanism mapping
-        try:
-            parts = _path_parts(var["path"])
-            node = mech_data
-            for p in parts[:-1]:
-                node = node[p]
-            leaf = parts[-1]
-            if isinstance(leaf, int):
-                node[leaf]
-            elif not isinstance(node, dict):
-                raise TypeError(var["path"])
-        except (KeyError, IndexError, TypeError):
-            raise ParameterError(f"design.{var['name']}.path", "a field present in the "
-                                 "mechanism file (generator block, stroke, ...)",
-                                 var["path"]) from None
-    ev = spec.evaluate
-    blocks = {"workspace": ev.workspace is not None,
-              "inscribed": ev.workspace is not None and ev.inscribed,
-              "orientation_capability": ev.workspace is not None and ev.orientation_capability,
-              "dexterity": ev.dexterity is not None and ev.workspace is not None,
-              "trajectory": ev.trajectory is not None}
-    if ev.dexterity is not None and ev.workspace is None:
-        raise ParameterError("evaluate.dexterity", "used with an evaluate.workspace block "
-                             "(its aggregates are over that workspace)", "no workspace")
-    known = sorted(set(METRICS) | set(ALIASES))
-
-    def check_metric(name, where):
-        if name not in METRICS and name not in ALIASES:
-            raise ParameterError(where, f"one of {known}", name)
-        need = needs_of(name)
-        if need is not None and not blocks[need]:
-            raise ParameterError(where, f"a metric the evaluation computes (add evaluate."
-                                 f"{need})", name)
-        if name in ALIASES and ev.workspace.kind != ALIASES[name]:
-            raise ParameterError(where, f"the volume of the evaluated kind "
-                                 f"('{ev.workspace.kind}_volume')", name)
-
-    objectives = []
-    for i, o in enumerate(spec.objectives):
-        if len(o) != 1:
-            raise ParameterError(f"objectives[{i}]", "one of {maximize: metric} or "
-                                 "{minimize: metric}", o)
-        (sense, name), = o.items()
-        check_metric(name, f"objectives[{i}].{sense}")
-        objectives.append({"metric": name, "sense": sense})
-    constraints = []
-    for i, c in enumerate(spec.constraints):
-        if not isinstance(c, dict) or len(c) != 1:
-            raise ParameterError(f"constraints[{i}]", "{metric: {min: x} | {max: x}} or "
-                                 "{metric: true}", c)
-        (name, rule), = c.items()
-        check_metric(name, f"constraints[{i}]")
-        if rule is True:
-            rule = {"min": 1.0}
-        if not isinstance(rule, dict) or not rule or set(rule) - {"min", "max"}:
-            raise ParameterError(f"constraints[{i}].{name}", "{min: x}, {max: x} or true",
-                                 rule)
-        for k, x in rule.items():
-            if isinstance(x, bool) or not isinstance(x, int | float):
-                raise ParameterError(f"constraints[{i}].{name}.{k}", "a number", x)
-        constraints.append({"metric": name, **{k: float(x) for k, x in rule.items()}})
-    opt = spec.optimizer
-    if opt.method == "de" and len(objectives) != 1:
-        raise ParameterError("optimizer.method", "'nsga2', 'grid', 'sobol' or 'lhs' for "
-                             "several objectives ('de' takes one)", opt.method)
-    if opt.method in ("nsga2", "de") and any(v["type"] == "choice" for v in variables):
-        raise ParameterError("optimizer.method", "'grid', 'sobol' or 'lhs' with choice "
-                             "variables", opt.method)
-    dx = ev.dexterity
-    evaluate = {
-        # the validated block as written (units included): parsed again where it is used
-        "workspace": None if ev.workspace is None else data["evaluate"]["workspace"],
-        "inscribed": blocks["inscribed"],
-        "orientation_capability": blocks["orientation_capability"],
-        "dexterity": None if dx is None else {
-            "characteristic_length": (None if str(dx.characteristic_length) == "auto"
-                                      else parse_length(dx.characteristic_length,
-                                                        "evaluate.dexterity."
-                                                        "characteristic_length")),
-            "gci_samples": dx.gci_samples, "force_limit": dx.force_limit},
-        "trajectory": None if ev.trajectory is None else ev.trajectory.model_dump(),
-    }
-    resolved = {"study": spec.study, "description": spec.description,
-                "mechanism": mech_data, "mechanism_file": str(mech_path),
-                "variables": variables, "evaluate": evaluate, "objectives": objectives,
-                "constraints": constraints, "optimizer": opt.model_dump(), "seed": spec.seed,
-                "output": spec.output or f"results/{spec.study}", "top": spec.top}
-    return spec, resolved
-
-
-def _merge(base: dict, over: dict) -> dict:
-    out = dict(base)
-    for k, v in over.items():
-        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) \
-            else v
-    return out
-
-
-_PATH_RE = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)")
-
-
-def _path_parts(path: str) -> list:
-    parts: list = []
-    for piece in path.split("."):
-        m = _PATH_RE.fullmatch(piece)
-        if not m:
-            raise KeyError(path)
-        parts.append(m.group(1))
-        parts += [int(i) for i in re.findall(r"\[(\d+)\]", m.group(2))]
-    return parts
-
-
-def set_path(data: dict, path: str, value) -> dict:
-    """A deep copy of ``data`` with ``path`` (``a.b[1]``) set to ``value``."""
-    out = copy.deepcopy(data)
-    parts = _path_parts(path)
-    node = out
-    for p in parts[:-1]:
-        node = node[p]
-    node[parts[-1]] = value
-    return out
-
-
-def study_schema() -> dict:
-    """JSON Schema of the study file (for editors)."""
-    return StudySpec.model_json_schema()
+        raise _translate(exc, prefix) from None

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["ParameterError", "format_value"]
+__all__ = ["ParameterError", "NumericalError", "format_value"]
 
 
 def format_value(value: Any) -> str:
@@ -25,3 +25,16 @@ class ParameterError(ValueError):
         self.allowed = allowed
         self.got = got
         super().__init__(f"{field}: must be {allowed}; got {format_value(got)}")
+
+
+class NumericalError(RuntimeError):
+    """A declared numerical failure (singular, undefined, not converged) that makes a result
+    impossible: recorded as data with its reason, never a crash or a silent NaN.
+
+    The message reads ``<what>: <reason>``.
+    """
+
+    def __init__(self, what: str, reason: str):
+        self.what = what
+        self.reason = reason
+        super().__init__(f"{what}: {reason}")

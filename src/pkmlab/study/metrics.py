@@ -1,42 +1,137 @@
-"""The metrics a design study can optimise or constrain, and what computes each.
+"""The metrics a design study can optimise or constrain: one registry, read by everyone.
 
-``METRICS[name] = (needs, unit, description)``; ``needs`` names the evaluation block that must
-be present in the study's ``evaluate`` section (``None``: always available from the geometry).
+Each evaluator (:mod:`.evaluators`) declares the metrics it writes here, with their unit, what
+they mean and what kind of number they are. The study validator, ``pkmlab schema``, ``pkmlab
+metrics`` and the README table all read this registry, so a metric is defined exactly once.
+
+Kinds of number (``statistic``):
+
+* ``exact`` — computed exactly for the geometry (footprint, stroke);
+* ``grid`` — exact in z, on the workspace's x-y grid and sampled orientation set (volumes:
+  carry their error estimate in ``workspace_volume_error``);
+* ``worst-case`` — the extreme over *every* voxel of the workspace grid and *every* sample of
+  its orientation set (never a random sample's extreme);
+* ``bound`` — a bracketed optimum: the value is the largest verified level, the bracket the
+  search resolution (``<name>_bracket``);
+* ``sampled`` — a Monte-Carlo statistic over random poses (its name says so, or it carries a
+  standard error);
+* ``flag`` — 1 or 0.
 """
 
 from __future__ import annotations
 
-__all__ = ["METRICS", "needs_of", "ALIASES"]
+from dataclasses import dataclass
 
-METRICS: dict[str, tuple[str | None, str, str]] = {
-    "workspace_volume": ("workspace", "cm³", "volume of the requested workspace"),
-    "workspace_empty": ("workspace", "", "1 if the requested workspace is empty"),
-    "z_span": ("workspace", "mm", "height of the workspace"),
-    "inscribed_box_volume": ("inscribed", "cm³", "largest inscribed axis-aligned box"),
-    "inscribed_box_edge": ("inscribed", "mm", "shortest edge of that box"),
-    "inscribed_cylinder_radius": ("inscribed", "mm", "largest inscribed vertical cylinder"),
-    "inscribed_cylinder_volume": ("inscribed", "cm³", "volume of that cylinder"),
-    "orientation_capability": ("orientation_capability", "deg",
-                               "largest ±a simultaneous Euler box with a non-empty dexterous "
-                               "workspace"),
-    "gci": ("dexterity", "", "global conditioning index (Monte-Carlo mean of 1/κ)"),
-    "gci_std_error": ("dexterity", "", "standard error of the GCI estimate"),
-    "worst_kappa": ("dexterity", "", "largest κ met by the GCI samples"),
-    "nominal_kappa": ("dexterity", "", "κ at the nominal pose"),
-    "min_force": ("dexterity", "N", "smallest force held in every direction (GCI samples)"),
-    "paper_motion_fits": ("trajectory", "", "1 if the paper's motion fits the stroke"),
-    "paper_motion_margin": ("trajectory", "mm", "smallest stroke margin along the motion"),
-    "base_outer_radius": (None, "mm", "footprint: largest base joint radius"),
-    "platform_outer_radius": (None, "mm", "largest platform joint radius"),
-    "stroke_length": (None, "mm", "actuator travel"),
-}
+__all__ = ["Metric", "METRICS", "KIND_VOLUMES", "metric", "metrics_of", "metrics_markdown",
+           "STATISTICS"]
 
-#: ``<kind>_volume`` names the workspace volume when the study's workspace is of that kind
-ALIASES = {"dexterous_volume": "dexterous", "reachable_volume": "reachable",
-           "constant_volume": "constant"}
+STATISTICS = ("exact", "grid", "worst-case", "bound", "sampled", "flag")
 
 
-def needs_of(name: str) -> str | None:
-    if name in ALIASES:
-        return "workspace"
-    return METRICS[name][0]
+@dataclass(frozen=True)
+class Metric:
+    """One study metric: ``name`` written by ``evaluator`` in ``unit``."""
+
+    name: str
+    evaluator: str
+    unit: str
+    statistic: str
+    description: str
+
+    def __post_init__(self):
+        if self.statistic not in STATISTICS:
+            raise ValueError(f"unknown statistic {self.statistic!r}")
+
+    @property
+    def label(self) -> str:
+        """``name (unit)`` for tables and axes."""
+        return f"{self.name} ({self.unit})" if self.unit else self.name
+
+
+_ALL = [
+    # geometry: always available
+    Metric("base_outer_radius", "geometry", "mm", "exact",
+           "footprint: largest horizontal distance of a base joint from the base z axis"),
+    Metric("platform_outer_radius", "geometry", "mm", "exact",
+           "largest distance of a platform joint from the platform joints' centroid"),
+    Metric("stroke_length", "geometry", "mm", "exact", "actuator travel (max - min)"),
+    # workspace
+    Metric("workspace_volume", "workspace", "cm³", "grid",
+           "volume of the requested workspace (exact in z, x-y grid and sampled orientation "
+           "set; error in workspace_volume_error)"),
+    Metric("workspace_volume_error", "workspace", "cm³", "grid",
+           "error estimate of workspace_volume: content of the boundary columns"),
+    Metric("constant_volume", "workspace", "cm³", "grid",
+           "workspace_volume when the requested kind is 'constant'"),
+    Metric("reachable_volume", "workspace", "cm³", "grid",
+           "workspace_volume when the requested kind is 'reachable'"),
+    Metric("dexterous_volume", "workspace", "cm³", "grid",
+           "workspace_volume when the requested kind is 'dexterous'"),
+    Metric("workspace_empty", "workspace", "", "flag", "1 if the requested workspace is empty"),
+    Metric("z_span", "workspace", "mm", "grid", "height of the workspace (0 when empty)"),
+    # inscribed shapes
+    Metric("inscribed_box_volume", "inscribed", "cm³", "grid",
+           "largest inscribed axis-aligned box found (verified by sampling)"),
+    Metric("inscribed_box_edge", "inscribed", "mm", "grid", "shortest edge of that box"),
+    Metric("inscribed_cylinder_radius", "inscribed", "mm", "grid",
+           "largest inscribed vertical cylinder found (verified by sampling)"),
+    Metric("inscribed_cylinder_volume", "inscribed", "cm³", "grid", "volume of that cylinder"),
+    # orientation capability
+    Metric("orientation_capability", "orientation_capability", "deg", "bound",
+           "largest a such that the ±a simultaneous Euler box has a non-empty dexterous "
+           "workspace on the study's grid: the largest level verified by bisection"),
+    Metric("orientation_capability_bracket", "orientation_capability", "deg", "bound",
+           "width of the bisection bracket above orientation_capability (the first level "
+           "found empty lies this much higher)"),
+    # dexterity
+    Metric("nominal_kappa", "dexterity", "", "exact",
+           "κ of the homogenised Jacobian at the nominal pose"),
+    Metric("characteristic_length", "dexterity", "mm", "exact",
+           "length L homogenising the Jacobian (Angeles' or the one given)"),
+    Metric("worst_kappa", "dexterity", "", "worst-case",
+           "largest κ over every voxel of the workspace × every orientation sample "
+           "(inf when a singular pose lies inside: stored as null with a note)"),
+    Metric("min_force", "dexterity", "N", "worst-case",
+           "smallest force held in every direction over every voxel × orientation sample"),
+    Metric("singularity_free", "dexterity", "", "flag",
+           "1 when no voxel × orientation sample of the workspace is singular"),
+    Metric("gci", "dexterity", "", "sampled",
+           "global conditioning index: Monte-Carlo mean of 1/κ over the workspace "
+           "(singular poses count 0); standard error in gci_std_error"),
+    Metric("gci_std_error", "dexterity", "", "sampled", "standard error of gci"),
+    Metric("sampled_max_kappa", "dexterity", "", "sampled",
+           "largest κ among the GCI's random poses (a sample statistic, ≤ worst_kappa)"),
+    Metric("sampled_min_force", "dexterity", "N", "sampled",
+           "smallest all-direction force among the GCI's random poses (≥ min_force)"),
+    # trajectory
+    Metric("paper_motion_fits", "trajectory", "", "flag",
+           "1 if Hopkins & Williams' ±2 in / ±30° motion stays within the stroke"),
+    Metric("paper_motion_margin", "trajectory", "mm", "exact",
+           "smallest stroke margin along that motion (negative: the overshoot)"),
+]
+
+#: name → :class:`Metric`
+METRICS: dict[str, Metric] = {m.name: m for m in _ALL}
+
+#: ``<kind>_volume`` → the workspace kind it requires
+KIND_VOLUMES = {"constant_volume": "constant", "reachable_volume": "reachable",
+                "dexterous_volume": "dexterous"}
+
+
+def metric(name: str) -> Metric:
+    return METRICS[name]
+
+
+def metrics_of(evaluator: str) -> tuple[str, ...]:
+    """Names of the metrics ``evaluator`` writes."""
+    return tuple(m.name for m in _ALL if m.evaluator == evaluator)
+
+
+def metrics_markdown() -> str:
+    """The README's metric table."""
+    rows = ["| metric | unit | evaluate block | kind | meaning |", "|---|---|---|---|---|"]
+    for m in _ALL:
+        block = "(always)" if m.evaluator == "geometry" else m.evaluator
+        rows.append(f"| `{m.name}` | {m.unit or '—'} | {block} | {m.statistic} | "
+                    f"{m.description} |")
+    return "\n".join(rows) + "\n"

@@ -15,65 +15,31 @@ import warnings
 
 import numpy as np
 
-__all__ = ["DesignSpace", "OPTIMISERS"]
+from .definition import PENALTY
+
+__all__ = ["OPTIMISERS", "expected_evaluations"]
 
 log = logging.getLogger(__name__)
 
-PENALTY = 1.0e12
+#: designs per batch handed to the runner by the sampling optimisers (generated lazily)
+CHUNK = 256
 
 
-class DesignSpace:
-    """The design variables: maps unit-cube points and optimiser vectors to parameter dicts."""
-
-    def __init__(self, variables: list[dict]):
-        self.variables = variables
-
-    @property
-    def names(self) -> list[str]:
-        return [v["name"] for v in self.variables]
-
-    def bounds(self) -> np.ndarray:
-        """``(n, 2)`` box for continuous optimisers (integers span [low, high + 1))."""
-        return np.array([[v["low"], v["high"] + (1.0 if v["type"] == "integer" else 0.0)]
-                         for v in self.variables])
-
-    def from_vector(self, x: np.ndarray) -> dict:
-        out = {}
-        for v, xi in zip(self.variables, x):
-            if v["type"] == "integer":
-                out[v["name"]] = int(min(np.floor(xi), v["high"]))
-            else:
-                out[v["name"]] = float(xi)
-        return out
-
-    def from_unit(self, u: np.ndarray) -> dict:
-        out = {}
-        for v, ui in zip(self.variables, u):
-            if v["type"] == "choice":
-                c = v["choices"]
-                out[v["name"]] = c[min(int(ui * len(c)), len(c) - 1)]
-            elif v["type"] == "integer":
-                n = int(v["high"] - v["low"]) + 1
-                out[v["name"]] = int(v["low"] + min(int(ui * n), n - 1))
-            else:
-                out[v["name"]] = float(v["low"] + ui * (v["high"] - v["low"]))
-        return out
-
-    def grid(self) -> list[dict]:
-        axes = []
-        for v in self.variables:
-            if v["type"] == "choice":
-                axes.append(list(v["choices"]))
-            elif v["type"] == "integer":
-                vals = np.unique(np.round(np.linspace(v["low"], v["high"], v["levels"])))
-                axes.append([int(x) for x in vals])
-            else:
-                axes.append([float(x) for x in np.linspace(v["low"], v["high"], v["levels"])])
-        return [dict(zip(self.names, combo)) for combo in itertools.product(*axes)]
+def _chunks(designs, size: int = CHUNK):
+    it = iter(designs)
+    while batch := list(itertools.islice(it, size)):
+        yield batch
 
 
 def _grid(space, evaluate_batch, opt, seed):
-    evaluate_batch(space.grid())
+    for batch in _chunks(space.grid()):
+        evaluate_batch(batch)
+
+
+def _qmc(engine, space, evaluate_batch, n):
+    for start in range(0, n, CHUNK):
+        u = engine.random(min(CHUNK, n - start))
+        evaluate_batch([space.from_unit(r) for r in u])
 
 
 def _sobol(space, evaluate_batch, opt, seed):
@@ -81,15 +47,16 @@ def _sobol(space, evaluate_batch, opt, seed):
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)   # any n; powers of 2 balance best
-        u = qmc.Sobol(d=len(space.variables), scramble=True, seed=seed).random(opt["samples"])
-    evaluate_batch([space.from_unit(r) for r in u])
+        _qmc(qmc.Sobol(d=len(space.variables), scramble=True, seed=seed), space,
+             evaluate_batch, opt.samples)
 
 
 def _lhs(space, evaluate_batch, opt, seed):
     from scipy.stats import qmc
 
-    u = qmc.LatinHypercube(d=len(space.variables), seed=seed).random(opt["samples"])
-    evaluate_batch([space.from_unit(r) for r in u])
+    u = qmc.LatinHypercube(d=len(space.variables), seed=seed).random(opt.samples)
+    for start in range(0, len(u), CHUNK):
+        evaluate_batch([space.from_unit(r) for r in u[start:start + CHUNK]])
 
 
 def _nsga2(space, evaluate_batch, opt, seed):
@@ -112,8 +79,8 @@ def _nsga2(space, evaluate_batch, opt, seed):
             if n_con:
                 out["G"] = G
 
-    minimize(StudyProblem(), NSGA2(pop_size=opt["population"]),
-             ("n_gen", opt["generations"]), seed=seed, verbose=False)
+    minimize(StudyProblem(), NSGA2(pop_size=opt.population),
+             ("n_gen", opt.generations), seed=seed, verbose=False)
 
 
 def _de(space, evaluate_batch, opt, seed):
@@ -128,9 +95,20 @@ def _de(space, evaluate_batch, opt, seed):
         viol = np.sum(np.clip(G, 0, None), axis=1) if G.shape[1] else 0.0
         return F[:, 0] + PENALTY * (viol > 0) + viol
 
-    differential_evolution(f, b, seed=seed, maxiter=opt["generations"],
-                           popsize=max(1, opt["population"] // len(b)), polish=False,
+    differential_evolution(f, b, seed=seed, maxiter=opt.generations,
+                           popsize=max(1, opt.population // len(b)), polish=False,
                            vectorized=True, updating="deferred", tol=0.0)
+
+
+def expected_evaluations(space, opt) -> int:
+    """How many candidates ``opt`` evaluates (at most, for de), the baseline included."""
+    if opt.method == "grid":
+        return space.grid_size() + 1
+    if opt.method in ("sobol", "lhs"):
+        return opt.samples + 1
+    if opt.method == "nsga2":
+        return opt.population * opt.generations + 2
+    return opt.population * (opt.generations + 1) + 1
 
 
 OPTIMISERS = {"grid": _grid, "sobol": _sobol, "lhs": _lhs, "nsga2": _nsga2, "de": _de}

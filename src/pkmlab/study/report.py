@@ -1,22 +1,33 @@
 """Study results from the store: tables, Pareto set, plots, exported designs, summary.
 
 Everything here reads the store; only :func:`export_designs` computes (the full workspace,
-mesh and κ map of the few Pareto designs it exports).
+mesh and κ map of the few Pareto designs it exports). Plots are built on
+:class:`matplotlib.figure.Figure` objects (no pyplot state, no global backend).
 """
 
 from __future__ import annotations
 
 import csv
 import json
+import logging
 import math
+import platform
+import time
 from pathlib import Path
 
 import numpy as np
 import yaml
 
-from .run import feasible, objective_matrix
+from .. import __version__
+from ..config import to_display
+from ..errors import NumericalError, ParameterError
+from .definition import Study
+from .metrics import METRICS
+from .run import BASELINE, feasible, objective_matrix
 
-__all__ = ["pareto_mask", "write_report", "export_designs", "display_value"]
+log = logging.getLogger(__name__)
+
+__all__ = ["pareto_mask", "write_report", "export_designs", "pareto_records"]
 
 
 def pareto_mask(F: np.ndarray) -> np.ndarray:
@@ -36,26 +47,28 @@ def pareto_mask(F: np.ndarray) -> np.ndarray:
     return keep
 
 
-def display_value(var: dict, x):
-    """A parameter in display units (mm, deg) for tables."""
-    if var["quantity"] == "angle":
-        return math.degrees(x)
-    return x
+def _params(study: Study, record: dict) -> dict:
+    """A record's design values (the baseline's from the mechanism spec)."""
+    if record["params"] == BASELINE:
+        return study.space.baseline_values()
+    return record["params"]
 
 
-def _rows(resolved: dict, records: list[dict]):
-    metrics = sorted({k for r in records for k in r["metrics"]})
-    names = [v["name"] for v in resolved["variables"]]
-    units = {v["name"]: v["unit"] for v in resolved["variables"]}
+def _rows(study: Study, records: list[dict]):
+    metrics = [m for m in METRICS if any(m in r["metrics"] for r in records)]
     header = (["seq", "role", "status", "reason", "seconds"]
-              + [f"{n} ({units[n]})" if units[n] else n for n in names] + metrics)
+              + [f"design.{v.name} ({v.unit})" if v.unit else f"design.{v.name}"
+                 for v in study.variables]
+              + [METRICS[m].label for m in metrics] + ["notes"])
     rows = []
     for r in records:
-        p = r["params"]
-        vals = [display_value(v, p[v["name"]]) if v["name"] in p else "" for v in
-                resolved["variables"]]
-        rows.append([r["seq"], r["role"], r["status"], r["reason"], f"{r['seconds']:.4f}",
-                     *vals, *[r["metrics"].get(m, "") for m in metrics]])
+        p = _params(study, r)
+        vals = ["" if p.get(v.name) is None else v.display(p[v.name]) for v in study.variables]
+        notes = "; ".join(f"{k}: {v}" for k, v in r.get("notes", {}).items())
+        rows.append([r["seq"], r["role"], r["status"], r["reason"].splitlines()[0]
+                     if r["reason"] else "", f"{r['seconds']:.4f}", *vals,
+                     *["" if r["metrics"].get(m) is None else r["metrics"][m]
+                       for m in metrics], notes])
     return header, rows
 
 
@@ -66,36 +79,47 @@ def _write_csv(path: Path, header, rows) -> None:
         w.writerows(rows)
 
 
-def pareto_records(resolved: dict, records: list[dict]) -> list[dict]:
+def pareto_records(study: Study, records: list[dict]) -> list[dict]:
     """The non-dominated feasible candidates, best first by the first objective."""
     cand = [r for r in records if r["role"] == "candidate"]
     if not cand:
         return []
-    ok = feasible(resolved, cand)
-    F, _ = objective_matrix(resolved, cand)
+    ok = feasible(study, cand)
+    F, _ = objective_matrix(study, cand)
     idx = np.flatnonzero(ok)
     front = idx[pareto_mask(F[idx])] if len(idx) else idx
     front = sorted(front, key=lambda i: tuple(F[i]))
     return [cand[i] for i in front]
 
 
-def write_report(out: Path, resolved: dict, records: list[dict]) -> dict:
+def provenance() -> dict:
+    """Where and when results were made."""
+    return {"pkmlab_version": __version__, "time": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+            "machine": platform.node(), "python": platform.python_version(),
+            "platform": platform.platform()}
+
+
+def write_report(out: Path, study: Study, records: list[dict]) -> dict:
     """evaluations.csv, pareto.csv, pareto.png, study.resolved.yaml, summary.md."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    from .. import __version__
-
-    (out / "study.resolved.yaml").write_text(yaml.safe_dump(
-        {"pkmlab_version": __version__, **_plain(resolved)}, sort_keys=False))
-    header, rows = _rows(resolved, records)
+    resolved = {**study.resolved(), "provenance": provenance()}
+    (out / "study.resolved.yaml").write_text(
+        "# The study as run: every default filled in, every quantity with its unit.\n"
+        "# `pkmlab run` accepts this file as it is.\n"
+        + yaml.safe_dump(_plain(resolved), sort_keys=False, allow_unicode=True))
+    header, rows = _rows(study, records)
     _write_csv(out / "evaluations.csv", header, rows)
-    front = pareto_records(resolved, records)
-    h2, r2 = _rows(resolved, front)
+    front = pareto_records(study, records)
+    h2, r2 = _rows(study, front)
     _write_csv(out / "pareto.csv", ["rank", *h2], [[i + 1, *row] for i, row in enumerate(r2)])
-    _plot(out / "pareto.png", resolved, records, front)
+    _plot(out / "pareto.png", study, records, front)
     baseline = next((r for r in records if r["role"] == "baseline"), None)
-    (out / "summary.md").write_text(_summary(resolved, records, front, baseline))
-    return {"evaluations": len(records), "pareto": len(front),
+    (out / "summary.md").write_text(_summary(study, records, front, baseline))
+    counts: dict = {}
+    for r in records:
+        counts[r["status"]] = counts.get(r["status"], 0) + 1
+    return {"evaluations": len(records), "pareto": len(front), "statuses": counts,
             "failed": sum(r["status"] != "ok" for r in records)}
 
 
@@ -103,41 +127,42 @@ def _plain(obj):
     return json.loads(json.dumps(obj, default=float))
 
 
-def _plot(path: Path, resolved, records, front) -> None:
-    import matplotlib
+def _plot(path: Path, study: Study, records, front) -> None:
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    objs = resolved["objectives"]
+    objs = study.objectives
     cand = [r for r in records if r["role"] == "candidate"]
-    ok = feasible(resolved, cand) if cand else np.zeros(0, dtype=bool)
+    ok = feasible(study, cand) if cand else np.zeros(0, dtype=bool)
 
     def vals(rs, m):
         return np.array([np.nan if r["metrics"].get(m) is None else r["metrics"][m]
                          for r in rs], dtype=float)
 
+    def label(o):
+        return f"{METRICS[o.metric].label}, {o.sense[:3]}."
+
     ncols = 2 if len(objs) > 2 else 1
-    fig, axes = plt.subplots(1, ncols, figsize=(6.5 * ncols, 5), squeeze=False)
+    fig = Figure(figsize=(6.5 * ncols, 5), layout="tight")
+    axes = fig.subplots(1, ncols, squeeze=False)
     ax = axes[0, 0]
-    mx = objs[0]["metric"]
-    my = objs[1]["metric"] if len(objs) > 1 else None
+    mx = objs[0].metric
+    my = objs[1].metric if len(objs) > 1 else None
     x = vals(cand, mx)
     y = vals(cand, my) if my else np.arange(len(cand))
     ax.scatter(x[~ok], y[~ok], s=8, c="0.75", label="infeasible")
     ax.scatter(x[ok], y[ok], s=10, c="tab:blue", label="feasible")
     if front:
         fx, fy = vals(front, mx), vals(front, my) if my else np.arange(len(front))
-        ax.scatter(fx, fy, s=30, c="tab:red", label="Pareto")
+        ax.scatter(fx, fy, s=30, c="tab:red", label="Pareto (all objectives)")
     base = [r for r in records if r["role"] == "baseline" and r["status"] == "ok"]
     if base and my:
         ax.scatter(vals(base, mx), vals(base, my), marker="*", s=160, c="k", label="baseline")
-    ax.set_xlabel(f"{mx} ({objs[0]['sense']})")
-    ax.set_ylabel(f"{my} ({objs[1]['sense']})" if my else "candidate")
+    ax.set_xlabel(label(objs[0]))
+    ax.set_ylabel(label(objs[1]) if my else "candidate")
     ax.legend(fontsize=8)
     if len(objs) > 2:
         ax = axes[0, 1]
-        names = [o["metric"] for o in objs]
+        names = [o.metric for o in objs]
         data = np.array([[np.nan if r["metrics"].get(m) is None else r["metrics"][m]
                           for m in names] for r in front], dtype=float)
         if len(data):
@@ -145,14 +170,12 @@ def _plot(path: Path, resolved, records, front) -> None:
             norm = (data - lo) / np.where(hi > lo, hi - lo, 1.0)
             for row in norm:
                 ax.plot(range(len(names)), row, c="tab:red", alpha=0.5)
-        ax.set_xticks(range(len(names)), [f"{n}\n({o['sense'][:3]})" for n, o in
-                                          zip(names, objs)], fontsize=8)
+        ax.set_xticks(range(len(names)), [label(o).replace(", ", "\n") for o in objs],
+                      fontsize=8)
         ax.set_ylabel("normalised over the Pareto set")
         ax.set_title("Pareto set, parallel coordinates", fontsize=9)
-    fig.suptitle(f"{resolved['study']}: {len(cand)} candidates, {len(front)} Pareto")
-    fig.tight_layout()
+    fig.suptitle(f"{study.name}: {len(cand)} candidates, {len(front)} Pareto")
     fig.savefig(path, dpi=110)
-    plt.close(fig)
 
 
 def _fmt(v) -> str:
@@ -163,80 +186,93 @@ def _fmt(v) -> str:
     return str(v)
 
 
-def _summary(resolved, records, front, baseline) -> str:
-    objs = [o["metric"] for o in resolved["objectives"]]
-    cons = [c["metric"] for c in resolved["constraints"]]
-    metrics = list(dict.fromkeys(objs + cons))
-    var_names = [v["name"] for v in resolved["variables"]]
-    n_fail = sum(r["status"] != "ok" for r in records)
-    lines = [f"# {resolved['study']}", "", resolved.get("description", ""), "",
-             f"{len(records)} evaluations ({n_fail} invalid or failed, recorded with their "
-             f"reason in evaluations.csv); {len(front)} designs on the Pareto front.",
-             "", "Objectives: " + ", ".join(f"{o['sense']} {o['metric']}" for o in
-                                            resolved["objectives"]),
-             "Constraints: " + (", ".join(
-                 f"{c['metric']} " + " and ".join(f"{'≥' if k == 'min' else '≤'} {c[k]:g}"
-                                                  for k in ("min", "max") if k in c)
-                 for c in resolved["constraints"]) or "none"), "",
-             "| design | " + " | ".join(var_names + metrics) + " |",
-             "|---" * (1 + len(var_names) + len(metrics)) + "|"]
+def _summary(study: Study, records, front, baseline) -> str:
+    metrics = list(dict.fromkeys([o.metric for o in study.objectives]
+                                 + [c.metric for c in study.constraints]))
+    counts: dict = {}
+    for r in records:
+        counts[r["status"]] = counts.get(r["status"], 0) + 1
+    status = ", ".join(f"{n} {s}" for s, n in sorted(counts.items()))
+    lines = [f"# {study.name}", "", study.description, "",
+             f"{len(records)} evaluations ({status}; reasons in evaluations.csv); "
+             f"{len(front)} designs on the Pareto front.", "",
+             "Objectives: " + ", ".join(f"{o.sense} {o.metric}" for o in study.objectives),
+             "Constraints: " + (", ".join(c.describe() for c in study.constraints) or "none"),
+             "", "| design | " + " | ".join(
+                 [f"{v.name} ({v.unit})" if v.unit else v.name for v in study.variables]
+                 + [METRICS[m].label for m in metrics]) + " |",
+             "|---" * (1 + len(study.variables) + len(metrics)) + "|"]
+    notes = []
 
     def row(label, r):
-        p = r["params"]
-        vals = [_fmt(display_value(v, p[v["name"]])) if v["name"] in p else "(paper)"
-                for v in resolved["variables"]]
+        p = _params(study, r)
+        vals = [_fmt(None if p.get(v.name) is None else v.display(p[v.name]))
+                for v in study.variables]
         ms = [_fmt(r["metrics"].get(m)) for m in metrics]
+        for k, why in r.get("notes", {}).items():
+            if k in metrics:
+                notes.append(f"- {label}, {k}: {why}")
         return f"| {label} | " + " | ".join(vals + ms) + " |"
 
     if baseline is not None:
-        lines.append(row("baseline" + ("" if baseline["status"] == "ok" else
-                                       f" ({baseline['status']})"), baseline))
-    for i, r in enumerate(front[:max(resolved.get("top", 5), 1) * 2]):
+        label = "baseline" + ("" if baseline["status"] == "ok" else
+                              f" ({baseline['status']}: {baseline['reason'].splitlines()[0]})")
+        lines.append(row(label, baseline))
+    for i, r in enumerate(front[:max(study.top, 1) * 2]):
         lines.append(row(f"Pareto {i + 1}", r))
-    lines += ["", "Parameters in mm and degrees. Full tables: evaluations.csv, pareto.csv; "
+    if notes:
+        lines += ["", "Notes (a value shown as — is undefined for the reason given):", *notes]
+    lines += ["", "Lengths in mm, angles in degrees, volumes in cm³, forces in N. Metric "
+              "definitions: `pkmlab metrics`. Full tables: evaluations.csv, pareto.csv; "
               "exported designs (mechanism YAML, workspace STL, slices, κ map) under designs/."]
     return "\n".join(lines) + "\n"
 
 
-def export_designs(out: Path, resolved: dict, front: list[dict]) -> list[Path]:
-    """For the top designs: mechanism.yaml, workspace.stl, slices.png, kappa_slices.png."""
-    import matplotlib
+def export_designs(out: Path, study: Study, front: list[dict]) -> tuple[list[Path], list[str]]:
+    """For the top designs: mechanism.yaml, workspace.stl, slices.png, kappa_slices.png.
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    Returns ``(folders, problems)``: a design whose export fails is skipped with its reason
+    in ``problems`` (logged), so an export error never stops the report.
+    """
+    folders, problems = [], []
+    for i, r in enumerate(front[:study.top]):
+        d = Path(out) / "designs" / f"{i + 1:02d}-{r['key'][:8]}"
+        try:
+            _export_one(d, study, r, i + 1)
+            folders.append(d)
+        except (ParameterError, NumericalError, ValueError, OSError) as exc:
+            log.warning("export of Pareto design %d failed: %s", i + 1, exc)
+            problems.append(f"Pareto design {i + 1}: {type(exc).__name__}: {exc}")
+    return folders, problems
 
+
+def _export_one(d: Path, study: Study, r: dict, rank: int) -> None:
     from .. import dexterity as dx
-    from ..config import load_mechanism, workspace_spec
     from ..dexterity.maps import metric_map
     from ..workspaces import workspace
     from ..workspaces.plots import slice_figure
-    from .evaluate import candidate_mapping
 
-    folders = []
-    ev = resolved["evaluate"]
-    for i, r in enumerate(front[:resolved.get("top", 5)]):
-        d = Path(out) / "designs" / f"{i + 1:02d}-{r['key'][:8]}"
-        d.mkdir(parents=True, exist_ok=True)
-        data = candidate_mapping(resolved["mechanism"], resolved["variables"], r["params"])
-        data = {**data, "name": f"{resolved['study']}-pareto-{i + 1}"}
-        (d / "mechanism.yaml").write_text(
-            f"# Pareto design {i + 1} of study {resolved['study']} (candidate {r['key']})\n"
-            + yaml.safe_dump(_plain(data), sort_keys=False))
-        if ev.get("workspace"):
-            mech = load_mechanism(data)
-            spec = workspace_spec(ev["workspace"])
-            res = workspace(mech, **spec.build())
-            res.plot_slices(d / "slices.png", window=spec.slice_window,
-                            spacing=spec.slice_spacing)
-            if not res.empty:
-                res.save_mesh(d / "workspace.stl")
-                L = (ev.get("dexterity") or {}).get("characteristic_length") or \
-                    dx.characteristic_length(mech).length
-                mm = metric_map(mech, res, "kappa", L)
-                fig = slice_figure(res, window=spec.slice_window, spacing=spec.slice_spacing,
-                                   values=np.where(np.isfinite(mm.grid), mm.grid, np.nan),
-                                   label=mm.label)
-                fig.savefig(d / "kappa_slices.png", dpi=110)
-                plt.close(fig)
-        folders.append(d)
-    return folders
+    d.mkdir(parents=True, exist_ok=True)
+    spec = study.space.spec_of(r["params"])
+    spec = spec.model_copy(update={"name": f"{study.name}-pareto-{rank}"})
+    (d / "mechanism.yaml").write_text(
+        f"# Pareto design {rank} of study {study.name} (candidate {r['key']})\n"
+        + yaml.safe_dump(_plain(to_display(spec)), sort_keys=False, allow_unicode=True))
+    ev = study.evaluation
+    if ev.workspace is None:
+        return
+    mech = spec.build()
+    res = workspace(mech, **ev.request)
+    ws = ev.workspace
+    res.plot_slices(d / "slices.png", window=ws.slice_window, spacing=ws.slice_spacing)
+    if res.empty:
+        return
+    res.save_mesh(d / "workspace.stl")
+    L = r["metrics"].get("characteristic_length") or dx.characteristic_length(mech).length
+    if not (L and math.isfinite(L)):
+        return
+    mm = metric_map(mech, res, "kappa", L)
+    fig = slice_figure(res, window=ws.slice_window, spacing=ws.slice_spacing,
+                       values=np.where(np.isfinite(mm.grid), mm.grid, np.nan),
+                       label=f"{mm.label}, L = {L:.4g} mm")
+    fig.savefig(d / "kappa_slices.png", dpi=110)

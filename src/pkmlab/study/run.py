@@ -1,24 +1,44 @@
-"""Drive a design study: optimiser → runner → store, resumable and reproducible."""
+"""Drive a design study: optimiser → runner → store, resumable and reproducible.
+
+A run owns its output folder: it holds a lock there while it runs (a second run into the same
+folder refuses, naming the holder), and it never mixes with or deletes an earlier run unless
+asked (``resume`` continues it, ``overwrite`` replaces it).
+"""
 
 from __future__ import annotations
 
 import logging
 import math
+import os
+import shutil
 from pathlib import Path
 
 import numpy as np
 
 from .. import __version__
 from ..errors import ParameterError
-from .evaluate import candidate_mapping, evaluate_candidate
-from .optimisers import OPTIMISERS, PENALTY, DesignSpace
-from .store import Store, candidate_key, fingerprint
+from .definition import PENALTY, Study
+from .evaluators import evaluate_design
+from .optimisers import OPTIMISERS
+from .store import Store, candidate_key
 
 log = logging.getLogger(__name__)
 
-__all__ = ["run_study", "objective_matrix", "feasible", "expected_evaluations"]
+__all__ = ["run_study", "objective_matrix", "feasible", "CandidateError", "BASELINE",
+           "OutputLock"]
 
 BASELINE = {"__baseline__": True}
+
+
+class CandidateError(RuntimeError):
+    """A candidate's evaluation raised an undeclared exception (a programming error): the run
+    stops after recording it. ``params`` is the design, ``details`` the worker's traceback."""
+
+    def __init__(self, params: dict, details: str):
+        self.params = params
+        self.details = details
+        super().__init__(f"evaluation of candidate {params} raised an error (recorded in the "
+                         f"store); the run stops:\n{details}")
 
 
 def _value(record: dict, metric: str):
@@ -26,57 +46,71 @@ def _value(record: dict, metric: str):
     return None if v is None or not math.isfinite(v) else float(v)
 
 
-def objective_matrix(resolved: dict, records: list[dict]) -> tuple[np.ndarray, np.ndarray]:
+def objective_matrix(study: Study, records: list[dict]) -> tuple[np.ndarray, np.ndarray]:
     """``F (n, n_obj)`` to minimise and ``G (n, n_con)`` that must be ``<= 0``."""
-    F = np.full((len(records), len(resolved["objectives"])), PENALTY)
-    G = np.full((len(records), sum(len(c) - 1 for c in resolved["constraints"])), PENALTY)
+    n_con = sum((c.min is not None) + (c.max is not None) for c in study.constraints)
+    F = np.full((len(records), len(study.objectives)), PENALTY)
+    G = np.full((len(records), n_con), PENALTY)
     for i, r in enumerate(records):
-        for j, o in enumerate(resolved["objectives"]):
-            v = _value(r, o["metric"])
+        for j, o in enumerate(study.objectives):
+            v = _value(r, o.metric)
             if v is not None:
-                F[i, j] = v if o["sense"] == "minimize" else -v
+                F[i, j] = v if o.sense == "minimize" else -v
         j = 0
-        for c in resolved["constraints"]:
-            v = _value(r, c["metric"])
+        for c in study.constraints:
+            v = _value(r, c.metric)
             for bound in ("min", "max"):
-                if bound in c:
+                b = getattr(c, bound)
+                if b is not None:
                     if v is not None:
-                        G[i, j] = (c["min"] - v) if bound == "min" else (v - c["max"])
+                        G[i, j] = (b - v) if bound == "min" else (v - b)
                     j += 1
     return F, G
 
 
-def feasible(resolved: dict, records: list[dict]) -> np.ndarray:
+def feasible(study: Study, records: list[dict]) -> np.ndarray:
     """``(n,)`` evaluated, every objective defined, every constraint met."""
-    F, G = objective_matrix(resolved, records)
+    F, G = objective_matrix(study, records)
     ok = np.array([r["status"] == "ok" for r in records], dtype=bool)
     return ok & np.all(F < PENALTY, axis=1) & np.all(G <= 0, axis=1)
 
 
-def expected_evaluations(resolved: dict) -> int:
-    opt = resolved["optimizer"]
-    if opt["method"] == "grid":
-        return len(DesignSpace(resolved["variables"]).grid()) + 1
-    if opt["method"] in ("sobol", "lhs"):
-        return opt["samples"] + 1
-    if opt["method"] == "nsga2":
-        return opt["population"] * opt["generations"] + 2
-    return opt["population"] * (opt["generations"] + 1) + 1
+class OutputLock:
+    """An exclusive lock on a results folder (``.lock``, holding the owner's pid), released
+    on exit and by the operating system when the process dies."""
+
+    def __init__(self, folder: Path):
+        self.path = Path(folder) / ".lock"
+        self.fh = None
+
+    def __enter__(self) -> OutputLock:
+        import fcntl
+
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self.fh = open(self.path, "a+")
+        try:
+            fcntl.flock(self.fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            self.fh.seek(0)
+            holder = self.fh.read().strip() or "another process"
+            self.fh.close()
+            raise ParameterError("output", "a results folder no other run is using",
+                                 f"{self.path.parent} is in use by {holder}") from None
+        self.fh.seek(0)
+        self.fh.truncate()
+        self.fh.write(f"pid {os.getpid()}")
+        self.fh.flush()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        import fcntl
+
+        fcntl.flock(self.fh, fcntl.LOCK_UN)
+        self.fh.close()
 
 
-def run_study(resolved: dict, runner, *, resume: bool = False, progress=None) -> Store:
-    """Run (or resume) a study; every evaluation is committed to the store as it finishes.
-
-    Args:
-        resolved: the resolved study from :func:`pkmlab.config.load_study`.
-        runner: a runner from :mod:`.runners` (serial, joblib, Dask).
-        resume: continue from the store in the output folder: candidates already stored are
-            read back, never evaluated again. Without it an existing store is replaced.
-        progress: optional callable ``progress(n_done_now)`` called per finished evaluation.
-    """
-    out = Path(resolved["output"])
+def _prepare(out: Path, fp: str, resume: bool, overwrite: bool) -> Store:
     path = out / "evaluations.sqlite"
-    fp = fingerprint(resolved)
     if path.exists() and resume:
         store = Store(path)
         old = store.get_meta("fingerprint")
@@ -85,15 +119,61 @@ def run_study(resolved: dict, runner, *, resume: bool = False, progress=None) ->
             raise ParameterError("--resume", "a results folder of the same study definition "
                                  "(mechanism, design, evaluate and seed unchanged)",
                                  f"{path} holds study fingerprint {old}, this file is {fp}")
-    else:
-        for suffix in ("", "-wal", "-shm"):
-            Path(str(path) + suffix).unlink(missing_ok=True)
-        store = Store(path)
+        return store
+    if resume:
+        raise ParameterError("--resume", "a results folder holding a started run",
+                             f"no evaluations.sqlite in {out}")
+    leftovers = [p for p in out.iterdir() if p.name != ".lock"] if out.exists() else []
+    if leftovers and not overwrite:
+        raise ParameterError("output", "a new or empty folder (--resume continues the run in "
+                             "it, --overwrite replaces it)",
+                             f"{out} holds {len(leftovers)} entries of an earlier run")
+    for p in leftovers:
+        shutil.rmtree(p) if p.is_dir() and not p.is_symlink() else p.unlink()
+    return Store(path)
+
+
+def run_study(study: Study, runner, *, resume: bool = False, overwrite: bool = False,
+              progress=None) -> Store:
+    """Run (or resume) a study; every evaluation is committed to the store as it finishes.
+
+    Args:
+        study: from :func:`pkmlab.study.load_study`.
+        runner: a runner from :mod:`.runners` (serial, joblib, Dask).
+        resume: continue the run in the output folder: candidates already stored are read
+            back, never evaluated again.
+        overwrite: replace an earlier run in the output folder (without it, a non-empty
+            folder is refused).
+        progress: optional callable ``progress(n_done_now)`` called per finished evaluation.
+
+    Raises:
+        ParameterError: the folder is in use, not empty, or holds another study.
+        CandidateError: a candidate raised an undeclared exception (recorded first).
+    """
+    out = Path(study.output)
+    fp = study.fingerprint()
+    with OutputLock(out):
+        store = _prepare(out, fp, resume, overwrite)
+        try:
+            _run(study, runner, store, fp, progress)
+        except BaseException:
+            store.close()
+            raise
+    return store
+
+
+def _run(study: Study, runner, store: Store, fp: str, progress) -> None:
     store.set_meta("fingerprint", fp)
-    store.set_meta("resolved", resolved)
+    store.set_meta("resolved", study.resolved())
     store.set_meta("version", __version__)
-    space = DesignSpace(resolved["variables"])
-    mech, ev, seed = resolved["mechanism"], resolved["evaluate"], resolved["seed"]
+    space, ev, seed = study.space, study.evaluation, study.seed
+
+    def commit(key, role, params, result):
+        store.put(key, role, params, result)
+        if progress:
+            progress(1)
+        if result["status"] == "error":
+            raise CandidateError(params, result["reason"])
 
     def evaluate_batch(params_list: list[dict]):
         keys = [candidate_key(fp, p) for p in params_list]
@@ -102,21 +182,15 @@ def run_study(resolved: dict, runner, *, resume: bool = False, progress=None) ->
             if k in seen or store.get(k) is not None:
                 continue
             seen.add(k)
-            todo.append((k, (candidate_mapping(mech, space.variables, p), ev, seed)))
+            todo.append((k, (space, p, ev, seed)))
         by_key = dict(zip(keys, params_list))
-        for k, result in runner.map(evaluate_candidate, todo):
-            store.put(k, "candidate", by_key[k], result)
-            if progress:
-                progress(1)
-        return objective_matrix(resolved, [store.get(k) for k in keys])
+        for k, result in runner.map(evaluate_design, todo):
+            commit(k, "candidate", by_key[k], result)
+        return objective_matrix(study, [store.get(k) for k in keys])
 
     base_key = candidate_key(fp, BASELINE)
     if store.get(base_key) is None:
-        for k, result in runner.map(evaluate_candidate, [(base_key, (mech, ev, seed))]):
-            store.put(k, "baseline", BASELINE, result)
-            if progress:
-                progress(1)
-    OPTIMISERS[resolved["optimizer"]["method"]](space, evaluate_batch, resolved["optimizer"],
-                                                seed)
+        for k, result in runner.map(evaluate_design, [(base_key, (space, None, ev, seed))]):
+            commit(k, "baseline", BASELINE, result)
+    OPTIMISERS[study.optimizer.method](space, evaluate_batch, study.optimizer, seed)
     store.set_meta("complete", True)
-    return store

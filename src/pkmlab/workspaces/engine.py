@@ -21,6 +21,7 @@ from scipy import ndimage
 
 from .._intervals import label_pieces
 from ..errors import ParameterError
+from ..limits import RESOLUTION_MM
 from ..mechanisms import NO_STROKE
 from ..poses import as_frames, matrix_to_euler
 from .constraints import Constraints, check
@@ -61,8 +62,9 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
     if kind not in KINDS:
         raise ParameterError("kind", f"one of {list(KINDS)}", kind)
     if not (isinstance(resolution, int | float) and math.isfinite(resolution)
-            and 0.05 <= resolution <= 100):
-        raise ParameterError("resolution", "a grid spacing in [0.05, 100] mm", resolution)
+            and RESOLUTION_MM[0] <= resolution <= RESOLUTION_MM[1]):
+        raise ParameterError("resolution", f"a grid spacing in [{RESOLUTION_MM[0]:g}, "
+                             f"{RESOLUTION_MM[1]:g}] mm", resolution)
     if method not in ("auto", "columns", "sampled"):
         raise ParameterError("method", "one of ['auto', 'columns', 'sampled']", method)
     cons = constraints or Constraints()

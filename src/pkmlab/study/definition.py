@@ -1,0 +1,182 @@
+"""The typed study: everything a run needs, built once at load, in internal units (mm, rad).
+
+:func:`pkmlab.study.load_study` returns a frozen :class:`Study`. Its :meth:`Study.resolved`
+is the study written back as a study file with every default filled in and every quantity
+with its unit; loading that file gives the same study (same :meth:`Study.fingerprint`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..config import to_display
+from .metrics import METRICS
+from .space import DesignSpace, Variable
+
+__all__ = ["Study", "Evaluation", "DexterityPlan", "TrajectoryPlan", "Objective",
+           "Constraint", "PENALTY"]
+
+#: Objective / constraint value of a candidate without the metric (failed, invalid, undefined).
+PENALTY = 1.0e12
+
+
+@dataclass(frozen=True)
+class DexterityPlan:
+    characteristic_length: float | None     # mm; None: Angeles'
+    gci_samples: int
+    force_limit: float                      # N
+
+
+@dataclass(frozen=True)
+class TrajectoryPlan:
+    segment_time: float                     # s
+    payload: float                          # kg
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """What to compute for each candidate; ``request`` is the built workspace request."""
+
+    workspace: object | None                # config.WorkspaceSpec
+    request: dict | None
+    inscribed: bool
+    orientation_capability: bool
+    dexterity: DexterityPlan | None
+    trajectory: TrajectoryPlan | None
+
+    @property
+    def evaluators(self) -> tuple[str, ...]:
+        """Evaluator names in evaluation order."""
+        names = ["geometry"]
+        if self.workspace is not None:
+            names.append("workspace")
+            names += [n for n in ("inscribed", "orientation_capability")
+                      if getattr(self, n)]
+            if self.dexterity is not None:
+                names.append("dexterity")
+        if self.trajectory is not None:
+            names.append("trajectory")
+        return tuple(names)
+
+    @property
+    def metrics(self) -> tuple[str, ...]:
+        """Every metric this evaluation writes a value for."""
+        kind = None if self.workspace is None else self.workspace.kind
+        return tuple(m.name for m in METRICS.values() if m.evaluator in self.evaluators
+                     and not (m.name.endswith("_volume") and m.name.split("_")[0]
+                              in ("constant", "reachable", "dexterous")
+                              and m.name != f"{kind}_volume"))
+
+
+@dataclass(frozen=True)
+class Objective:
+    metric: str
+    sense: str                              # "maximize" | "minimize"
+
+
+@dataclass(frozen=True)
+class Constraint:
+    metric: str
+    min: float | None = None
+    max: float | None = None
+
+    def describe(self) -> str:
+        parts = ([f"≥ {self.min:g}"] if self.min is not None else []) + \
+            ([f"≤ {self.max:g}"] if self.max is not None else [])
+        return f"{self.metric} " + " and ".join(parts)
+
+
+@dataclass(frozen=True)
+class Study:
+    """A validated design study."""
+
+    name: str
+    description: str
+    space: DesignSpace
+    evaluation: Evaluation
+    objectives: tuple[Objective, ...]
+    constraints: tuple[Constraint, ...]
+    optimizer: object                       # spec.OptimizerSpec
+    seed: int
+    output: Path
+    top: int
+    source: Path | None = None              # the study file
+
+    @property
+    def variables(self) -> tuple[Variable, ...]:
+        return self.space.variables
+
+    def baseline(self):
+        """The mechanism the design space starts from."""
+        return self.space.base_spec.build()
+
+    def with_output(self, output: Path) -> Study:
+        from dataclasses import replace
+
+        return replace(self, output=Path(output))
+
+    # ---- the study written back -----------------------------------------------------------
+    def resolved(self) -> dict:
+        """This study as a study-file mapping: every default, every unit explicit."""
+        design = {}
+        for v in self.space.variables:
+            d: dict = {"type": v.kind, "quantity": v.quantity}
+            if v.target is not None:
+                d["path"] = _path_text(v.target)
+            if v.kind == "choice":
+                d["choices"] = [_quantity(v, c) for c in v.choices]
+            else:
+                d.update(low=_quantity(v, v.low), high=_quantity(v, v.high), levels=v.levels)
+            design[v.name] = d
+        ev = self.evaluation
+        evaluate: dict = {
+            "workspace": None if ev.workspace is None else to_display(ev.workspace),
+            "inscribed": ev.inscribed, "orientation_capability": ev.orientation_capability,
+            "dexterity": None if ev.dexterity is None else {
+                "characteristic_length": ("auto" if ev.dexterity.characteristic_length is None
+                                          else f"{ev.dexterity.characteristic_length:.12g} mm"),
+                "gci_samples": ev.dexterity.gci_samples,
+                "force_limit": ev.dexterity.force_limit},
+            "trajectory": None if ev.trajectory is None else {
+                "paper_motion": True, "segment_time": ev.trajectory.segment_time,
+                "payload": ev.trajectory.payload},
+        }
+        return {
+            "study": self.name, "description": self.description,
+            "mechanism": {"inline": to_display(self.space.base_spec)},
+            "design": design,
+            "derived": {_path_text(d.target): d.expression.text for d in self.space.derived},
+            "evaluate": evaluate,
+            "objectives": [{o.sense: o.metric} for o in self.objectives],
+            "constraints": [{c.metric: {k: getattr(c, k) for k in ("min", "max")
+                                        if getattr(c, k) is not None}}
+                            for c in self.constraints],
+            "optimizer": self.optimizer.model_dump(),
+            "seed": self.seed, "output": str(self.output), "top": self.top,
+        }
+
+    def fingerprint(self) -> str:
+        """Hash of what determines the evaluations (mechanism, design space, evaluation,
+        seed): the store refuses to resume a study whose fingerprint changed."""
+        r = self.resolved()
+        keep = {k: r[k] for k in ("mechanism", "design", "derived", "evaluate", "seed")}
+        text = json.dumps(keep, sort_keys=True, separators=(",", ":"), default=str)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _path_text(parts: tuple) -> str:
+    out = ""
+    for p in parts:
+        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else p)
+    return out
+
+
+def _quantity(v: Variable, x):
+    if v.quantity == "length":
+        return f"{x:.12g} mm"
+    if v.quantity == "angle":
+        return f"{v.display(x):.12g} deg"
+    return x

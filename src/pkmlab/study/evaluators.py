@@ -1,0 +1,255 @@
+"""Candidate evaluation: pure evaluators, each declaring the metrics it writes.
+
+An evaluator is a function ``(mech, ctx) -> {metric: value}`` registered with the name of its
+``evaluate`` block; the metrics it may write are those :mod:`.metrics` lists under that name,
+and :func:`evaluate_design` checks that it writes exactly those (a missing or unexpected metric
+is a programming error). A value is a float, or ``None`` with a note in ``ctx.notes`` saying
+why (an empty workspace, a singular pose, a capped search): never a silent NaN.
+
+Failure policy (:func:`evaluate_design`):
+
+* :class:`~pkmlab.errors.ParameterError` — the design is geometrically invalid: status
+  ``invalid`` with the reason;
+* :class:`~pkmlab.errors.NumericalError` — a declared numerical failure: status ``failed``;
+* anything else is a programming error: status ``error`` with the traceback; the study driver
+  records it and stops the run (:class:`~pkmlab.study.run.CandidateError`).
+
+Evaluators never print, plot or write files.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+import traceback
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import dexterity as dx
+from ..errors import NumericalError, ParameterError
+from ..limits import CAPABILITY_MAX_DEG
+from ..trajectory import check_trajectory, paper_motion
+from ..workspaces import OrientationSet, workspace
+from .metrics import metrics_of
+
+log = logging.getLogger(__name__)
+
+__all__ = ["EVALUATORS", "Context", "evaluate_design", "evaluate_mechanism", "capability"]
+
+
+@dataclass
+class Context:
+    """What one candidate's evaluators share: the plan, the seed, intermediate results."""
+
+    evaluation: object          # pkmlab.study.definition.Evaluation
+    seed: int
+    result: object = None       # the WorkspaceResult, once computed
+    L: float | None = None      # characteristic length used (mm)
+    notes: dict = field(default_factory=dict)
+
+
+#: name → evaluator; the order is the evaluation order (dependencies first)
+EVALUATORS: dict[str, Callable] = {}
+
+
+def _evaluator(name: str):
+    def register(fn):
+        EVALUATORS[name] = fn
+        return fn
+    return register
+
+
+def _finite(x) -> float | None:
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+@_evaluator("geometry")
+def _geometry(mech, ctx: Context) -> dict:
+    fp = mech.footprint()
+    return {"base_outer_radius": fp["base_radius"],
+            "platform_outer_radius": fp["platform_radius"],
+            "stroke_length": float(mech.stroke[1] - mech.stroke[0])}
+
+
+@_evaluator("workspace")
+def _workspace(mech, ctx: Context) -> dict:
+    ev = ctx.evaluation
+    res = workspace(mech, **ev.request)
+    ctx.result = res
+    vol = res.volume / 1e3
+    zr = res.metrics()["z_range_mm"]
+    out = {"workspace_volume": vol, "workspace_volume_error": res.volume_error / 1e3,
+           "workspace_empty": float(res.empty),
+           "z_span": 0.0 if zr is None else float(zr[1] - zr[0])}
+    out[f"{res.kind}_volume"] = vol
+    return out
+
+
+@_evaluator("inscribed")
+def _inscribed(mech, ctx: Context) -> dict:
+    res = ctx.result
+    names = metrics_of("inscribed")
+    if res.empty:
+        for n in names:
+            ctx.notes[n] = "workspace empty"
+        return dict.fromkeys(names, 0.0)
+    box = res.inscribed_box(samples=2000, seed=ctx.seed)
+    cyl = res.inscribed_cylinder(samples=2000, seed=ctx.seed)
+    out = {"inscribed_box_volume": box.volume / 1e3, "inscribed_box_edge": float(box.size.min()),
+           "inscribed_cylinder_radius": float(cyl.radius),
+           "inscribed_cylinder_volume": cyl.volume / 1e3}
+    if not box.volume > 0:
+        for n in ("inscribed_box_volume", "inscribed_box_edge"):
+            out[n] = None
+            ctx.notes[n] = "no box survived verification (the workspace is thinner than a voxel)"
+    if not cyl.volume > 0:
+        for n in ("inscribed_cylinder_radius", "inscribed_cylinder_volume"):
+            out[n] = None
+            ctx.notes[n] = "no cylinder survived verification"
+    return out
+
+
+def capability(mech, request: dict, iterations: int = 8) -> tuple[float, float, str]:
+    """Largest ``a`` (deg) whose ±a simultaneous Euler box has a non-empty dexterous workspace
+    on ``request``'s grid, by bisection → ``(a, bracket, note)``.
+
+    The verified level ``a`` is non-empty and ``a + bracket`` was found empty (so the value is
+    a lower bound of the grid's capability to within ``bracket``); ``note`` is non-empty when
+    the search hit :data:`~pkmlab.limits.CAPABILITY_MAX_DEG` (bracket 0, the value a lower
+    bound only) or the nominal orientation itself has no workspace.
+    """
+    oset = request["orientations"]
+    samples = oset.samples if oset.kind == "box" else 7
+
+    def ok(a_deg: float) -> bool:
+        o = OrientationSet.box(np.radians([a_deg] * 3), "simultaneous", samples)
+        return not workspace(mech, "dexterous", o, request["resolution"],
+                             request["constraints"]).empty
+
+    if not ok(0.0):
+        return 0.0, 0.0, "no workspace at the nominal orientation"
+    lo, hi = 0.0, 60.0
+    if ok(hi):
+        lo, hi = hi, CAPABILITY_MAX_DEG
+        if ok(hi):
+            return hi, 0.0, (f"not bounded by the search: the ±{hi:g}° box (all of SO(3)) "
+                             "has a dexterous workspace")
+        iterations += 1                             # same resolution over a 120° bracket
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
+    return lo, hi - lo, ""
+
+
+@_evaluator("orientation_capability")
+def _capability(mech, ctx: Context) -> dict:
+    a, bracket, note = capability(mech, ctx.evaluation.request)
+    if note:
+        ctx.notes["orientation_capability"] = note
+    return {"orientation_capability": a, "orientation_capability_bracket": bracket}
+
+
+@_evaluator("dexterity")
+def _dexterity(mech, ctx: Context) -> dict:
+    plan, res = ctx.evaluation.dexterity, ctx.result
+    if plan.characteristic_length is not None:
+        L = plan.characteristic_length
+    else:
+        cl = dx.characteristic_length(mech)
+        if not cl.ok:
+            raise NumericalError("characteristic length", "Angeles' length is undefined: the "
+                                 "Jacobian is singular or undefined at the nominal pose")
+        L = cl.length
+    ctx.L = L
+    out = {"characteristic_length": float(L),
+           "nominal_kappa": _finite(dx.condition_number(mech.jacobian(mech.nominal_pose),
+                                                        L)[0])}
+    if out["nominal_kappa"] is None:
+        ctx.notes["nominal_kappa"] = "singular at the nominal pose"
+    names = ("worst_kappa", "min_force", "singularity_free", "gci", "gci_std_error",
+             "sampled_max_kappa", "sampled_min_force")
+    if res.empty:
+        for n in names:
+            ctx.notes[n] = "workspace empty"
+        out.update(dict.fromkeys(names))
+        return out
+    wc = dx.worst_case(mech, res, L, plan.force_limit)
+    out["worst_kappa"] = _finite(wc.worst_kappa)
+    out["min_force"] = float(wc.min_force)
+    out["singularity_free"] = float(not wc.singular)
+    if out["worst_kappa"] is None:
+        ctx.notes["worst_kappa"] = f"singular pose inside the workspace ({wc.method})"
+    g = dx.gci_monte_carlo(mech, res, L, samples=plan.gci_samples, seed=ctx.seed)
+    out["gci"] = g.gci if g.ok else None
+    out["gci_std_error"] = _finite(g.std_error) if g.ok else None
+    out["sampled_max_kappa"] = _finite(1.0 / g.lci_min) if g.ok and g.lci_min > 0 else None
+    rng = np.random.default_rng(ctx.seed)
+    p, R = dx.aggregate.sample_poses(res, plan.gci_samples, rng)
+    valid = mech.inverse((p, R)).valid
+    F = dx.max_force_all_directions(mech.jacobian((p[valid], R[valid])), plan.force_limit)
+    out["sampled_min_force"] = float(np.nanmin(F)) if len(F) else None
+    for n in ("gci", "gci_std_error", "sampled_max_kappa", "sampled_min_force"):
+        if out[n] is None:
+            ctx.notes[n] = "no valid Monte-Carlo pose"
+    return out
+
+
+@_evaluator("trajectory")
+def _trajectory(mech, ctx: Context) -> dict:
+    plan = ctx.evaluation.trajectory
+    t, X = paper_motion(mech, segment_time=plan.segment_time)
+    rep = check_trajectory(mech, t, X, payload_mass_kg=plan.payload)
+    margins = np.concatenate([rep.margin_low, rep.margin_high])
+    out = {"paper_motion_fits": float(rep.fits),
+           "paper_motion_margin": _finite(np.min(margins)) if np.all(np.isfinite(margins))
+           else None}
+    if out["paper_motion_margin"] is None:
+        ctx.notes["paper_motion_margin"] = "a pose of the motion has no inverse kinematics"
+    return out
+
+
+def evaluate_mechanism(mech, evaluation, seed: int) -> tuple[dict, dict]:
+    """Every evaluator ``evaluation`` asks for, in order → ``(metrics, notes)``.
+
+    Raises :class:`ParameterError` / :class:`NumericalError` for an invalid design or a
+    declared numerical failure, anything else for a programming error.
+    """
+    ctx = Context(evaluation, seed)
+    _ = mech.nominal_pose      # ParameterError if no level pose reaches mid-stroke
+    metrics: dict = {}
+    for name in evaluation.evaluators:
+        out = EVALUATORS[name](mech, ctx)
+        declared = set(metrics_of(name)) & set(evaluation.metrics)
+        if set(out) != declared:
+            raise AssertionError(f"evaluator {name!r} wrote {sorted(out)}, declared "
+                                 f"{sorted(declared)}")
+        metrics.update(out)
+    return metrics, ctx.notes
+
+
+def evaluate_design(space, design: dict | None, evaluation, seed: int) -> dict:
+    """Evaluate one design of ``space`` (``None``: the baseline) → a plain-data record
+    ``{"status", "reason", "metrics", "notes", "seconds"}`` (see the module's failure policy).
+
+    Runs unchanged in a joblib worker or on a Dask cluster.
+    """
+    t0 = time.perf_counter()
+    metrics: dict = {}
+    notes: dict = {}
+    try:
+        mech = space.decode(design)
+        metrics, notes = evaluate_mechanism(mech, evaluation, seed)
+        status, reason = "ok", ""
+    except ParameterError as exc:
+        status, reason = "invalid", str(exc)
+    except NumericalError as exc:
+        status, reason = "failed", str(exc)
+    except Exception as exc:  # noqa: BLE001 - recorded, then the driver stops the run
+        status = "error"
+        reason = f"{type(exc).__name__}: {exc}\n" + traceback.format_exc()
+    return {"status": status, "reason": reason, "metrics": metrics, "notes": notes,
+            "seconds": time.perf_counter() - t0}

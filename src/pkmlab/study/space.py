@@ -1,0 +1,280 @@
+"""The design space: variables in internal units, derived fields, and decoding into mechanisms.
+
+A design is a dict ``{variable name: value}`` in internal units (mm, rad, plain numbers or a
+text choice). :meth:`DesignSpace.decode` writes each variable (and each derived field, an
+arithmetic expression of the variables) into the typed mechanism spec and builds the
+:class:`~pkmlab.mechanisms.Mechanism` directly: no YAML is written or parsed.
+"""
+
+from __future__ import annotations
+
+import ast
+import itertools
+import math
+import operator
+import re
+from collections import Counter
+from dataclasses import dataclass
+
+import numpy as np
+from pydantic import BaseModel
+
+from ..errors import ParameterError
+from ..mechanisms import Mechanism
+
+__all__ = ["Variable", "Derived", "DesignSpace", "Expression", "parse_path", "get_path",
+           "with_path"]
+
+
+# ---- paths into a typed spec ---------------------------------------------------------------------
+
+
+def parse_path(path: str) -> tuple:
+    """``"generator.base_radii[1]"`` → ``("generator", "base_radii", 1)``."""
+    parts: list = []
+    for piece in path.split("."):
+        m = re.fullmatch(r"([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)", piece)
+        if not m:
+            raise KeyError(path)
+        parts.append(m.group(1))
+        parts += [int(i) for i in re.findall(r"\[(\d+)\]", m.group(2))]
+    return tuple(parts)
+
+
+def get_path(node, parts: tuple):
+    """The value at ``parts`` in a pydantic model / list tree (KeyError if absent)."""
+    for p in parts:
+        if isinstance(node, BaseModel) and isinstance(p, str) and p in type(node).model_fields:
+            node = getattr(node, p)
+        elif isinstance(node, list) and isinstance(p, int) and p < len(node):
+            node = node[p]
+        else:
+            raise KeyError(p)
+    return node
+
+
+def with_path(node, parts: tuple, value):
+    """A copy of ``node`` with ``parts`` set to ``value`` (models copied, never mutated)."""
+    if not parts:
+        return value
+    head, rest = parts[0], parts[1:]
+    if isinstance(node, BaseModel):
+        return node.model_copy(update={head: with_path(getattr(node, head), rest, value)})
+    new = list(node)
+    new[head] = with_path(node[head], rest, value)
+    return new
+
+
+# ---- derived fields: a small, safe arithmetic language -----------------------------------
+
+_BINARY = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
+           ast.Div: operator.truediv, ast.Pow: operator.pow}
+_UNARY = {ast.USub: operator.neg, ast.UAdd: operator.pos}
+_FUNCTIONS = {"min": min, "max": max, "abs": abs, "sqrt": math.sqrt, "sin": math.sin,
+              "cos": math.cos, "tan": math.tan, "atan2": math.atan2}
+_ALLOWED = (ast.Expression, ast.BinOp, ast.UnaryOp, ast.Constant, ast.Call, ast.Load,
+            *_BINARY, *_UNARY)
+#: Constants an expression may use; values are internal units (mm, rad).
+CONSTANTS = {"pi": math.pi, "deg": math.pi / 180.0, "rad": 1.0, "mm": 1.0, "cm": 10.0,
+             "m": 1000.0, "inch": 25.4}
+
+
+@dataclass(frozen=True)
+class Expression:
+    """An arithmetic expression of design variables, evaluated in internal units (mm, rad):
+    ``base_ratio * base_outer_radius``, ``platform_rotation + 10 * deg``."""
+
+    text: str
+    names: tuple[str, ...]
+
+    @classmethod
+    def parse(cls, text: str, field: str, known: set[str]) -> Expression:
+        if not isinstance(text, str | int | float) or isinstance(text, bool):
+            raise ParameterError(field, "an arithmetic expression of design variables", text)
+        text = str(text)
+        try:
+            tree = ast.parse(text, mode="eval")
+        except SyntaxError:
+            raise ParameterError(field, "an arithmetic expression (+ - * / **, numbers, design "
+                                 "variables, " + ", ".join(sorted(_FUNCTIONS)) + ")",
+                                 text) from None
+        names = []
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Name):
+                if node.id not in known and node.id not in CONSTANTS \
+                        and node.id not in _FUNCTIONS:
+                    raise ParameterError(field, f"an expression of the design variables "
+                                         f"{sorted(known)} and constants {sorted(CONSTANTS)}",
+                                         node.id)
+                if node.id in known:
+                    names.append(node.id)
+            elif not isinstance(node, _ALLOWED) or (
+                    isinstance(node, ast.Constant) and (isinstance(node.value, bool)
+                                                        or not isinstance(node.value,
+                                                                          int | float))):
+                raise ParameterError(field, "arithmetic only (+ - * / **, numbers, names, "
+                                     "function calls)", text)
+            if isinstance(node, ast.Call) and not (isinstance(node.func, ast.Name)
+                                                   and node.func.id in _FUNCTIONS):
+                raise ParameterError(field, f"calls of {sorted(_FUNCTIONS)} only", text)
+        return cls(text, tuple(dict.fromkeys(names)))
+
+    def __call__(self, values: dict) -> float:
+        env = {**CONSTANTS, **values}
+
+        def ev(node):
+            if isinstance(node, ast.Expression):
+                return ev(node.body)
+            if isinstance(node, ast.Constant):
+                return node.value
+            if isinstance(node, ast.Name):
+                return env[node.id]
+            if isinstance(node, ast.BinOp):
+                return _BINARY[type(node.op)](ev(node.left), ev(node.right))
+            if isinstance(node, ast.UnaryOp):
+                return _UNARY[type(node.op)](ev(node.operand))
+            return _FUNCTIONS[node.func.id](*[ev(a) for a in node.args])
+
+        try:
+            out = float(ev(ast.parse(self.text, mode="eval")))
+        except (ZeroDivisionError, ValueError, OverflowError) as exc:
+            raise ParameterError(f"derived ({self.text})", "an expression defined for this "
+                                 "design", f"{type(exc).__name__}: {exc}") from None
+        if not math.isfinite(out):
+            raise ParameterError(f"derived ({self.text})", "a finite value", out)
+        return out
+
+
+# ---- variables ---------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One design variable, in internal units.
+
+    ``target`` is the path it writes in the mechanism spec, or ``None`` for a free parameter
+    that only derived fields use. ``quantity`` is ``length`` (mm), ``angle`` (rad), ``number``
+    or ``text``; ``kind`` is ``continuous``, ``integer`` or ``choice``.
+    """
+
+    name: str
+    target: tuple | None
+    quantity: str
+    kind: str
+    low: float | None = None
+    high: float | None = None
+    choices: tuple = ()
+    levels: int = 5
+
+    @property
+    def unit(self) -> str:
+        return {"length": "mm", "angle": "deg"}.get(self.quantity, "")
+
+    def display(self, x):
+        """A value in display units (mm, deg) for tables and files."""
+        return math.degrees(x) if self.quantity == "angle" else x
+
+
+@dataclass(frozen=True)
+class Derived:
+    """A mechanism field computed from the variables: ``target`` ← ``expression``."""
+
+    name: str
+    target: tuple
+    expression: Expression
+
+
+class DesignSpace:
+    """Variables and derived fields over a typed mechanism spec (the baseline design)."""
+
+    def __init__(self, base_spec, variables: tuple[Variable, ...],
+                 derived: tuple[Derived, ...] = ()):
+        self.base_spec = base_spec
+        self.variables = tuple(variables)
+        self.derived = tuple(derived)
+
+    @property
+    def names(self) -> list[str]:
+        return [v.name for v in self.variables]
+
+    # ---- decoding ----------------------------------------------------------------------------
+    def spec_of(self, design: dict | None):
+        """The typed mechanism spec of one design (``None``: the baseline's)."""
+        spec = self.base_spec
+        if design is None:
+            return spec
+        for v in self.variables:
+            if v.target is not None:
+                x = design[v.name]
+                spec = with_path(spec, v.target, int(x) if v.kind == "integer" else x)
+        for d in self.derived:
+            spec = with_path(spec, d.target, d.expression(design))
+        return spec
+
+    def decode(self, design: dict | None) -> Mechanism:
+        """The mechanism of one design (``None``: the baseline); raises
+        :class:`ParameterError` if it is invalid."""
+        return self.spec_of(design).build()
+
+    def baseline_values(self) -> dict:
+        """Each variable's value in the baseline design (``None`` for free parameters)."""
+        return {v.name: None if v.target is None else get_path(self.base_spec, v.target)
+                for v in self.variables}
+
+    # ---- optimiser views -----------------------------------------------------------------------
+    def bounds(self) -> np.ndarray:
+        """``(n, 2)`` box for continuous optimisers (integers span [low, high + 1))."""
+        return np.array([[v.low, v.high + (1.0 if v.kind == "integer" else 0.0)]
+                         for v in self.variables])
+
+    def from_vector(self, x: np.ndarray) -> dict:
+        return {v.name: int(min(np.floor(xi), v.high)) if v.kind == "integer" else float(xi)
+                for v, xi in zip(self.variables, x)}
+
+    def from_unit(self, u: np.ndarray) -> dict:
+        out = {}
+        for v, ui in zip(self.variables, u):
+            if v.kind == "choice":
+                out[v.name] = v.choices[min(int(ui * len(v.choices)), len(v.choices) - 1)]
+            elif v.kind == "integer":
+                n = int(v.high - v.low) + 1
+                out[v.name] = int(v.low + min(int(ui * n), n - 1))
+            else:
+                out[v.name] = float(v.low + ui * (v.high - v.low))
+        return out
+
+    def grid_axes(self) -> list[list]:
+        axes = []
+        for v in self.variables:
+            if v.kind == "choice":
+                axes.append(list(v.choices))
+            elif v.kind == "integer":
+                axes.append([int(x) for x in np.unique(np.round(np.linspace(v.low, v.high,
+                                                                            v.levels)))])
+            else:
+                axes.append([float(x) for x in np.linspace(v.low, v.high, v.levels)])
+        return axes
+
+    def grid_size(self) -> int:
+        return math.prod(len(a) for a in self.grid_axes())
+
+    def grid(self):
+        """Every grid design, generated lazily."""
+        for combo in itertools.product(*self.grid_axes()):
+            yield dict(zip(self.names, combo))
+
+    # ---- how much of the box is buildable ------------------------------------------------------
+    def validity(self, samples: int = 128, seed: int = 0) -> tuple[float, list[tuple[str, int]]]:
+        """Fraction of a scrambled Sobol sample of the design box that fails to build (no
+        mechanism, or no level mid-stroke pose), and the most common reasons with counts."""
+        from scipy.stats import qmc
+
+        u = qmc.Sobol(d=len(self.variables), scramble=True, seed=seed).random(samples)
+        reasons: Counter = Counter()
+        for row in u:
+            try:
+                _ = self.decode(self.from_unit(row)).nominal_pose
+            except ParameterError as exc:
+                reasons[f"{exc.field}: must be {exc.allowed}"] += 1
+        bad = sum(reasons.values())
+        return bad / samples, reasons.most_common(3)

@@ -1,0 +1,370 @@
+"""Study files: the YAML schema (pydantic) and :func:`load_study`, which builds the typed
+:class:`~pkmlab.study.definition.Study` once.
+
+Everything ``pkmlab validate`` accepts, ``pkmlab run`` runs: every check of a request
+(workspace kinds and ranges, lengths, metric names, duplicate objectives) happens here, at
+load, through the same functions the library uses. Errors are
+:class:`~pkmlab.errors.ParameterError` naming the field path.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field
+
+from .. import limits
+from ..config import mechanism_spec, read_yaml, validate_model, workspace_spec
+from ..errors import ParameterError
+from ..units import parse_angle, parse_length
+from .definition import (
+    Constraint,
+    DexterityPlan,
+    Evaluation,
+    Objective,
+    Study,
+    TrajectoryPlan,
+)
+from .metrics import KIND_VOLUMES, METRICS
+from .space import Derived, DesignSpace, Expression, Variable, get_path, parse_path
+
+__all__ = ["load_study", "study_from_mapping", "StudySpec", "study_schema", "DESIGN_ALIASES"]
+
+_PAIRED = {
+    "base_inner_radius": ("generator.base_radii[0]", "length"),
+    "base_outer_radius": ("generator.base_radii[1]", "length"),
+    "platform_inner_radius": ("generator.platform_radii[0]", "length"),
+    "platform_outer_radius": ("generator.platform_radii[1]", "length"),
+    "platform_rotation": ("generator.platform_rotation", "angle"),
+    "base_pair_angle": ("generator.base_pair_angle", "angle"),
+    "base_pair_separation": ("generator.base_pair_separation", "angle"),
+    "platform_pair_separation": ("generator.platform_pair_separation", "angle"),
+    "stroke_min": ("stroke[0]", "length"),
+    "stroke_max": ("stroke[1]", "length"),
+    "tool_offset_z": ("tool_offset[2]", "length"),
+    "pairing": ("generator.pairing", "text"),
+}
+#: named design variables → (path in the mechanism spec, quantity), per family
+DESIGN_ALIASES: dict[str, dict[str, tuple[str, str]]] = {
+    "psu6": {**_PAIRED, "link_length": ("link_length", "length")},
+    "ups6": dict(_PAIRED),
+    "luzi3": {"base_diameter": ("generator.base_diameter", "length"),
+              "platform_diameter": ("generator.platform_diameter", "length"),
+              "phi": ("generator.phi", "angle"),
+              "upper_link": ("upper_link", "length"),
+              "stroke_min": ("stroke[0]", "length"),
+              "stroke_max": ("stroke[1]", "length")},
+}
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class DesignVariableSpec(_Model):
+    """One design variable: a continuous or integer range, or a list of choices."""
+
+    low: Any = Field(None, description="lower bound, with units ('110 mm', '5 deg')")
+    high: Any = Field(None, description="upper bound, with units")
+    choices: list[Any] | None = Field(None, description="discrete choices instead of a range")
+    type: Literal["continuous", "integer", "choice"] | None = None
+    path: str | None = Field(None, description="mechanism field, e.g. generator.base_radii[1]; "
+                             "none for a free parameter used by 'derived'")
+    quantity: Literal["length", "angle", "number", "text"] | None = None
+    levels: int = Field(5, ge=2, le=1000, description="grid optimiser: values per variable")
+
+
+def _auto_length(v: Any) -> float | None:
+    if isinstance(v, str) and v.strip().lower() == "auto":
+        return None
+    x = parse_length(v, "")
+    if not x > 0:
+        raise ValueError(f"must be 'auto' or a length > 0 mm; got {v!r}")
+    return x
+
+
+class DexteritySpec(_Model):
+    characteristic_length: Annotated[float | None, BeforeValidator(_auto_length)] = Field(
+        None, description="'auto' (Angeles' length, the default) or a length > 0")
+    gci_samples: int = Field(2000, ge=limits.GCI_SAMPLES[0], le=limits.GCI_SAMPLES[1])
+    force_limit: float = Field(150.0, gt=0, allow_inf_nan=False,
+                               description="actuator force limit (N)")
+
+
+class TrajectorySpec(_Model):
+    paper_motion: Literal[True] = True
+    segment_time: float = Field(1.0, gt=0, allow_inf_nan=False, description="s per segment")
+    payload: float = Field(0.0, ge=0, allow_inf_nan=False, description="payload mass (kg)")
+
+
+class EvaluateSpec(_Model):
+    workspace: dict[str, Any] | None = Field(None, description="a workspace request (see "
+                                             "'pkmlab workspace'): kind, box or tilt, ...")
+    inscribed: bool = False
+    orientation_capability: bool = False
+    dexterity: DexteritySpec | None = None
+    trajectory: TrajectorySpec | None = None
+
+
+class OptimizerSpec(_Model):
+    method: Literal["grid", "sobol", "lhs", "nsga2", "de"]
+    samples: int = Field(64, ge=1, le=10_000_000, description="sobol / lhs designs")
+    population: int = Field(32, ge=4, le=100_000, description="nsga2 / de population")
+    generations: int = Field(10, ge=1, le=100_000, description="nsga2 / de generations")
+
+
+class MechanismSource(_Model):
+    """A mechanism file plus overrides, or (``inline``) the mechanism mapping itself."""
+
+    file: str | None = Field(None, description="mechanism YAML, relative to the study file")
+    overrides: dict[str, Any] = Field(default_factory=dict)
+    inline: dict[str, Any] | None = Field(None, description="a mechanism mapping (family, "
+                                          "generator, ...) instead of a file")
+
+
+class StudySpec(_Model):
+    """A design study file (docs/studies.md): what to vary, evaluate, optimise and keep."""
+
+    study: str = Field(pattern=r"^[A-Za-z0-9._-]+$")
+    description: str = ""
+    mechanism: MechanismSource
+    design: dict[str, DesignVariableSpec] = Field(min_length=1)
+    derived: dict[str, Any] = Field(default_factory=dict, description="mechanism fields "
+                                    "computed from the variables: {alias or path: expression}")
+    evaluate: EvaluateSpec
+    objectives: list[dict[Literal["maximize", "minimize"], str]] = Field(min_length=1)
+    constraints: list[dict[str, Any]] = Field(default_factory=list)
+    optimizer: OptimizerSpec
+    seed: int = Field(0, ge=0, le=2**32 - 1)
+    output: str | None = Field(None, description="output folder, relative to the study file "
+                               "(default results/<study> in the working directory)")
+    top: int = Field(5, ge=0, le=100, description="Pareto designs exported in full")
+    provenance: dict[str, Any] | None = Field(None, description="written by pkmlab into "
+                                              "study.resolved.yaml; ignored on load")
+
+
+def study_schema() -> dict:
+    """JSON Schema of the study file (for editors); metric names are enumerated."""
+    schema = StudySpec.model_json_schema()
+    names = sorted(METRICS)
+    schema["properties"]["objectives"]["items"] = {
+        "type": "object", "minProperties": 1, "maxProperties": 1,
+        "properties": {s: {"enum": names} for s in ("maximize", "minimize")},
+        "additionalProperties": False}
+    return schema
+
+
+# ---- building the typed study -------------------------------------------------------------
+
+
+def _merge(base: dict, over: dict) -> dict:
+    out = dict(base)
+    for k, v in over.items():
+        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) \
+            else v
+    return out
+
+
+def _target(name: str, where: str, path: str | None, family: str, spec) -> tuple | None:
+    alias = DESIGN_ALIASES[family].get(name)
+    text = path or (alias[0] if alias else None)
+    if text is None:
+        return None
+    try:
+        parts = parse_path(text)
+        leaf = get_path(spec, parts)
+    except KeyError:
+        raise ParameterError(where, "a field present in the mechanism spec (a generator "
+                             "field, stroke[0], link_length, ...)", text) from None
+    if isinstance(leaf, list | dict) or hasattr(leaf, "model_fields"):
+        raise ParameterError(where, "a single value (index a list: base_radii[1])", text)
+    return parts
+
+
+def _variable(name: str, v: DesignVariableSpec, family: str, spec) -> Variable:
+    field = f"design.{name}"
+    alias = DESIGN_ALIASES[family].get(name)
+    target = _target(name, f"{field}.path", v.path, family, spec)
+    quantity = v.quantity or (alias[1] if alias else None)
+    if target is None and alias is None and v.path is None and quantity not in (None,
+                                                                                 "number"):
+        raise ParameterError(f"{field}.path", "given for a non-number variable", None)
+    if target is None and quantity is None:
+        raise ParameterError(field, f"a known variable of family {family!r} "
+                             f"{sorted(DESIGN_ALIASES[family])}, one with 'path' and "
+                             "'quantity', or a free parameter with 'quantity: number'", name)
+    if quantity is None:
+        raise ParameterError(f"{field}.quantity", "one of ['length', 'angle', 'number', "
+                             "'text']", None)
+    kind = v.type or ("choice" if v.choices is not None else "continuous")
+    if quantity == "text" and kind != "choice":
+        raise ParameterError(f"{field}.choices", "a list of choices (a text variable has no "
+                             "range)", None)
+
+    def conv(x, which):
+        where = f"{field}.{which}"
+        if quantity == "text":
+            if not isinstance(x, str):
+                raise ParameterError(where, "a text choice", x)
+            return x
+        if quantity == "number":
+            if isinstance(x, bool) or not isinstance(x, int | float) or x != x \
+                    or abs(x) == float("inf"):
+                raise ParameterError(where, "a finite number", x)
+            return float(x)
+        parse = parse_length if quantity == "length" else parse_angle
+        try:
+            return parse(x, where)
+        except ParameterError as exc:
+            raise ParameterError(where, exc.allowed, x) from None
+
+    if kind == "choice":
+        if not v.choices:
+            raise ParameterError(f"{field}.choices", "a non-empty list", v.choices)
+        return Variable(name, target, quantity, "choice",
+                        choices=tuple(conv(c, "choices") for c in v.choices))
+    for which in ("low", "high"):
+        if getattr(v, which) is None:
+            raise ParameterError(f"{field}.{which}", "given (a bound of the range)", None)
+    lo, hi = conv(v.low, "low"), conv(v.high, "high")
+    if not lo < hi:
+        raise ParameterError(field, "low < high", f"low {v.low!r}, high {v.high!r}")
+    if kind == "integer" and (lo != int(lo) or hi != int(hi)):
+        raise ParameterError(field, "integer bounds for an integer variable", [v.low, v.high])
+    return Variable(name, target, quantity, kind, lo, hi, levels=v.levels)
+
+
+def _metric(name: Any, where: str, evaluation: Evaluation) -> str:
+    if not isinstance(name, str) or name not in METRICS:
+        raise ParameterError(where, f"one of {sorted(METRICS)}", name)
+    if name in KIND_VOLUMES and evaluation.workspace is not None \
+            and evaluation.workspace.kind != KIND_VOLUMES[name]:
+        raise ParameterError(where, f"the volume of the evaluated kind "
+                             f"('{evaluation.workspace.kind}_volume')", name)
+    if name not in evaluation.metrics:
+        need = METRICS[name].evaluator
+        raise ParameterError(where, f"a metric the evaluation computes (add evaluate.{need}"
+                             + (" and evaluate.workspace" if need in ("inscribed",
+                                "orientation_capability", "dexterity") else "") + ")", name)
+    return name
+
+
+def _evaluation(ev: EvaluateSpec) -> Evaluation:
+    ws = None if ev.workspace is None else workspace_spec(ev.workspace,
+                                                          prefix="evaluate.workspace.")
+    for block in ("inscribed", "orientation_capability", "dexterity"):
+        if getattr(ev, block) not in (None, False) and ws is None:
+            raise ParameterError(f"evaluate.{block}", "used with an evaluate.workspace block "
+                                 "(it is computed over that workspace)", "no workspace")
+    dx = ev.dexterity
+    return Evaluation(
+        workspace=ws, request=None if ws is None else ws.build(),
+        inscribed=ev.inscribed, orientation_capability=ev.orientation_capability,
+        dexterity=None if dx is None else DexterityPlan(dx.characteristic_length,
+                                                        dx.gci_samples, dx.force_limit),
+        trajectory=None if ev.trajectory is None else TrajectoryPlan(
+            ev.trajectory.segment_time, ev.trajectory.payload))
+
+
+def study_from_mapping(data: Any, base: Path | None = None,
+                       source: Path | None = None) -> Study:
+    """A study mapping (a parsed study file) → :class:`Study`; relative paths resolve
+    against ``base`` (the study file's folder)."""
+    if not isinstance(data, dict):
+        raise ParameterError("(study)", "a mapping with study, mechanism, design, evaluate, "
+                             "objectives, optimizer", type(data).__name__)
+    spec = validate_model(StudySpec, data)
+    base = Path(".") if base is None else base
+    src = spec.mechanism
+    if (src.file is None) == (src.inline is None):
+        raise ParameterError("mechanism", "exactly one of 'file' (with optional 'overrides') "
+                             "or 'inline'", sorted(k for k in ("file", "inline")
+                                                   if getattr(src, k) is not None))
+    if src.file is not None:
+        mech_path = (base / src.file)
+        if not mech_path.is_file():
+            raise ParameterError("mechanism.file", "an existing mechanism YAML file", src.file)
+        mech_data = read_yaml(mech_path, "mechanism")
+        if not isinstance(mech_data, dict):
+            raise ParameterError("mechanism.file", "a mechanism YAML mapping", src.file)
+    else:
+        mech_data = dict(src.inline)
+    mech_spec = mechanism_spec(_merge(mech_data, src.overrides), prefix="mechanism.")
+    try:
+        mech_spec.build()
+    except ParameterError as exc:
+        raise ParameterError(f"mechanism.{exc.field}", exc.allowed, exc.got) from None
+    family = mech_spec.family
+    variables = tuple(_variable(n, v, family, mech_spec) for n, v in spec.design.items())
+    names = {v.name for v in variables}
+    derived = []
+    for key, text in spec.derived.items():
+        where = f"derived.{key}"
+        if key in names:
+            raise ParameterError(where, "a field no design variable sets", key)
+        target = _target(key, where, None if key in DESIGN_ALIASES[family] else key, family,
+                         mech_spec)
+        derived.append(Derived(key, target, Expression.parse(text, where, names)))
+    written = [v.target for v in variables if v.target is not None] + \
+        [d.target for d in derived]
+    if len(set(written)) != len(written):
+        raise ParameterError("design", "variables and derived fields that each set a "
+                             "different mechanism field", "a field set twice")
+    used = {n for d in derived for n in d.expression.names}
+    for v in variables:
+        if v.target is None and v.name not in used:
+            raise ParameterError(f"design.{v.name}", "a mechanism field (alias or 'path') or "
+                                 "a parameter used by 'derived'", v.name)
+    evaluation = _evaluation(spec.evaluate)
+    objectives = []
+    for i, o in enumerate(spec.objectives):
+        if len(o) != 1:
+            raise ParameterError(f"objectives[{i}]", "one of {maximize: metric} or "
+                                 "{minimize: metric}", o)
+        (sense, name), = o.items()
+        objectives.append(Objective(_metric(name, f"objectives[{i}].{sense}", evaluation),
+                                    sense))
+        if any(ob.metric == name for ob in objectives[:-1]):
+            raise ParameterError(f"objectives[{i}].{sense}", "a metric not already an "
+                                 "objective", name)
+    constraints = []
+    for i, c in enumerate(spec.constraints):
+        if not isinstance(c, dict) or len(c) != 1:
+            raise ParameterError(f"constraints[{i}]", "{metric: {min: x} | {max: x}} or "
+                                 "{metric: true}", c)
+        (name, rule), = c.items()
+        _metric(name, f"constraints[{i}]", evaluation)
+        if rule is True:
+            if METRICS[name].statistic != "flag":
+                raise ParameterError(f"constraints[{i}].{name}", "{min: x} or {max: x} ("
+                                     "'true' is for flags such as singularity_free)", rule)
+            rule = {"min": 1.0}
+        if not isinstance(rule, dict) or not rule or set(rule) - {"min", "max"}:
+            raise ParameterError(f"constraints[{i}].{name}", "{min: x}, {max: x} or true",
+                                 rule)
+        for k, x in rule.items():
+            if isinstance(x, bool) or not isinstance(x, int | float) or x != x:
+                raise ParameterError(f"constraints[{i}].{name}.{k}", "a number", x)
+        if "min" in rule and "max" in rule and rule["min"] > rule["max"]:
+            raise ParameterError(f"constraints[{i}].{name}", "min <= max", rule)
+        constraints.append(Constraint(name, rule.get("min"), rule.get("max")))
+    opt = spec.optimizer
+    if opt.method == "de" and len(objectives) != 1:
+        raise ParameterError("optimizer.method", "'nsga2', 'grid', 'sobol' or 'lhs' for "
+                             "several objectives ('de' takes one)", opt.method)
+    if opt.method in ("nsga2", "de") and any(v.kind == "choice" for v in variables):
+        raise ParameterError("optimizer.method", "'grid', 'sobol' or 'lhs' with choice "
+                             "variables", opt.method)
+    output = Path("results") / spec.study if spec.output is None else base / spec.output
+    return Study(name=spec.study, description=spec.description,
+                 space=DesignSpace(mech_spec, variables, tuple(derived)),
+                 evaluation=evaluation, objectives=tuple(objectives),
+                 constraints=tuple(constraints), optimizer=opt, seed=spec.seed,
+                 output=output, top=spec.top, source=source)
+
+
+def load_study(source: str | Path) -> Study:
+    """Validate a study file and build its :class:`Study` (raises ParameterError)."""
+    path = Path(source)
+    return study_from_mapping(read_yaml(path, "study"), path.parent, path)
