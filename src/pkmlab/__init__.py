@@ -1,12 +1,23 @@
 """pkmlab: design-optimisation workbench for parallel manipulators."""
 
 from .config import load_mechanism
-from .errors import ParameterError
+from .errors import NumericalError, ParameterError
 from .mechanisms import PSU6, REGISTRY, UPS6, Luzi3, Mechanism
 from .workspaces import Constraints, JointLimits, OrientationSet, WorkspaceResult, workspace
 
 __version__ = "0.1.0"
 
-__all__ = ["load_mechanism", "ParameterError", "REGISTRY", "Mechanism", "PSU6", "UPS6", "Luzi3",
-           "workspace", "OrientationSet", "Constraints", "JointLimits", "WorkspaceResult",
-           "__version__"]
+__all__ = ["load_mechanism", "load_study", "ParameterError", "NumericalError", "REGISTRY",
+           "Mechanism", "PSU6", "UPS6", "Luzi3", "workspace", "OrientationSet", "Constraints",
+           "JointLimits", "WorkspaceResult", "__version__"]
+
+
+def __getattr__(name: str):
+    """Heavy subpackages load on first use (``pkmlab.study``, ``pkmlab.load_study``)."""
+    import importlib
+
+    if name in ("study", "dexterity", "trajectory"):
+        return importlib.import_module(f".{name}", __name__)
+    if name == "load_study":
+        return importlib.import_module(".study", __name__).load_study
+    raise AttributeError(f"module 'pkmlab' has no attribute {name!r}")

@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..poses import as_frames, frames_to_poses, log_so3
-from .base import NO_STROKE, AssemblyModes, FKResult, step_frames
+from .results import NO_STROKE, AssemblyModes, FKResult, step_frames
 
 
 def _solve(G: np.ndarray, f: np.ndarray) -> np.ndarray:
@@ -73,8 +74,6 @@ def forward_newton(mech, q, guess=None, *, tol: float = 1e-9, max_iter: int = 50
     """Batched forward kinematics; see :meth:`Mechanism.forward`."""
     q = np.atleast_2d(np.asarray(q, dtype=float))
     if q.shape[1:] != (6,):
-        from ..errors import ParameterError
-
         raise ParameterError("q", "an array of shape (6,) or (N, 6) in mm", q.shape)
     n = q.shape[0]
     p0, R0 = as_frames(mech.nominal_pose if guess is None else guess, field="guess")

@@ -25,6 +25,7 @@ from ..limits import RESOLUTION_MM
 from ..mechanisms import NO_STROKE
 from ..poses import as_frames, matrix_to_euler
 from .constraints import Constraints, check
+from .field import interval_field
 from .orientations import OrientationSet
 from .refine import refine_columns
 from .result import WorkspaceResult
@@ -210,23 +211,6 @@ def _z_axis(lo, hi, h):
         return np.empty(0)
     zmin, zmax = float(lo[finite].min()), float(hi[finite].max())
     return np.arange(math.floor(zmin / h), math.ceil(zmax / h) + 1) * h
-
-
-def interval_field(xs, ys, zs, lo, hi, h):
-    """Signed z distance to the column sets, clipped to [-h, h] (positive inside)."""
-    f = np.full((len(xs), len(ys), len(zs)), -h, dtype=np.float32)
-    if f.size == 0:
-        return f
-    used = int(np.max(np.sum(lo <= hi, axis=-1), initial=0))
-    z = zs[None, None, :]
-    for k in range(used):
-        a = lo[..., k, None]
-        b = hi[..., k, None]
-        with np.errstate(invalid="ignore"):
-            piece = np.minimum(z - a, b - z)
-        piece = np.where(a <= b, piece, -np.inf)
-        np.maximum(f, np.clip(piece, -h, h), out=f)
-    return f
 
 
 def _column_extras(mech, xs, ys, R, mode, cons, lo, hi, overflow):

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
+from .field import interval_field
 
 __all__ = ["WorkspaceResult"]
 
@@ -64,8 +65,6 @@ class WorkspaceResult:
         """
         if self.voxel_field is not None:
             return self.voxel_field
-        from .engine import interval_field
-
         return interval_field(self.xs, self.ys, self.zs, self.lo, self.hi, self.resolution)
 
     @cached_property

@@ -1,0 +1,94 @@
+"""Result types of the mechanism protocol (inverse and forward kinematics, assembly modes)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..poses import exp_so3
+from . import _kernels
+
+#: Stroke override of :meth:`Mechanism.inverse` that checks geometry only.
+NO_STROKE = (-math.inf, math.inf)
+
+__all__ = ["NO_STROKE", "LEG_STATUS", "IKResult", "FKResult", "AssemblyModes", "step_frames"]
+
+#: Leg status / pose reason codes of :meth:`Mechanism.inverse`, by severity.
+LEG_STATUS = {
+    _kernels.OK: "ok",
+    _kernels.BELOW_STROKE: "stroke below minimum",
+    _kernels.ABOVE_STROKE: "stroke above maximum",
+    _kernels.DEGENERATE: "degenerate leg geometry",
+    _kernels.NO_SOLUTION: "no real solution",
+    _kernels.INVALID_INPUT: "non-finite pose",
+    _kernels.OTHER_MODE: "leg outside the working mode",
+}
+
+
+@dataclass(frozen=True)
+class IKResult:
+    """Inverse kinematics of N poses.
+
+    Attributes:
+        q: actuator values ``(N, 6)`` in mm; NaN only where ``leg_status`` is
+            ``no real solution``, ``degenerate leg geometry`` or ``non-finite pose``.
+        valid: ``(N,)`` True where every leg is solvable and within its stroke.
+        reason: ``(N,)`` int code, the most severe leg status (keys of ``LEG_STATUS``).
+        leg_status: ``(N, 6)`` int code per leg.
+    """
+
+    q: np.ndarray
+    valid: np.ndarray
+    reason: np.ndarray
+    leg_status: np.ndarray
+
+    @property
+    def reason_text(self) -> np.ndarray:
+        """``(N,)`` human-readable reason per pose."""
+        return np.array([LEG_STATUS[int(c)] for c in self.reason], dtype=object)
+
+
+@dataclass(frozen=True)
+class FKResult:
+    """Forward kinematics of N actuator vectors.
+
+    Attributes:
+        pose: ``(N, 6)`` tool pose (mm, rad); NaN where not converged.
+        converged: ``(N,)`` residual below tolerance in the mechanism's working mode.
+        residual: ``(N,)`` largest loop-closure error in mm.
+        iterations: ``(N,)`` Newton iterations used (continuation steps add up).
+        status: ``(N,)`` ``"ok"``, ``"not converged"`` or ``"singular"``.
+    """
+
+    pose: np.ndarray
+    converged: np.ndarray
+    residual: np.ndarray
+    iterations: np.ndarray
+    status: np.ndarray
+
+
+@dataclass(frozen=True)
+class AssemblyModes:
+    """All assembly modes found for one actuator vector, nominal-closest first.
+
+    Attributes:
+        pose: ``(M, 6)`` tool poses (mm, rad).
+        residual: ``(M,)`` largest loop-closure error in mm.
+        working_mode: ``(M,)`` True where the pose's inverse kinematics (the family's working
+            branch, e.g. the positive root of the 6-PSU) reproduces the actuator values.
+        distance: ``(M,)`` distance to the nominal pose (mm + characteristic length · rad).
+        starts: number of starting points used.
+    """
+
+    pose: np.ndarray
+    residual: np.ndarray
+    working_mode: np.ndarray
+    distance: np.ndarray
+    starts: int
+
+
+def step_frames(p: np.ndarray, R: np.ndarray, twist: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Apply a base-frame twist displacement ``(N, 6)`` to frames: p += v, R ← exp(ω)·R."""
+    return p + twist[:, :3], exp_so3(twist[:, 3:]) @ R
