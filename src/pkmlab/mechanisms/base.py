@@ -48,6 +48,7 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import ParameterError
 from ..poses import as_frames, log_so3
+from ..tolerances import TOL
 from . import _kernels
 from .results import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult
 from .solvers import forward_newton, multistart_modes
@@ -78,10 +79,11 @@ def as_points(value: Any, field: str, count: int) -> np.ndarray:
         raise ParameterError(field, "finite coordinates", arr.tolist())
     d = np.linalg.norm(arr[:, None, :] - arr[None, :, :], axis=-1)
     i, j = np.triu_indices(count, 1)
-    close = d[i, j] < 1e-6
+    close = d[i, j] < TOL.coincident_mm
     if np.any(close):
         a, b = i[close][0], j[close][0]
-        raise ParameterError(field, "distinct joint centres (no two closer than 1e-6 mm)",
+        raise ParameterError(field, "distinct joint centres (no two closer than "
+                             f"{TOL.coincident_mm:g} mm)",
                              f"points {a + 1} and {b + 1} coincide at {arr[a].tolist()}")
     arr = arr.copy()
     arr.setflags(write=False)
@@ -315,8 +317,8 @@ class Mechanism:
         p, R = _frames_tuple(poses) if isinstance(poses, tuple) else as_frames(poses)
         return self._jacobian(p, R)
 
-    def forward(self, q: np.ndarray, guess: np.ndarray | None = None, *, tol: float = 1e-9,
-                max_iter: int = 50) -> FKResult:
+    def forward(self, q: np.ndarray, guess: np.ndarray | None = None, *,
+                tol: float = TOL.fk_residual_mm, max_iter: int = 50) -> FKResult:
         """Forward kinematics by Newton's method with the analytic Jacobian.
 
         Args:
@@ -329,13 +331,13 @@ class Mechanism:
         return forward_newton(self, q, guess, tol=tol, max_iter=max_iter)
 
     def assembly_modes(self, q: np.ndarray, *, starts: int = 1500, seed: int = 0,
-                       tol: float = 1e-9) -> AssemblyModes:
+                       tol: float = TOL.fk_residual_mm) -> AssemblyModes:
         """All real assembly modes for one actuator vector ``(6,)``, by multi-start Newton.
 
         Starting points: the nominal pose, plus ``starts`` poses with positions uniform in a
         box of half-size ``2·scale`` around the base centre and orientations uniform on SO(3)
-        (seeded). Solutions are de-duplicated (1e-6·scale mm, 1e-6 rad) and sorted by distance
-        to the nominal pose.
+        (seeded). Solutions are de-duplicated (``TOL.mode_duplicate_rel``·scale mm and rad)
+        and sorted by distance to the nominal pose.
         """
         return multistart_modes(self, q, starts=starts, seed=seed, tol=tol)
 
@@ -372,7 +374,7 @@ class Mechanism:
         for k in range(len(zs) - 1):
             a, b = vals[k], vals[k + 1]
             if np.isfinite(a) and np.isfinite(b) and a * b <= 0:
-                z = brentq(mean_q, zs[k + 1], zs[k], xtol=1e-12)
+                z = brentq(mean_q, zs[k + 1], zs[k], xtol=TOL.nominal_z_mm)
                 return np.array([0.0, 0.0, z, 0.0, 0.0, yaw])
         raise ParameterError(f"{self.family}.stroke",
                              "a window whose mid-point is reachable by a level, centred platform",

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..poses import as_frames, frames_to_poses, log_so3
+from ..tolerances import TOL
 from .results import NO_STROKE, AssemblyModes, FKResult, step_frames
 
 
@@ -20,7 +21,7 @@ def _solve(G: np.ndarray, f: np.ndarray) -> np.ndarray:
     try:
         return np.linalg.solve(G, f[..., None])[..., 0]
     except np.linalg.LinAlgError:
-        return np.einsum("nij,nj->ni", np.linalg.pinv(G, rcond=1e-13), f)
+        return np.einsum("nij,nj->ni", np.linalg.pinv(G, rcond=TOL.newton_rcond), f)
 
 
 def newton(mech, p, R, q, *, tol: float, max_iter: int, polish: int = 2):
@@ -69,7 +70,7 @@ def _working_mode(mech, p, R, q, tol_mode: float) -> np.ndarray:
     return np.isfinite(err) & (err <= tol_mode)
 
 
-def forward_newton(mech, q, guess=None, *, tol: float = 1e-9, max_iter: int = 50,
+def forward_newton(mech, q, guess=None, *, tol: float = TOL.fk_residual_mm, max_iter: int = 50,
                    continuation_steps: int = 12) -> FKResult:
     """Batched forward kinematics; see :meth:`Mechanism.forward`."""
     q = np.atleast_2d(np.asarray(q, dtype=float))
@@ -79,7 +80,7 @@ def forward_newton(mech, q, guess=None, *, tol: float = 1e-9, max_iter: int = 50
     p0, R0 = as_frames(mech.nominal_pose if guess is None else guess, field="guess")
     if p0.shape[0] == 1 and n > 1:
         p0, R0 = np.repeat(p0, n, axis=0), np.repeat(R0, n, axis=0)
-    tol_mode = max(1e3 * tol, 1e-6)
+    tol_mode = max(1e3 * tol, TOL.working_mode_mm)
     p, R, res, it, _ = newton(mech, p0, R0, q, tol=tol, max_iter=max_iter)
     ok = (res < tol) & _working_mode(mech, p, R, q, tol_mode)
 
@@ -122,7 +123,7 @@ def multistart_modes(mech, q, *, starts: int, seed: int, tol: float) -> Assembly
     conv = res < tol
     p, R, res = p[conv], R[conv], res[conv]
     # De-duplicate: greedy clustering in (position, rotation) space.
-    lin_tol, ang_tol = 1e-6 * mech.scale, 1e-6
+    lin_tol, ang_tol = TOL.mode_duplicate_rel * mech.scale, TOL.mode_duplicate_rel
     keep: list[int] = []
     for i in np.argsort(res):
         if keep:
@@ -137,7 +138,7 @@ def multistart_modes(mech, q, *, starts: int, seed: int, tol: float) -> Assembly
     dist = mech._pose_distance(p, R) if k.size else np.zeros(0)
     order = np.argsort(dist)
     p, R, res, dist = p[order], R[order], res[order], dist[order]
-    working = _working_mode(mech, p, R, qq[: p.shape[0]], max(1e3 * tol, 1e-6)) \
+    working = _working_mode(mech, p, R, qq[: p.shape[0]], max(1e3 * tol, TOL.working_mode_mm)) \
         if k.size else np.zeros(0, dtype=bool)
     return AssemblyModes(pose=frames_to_poses(p, R) if k.size else np.zeros((0, 6)),
                          residual=res, working_mode=working, distance=dist,
