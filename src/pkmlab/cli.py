@@ -257,23 +257,16 @@ def _csv_list(text: str | None, field: str, n: int) -> list[str] | None:
 def _write_workspace(res, out_dir: Path, mesh_formats: list[str], window: float,
                      spacing: float) -> list[Path]:
     """Write every output into a scratch folder first, then move it into ``out_dir``."""
-    import shutil
-    import tempfile
+    from .atomic import staged
 
-    out_dir.mkdir(parents=True, exist_ok=True)
-    written = []
-    with tempfile.TemporaryDirectory(dir=out_dir, prefix=".partial-") as tmp:
-        tmp = Path(tmp)
+    for stale in ("workspace.stl", "workspace.ply", "workspace.glb"):
+        (out_dir / stale).unlink(missing_ok=True)
+    with staged(out_dir) as tmp:
         files = [res.save_npz(tmp / "workspace.npz"), res.save_json(tmp / "workspace.json"),
                  res.plot_slices(tmp / "slices.png", window=window, spacing=spacing)]
         if not res.empty:
             files += [res.save_mesh(tmp / f"workspace.{fmt}") for fmt in mesh_formats]
-        for stale in ("workspace.stl", "workspace.ply", "workspace.glb"):
-            (out_dir / stale).unlink(missing_ok=True)
-        for f in files:
-            shutil.move(str(f), out_dir / f.name)
-            written.append(out_dir / f.name)
-    return written
+    return [out_dir / f.name for f in files]
 
 
 def _workspace_summary(res, written, as_json: bool, extra: dict | None = None) -> None:

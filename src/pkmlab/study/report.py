@@ -8,6 +8,7 @@ mesh and κ map of the few Pareto designs it exports). Plots are built on
 from __future__ import annotations
 
 import csv
+import io
 import json
 import logging
 import math
@@ -18,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from .. import __version__
+from .. import __version__, atomic
 from ..config import to_display
 from ..errors import NumericalError, ParameterError
 from .definition import Study
@@ -73,10 +74,11 @@ def _rows(study: Study, records: list[dict]):
 
 
 def _write_csv(path: Path, header, rows) -> None:
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(header)
-        w.writerows(rows)
+    buf = io.StringIO(newline="")
+    w = csv.writer(buf)
+    w.writerow(header)
+    w.writerows(rows)
+    atomic.write_text(path, buf.getvalue())
 
 
 def pareto_records(study: Study, records: list[dict]) -> list[dict]:
@@ -104,10 +106,10 @@ def write_report(out: Path, study: Study, records: list[dict]) -> dict:
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     resolved = {**study.resolved(), "provenance": provenance()}
-    (out / "study.resolved.yaml").write_text(
-        "# The study as run: every default filled in, every quantity with its unit.\n"
-        "# `pkmlab run` accepts this file as it is.\n"
-        + yaml.safe_dump(_plain(resolved), sort_keys=False, allow_unicode=True))
+    atomic.write_text(out / "study.resolved.yaml",
+                      "# The study as run: every default filled in, every quantity with its "
+                      "unit.\n# `pkmlab run` accepts this file as it is.\n"
+                      + yaml.safe_dump(_plain(resolved), sort_keys=False, allow_unicode=True))
     header, rows = _rows(study, records)
     _write_csv(out / "evaluations.csv", header, rows)
     front = pareto_records(study, records)
@@ -115,7 +117,7 @@ def write_report(out: Path, study: Study, records: list[dict]) -> dict:
     _write_csv(out / "pareto.csv", ["rank", *h2], [[i + 1, *row] for i, row in enumerate(r2)])
     _plot(out / "pareto.png", study, records, front)
     baseline = next((r for r in records if r["role"] == "baseline"), None)
-    (out / "summary.md").write_text(_summary(study, records, front, baseline))
+    atomic.write_text(out / "summary.md", _summary(study, records, front, baseline))
     counts: dict = {}
     for r in records:
         counts[r["status"]] = counts.get(r["status"], 0) + 1
@@ -175,7 +177,9 @@ def _plot(path: Path, study: Study, records, front) -> None:
         ax.set_ylabel("normalised over the Pareto set")
         ax.set_title("Pareto set, parallel coordinates", fontsize=9)
     fig.suptitle(f"{study.name}: {len(cand)} candidates, {len(front)} Pareto")
-    fig.savefig(path, dpi=110)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    atomic.write_bytes(path, buf.getvalue())
 
 
 def _fmt(v) -> str:
