@@ -13,7 +13,8 @@ from pkmlab.mechanisms import REGISTRY, Luzi3
 ROOT = Path(__file__).resolve().parents[1]
 MECH_DIR = ROOT / "studies" / "mechanisms"
 
-# Every shipped mechanism file, plus the Luzi geometry that matches the paper's Table 1.
+# Every shipped mechanism file, plus the Luzi geometry with the upper link (200 mm) that the
+# paper's Table 1 ψ columns were computed with (rows 1-2; docs/validation.md).
 SHIPPED = sorted(MECH_DIR.glob("*.yaml"))
 
 
