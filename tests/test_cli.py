@@ -90,4 +90,4 @@ def test_bad_mechanism_file_exits_2(tmp_path):
                  .replace("link_length: 225 mm", "link_length: -225 mm"))
     r = runner.invoke(app, ["inspect", str(f)])
     assert r.exit_code == 2
-    assert "link_length: must be a length > 0 mm" in r.stderr
+    assert "link_length (m.yaml, line 19, column 1): must be a length > 0 mm" in r.stderr
