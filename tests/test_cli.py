@@ -4,6 +4,11 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -90,4 +95,110 @@ def test_bad_mechanism_file_exits_2(tmp_path):
                  .replace("link_length: 225 mm", "link_length: -225 mm"))
     r = runner.invoke(app, ["inspect", str(f)])
     assert r.exit_code == 2
-    assert "link_length: must be a length > 0 mm" in r.stderr
+    assert "link_length (m.yaml, line 19, column 1): must be a length > 0 mm" in r.stderr
+
+
+# ---- bad input: one line on stderr naming the field (and where in the file), exit 2 ----------
+
+BAD_DIR = Path(__file__).parent / "data" / "bad"
+HW = (MECH_DIR / "hopkins-williams-6psu.yaml").read_text()
+
+
+def expectation(path: Path) -> list[str]:
+    """``# expect: <command> | <field path> | <position>`` on the file's first line."""
+    first = path.read_bytes().split(b"\n", 1)[0].decode("latin-1")
+    assert first.startswith("# expect: "), path
+    return [part.strip() for part in first.removeprefix("# expect: ").split("|")]
+
+
+def one_clean_error(r, *fragments: str) -> str:
+    assert r.exit_code == 2, (r.exit_code, r.output, r.exception)
+    assert isinstance(r.exception, SystemExit), r.exception
+    lines = r.stderr.splitlines()
+    assert len(lines) == 1, r.stderr
+    line = lines[0]
+    assert line.startswith("error: ") and ": must be " in line and "; got " in line, line
+    for text in fragments:
+        assert text in line, (text, line)
+    for leak in ("Traceback", "Input should", "function-", "[key]", "Value error"):
+        assert leak not in r.output, line
+    return line
+
+
+@pytest.mark.parametrize("path", sorted(BAD_DIR.glob("*.yaml")), ids=lambda p: p.stem)
+def test_bad_input_corpus(path):
+    command, field, where = expectation(path)
+    r = runner.invoke(app, [command, str(path)])
+    line = one_clean_error(r, field, f"{where})")
+    assert line.index(field) < line.index(where) < line.index(": must be ")
+
+
+def test_bracketed_text_is_printed_as_written(tmp_path):
+    line = one_clean_error(runner.invoke(app, ["inspect", str(BAD_DIR / "stroke-reversed.yaml")]))
+    assert "must be [min, max] with min < max; got ['4 in', '0 mm']" in line
+    one_clean_error(runner.invoke(app, ["ik", HOPKINS, "--pose", "[/],0,300,0,0,0"]),
+                    "--pose[0]: must be", "got '[/]'")
+    folder = tmp_path / "["
+    folder.mkdir()
+    (folder / "x]").write_text(HW.replace("name: hopkins-williams-6psu", "name: '[/bold]'"))
+    r = runner.invoke(app, ["inspect", str(folder / "x]")])
+    assert r.exit_code == 0, r.output
+    assert "[/bold]" in r.stdout
+
+
+def timed(args: list[str]):
+    t = time.perf_counter()
+    r = runner.invoke(app, args)
+    return r, time.perf_counter() - t
+
+
+def test_billion_laughs_is_refused_at_once(tmp_path):
+    bomb = ['a: &a ["lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol"]']
+    bomb += [f"{c}: &{c} [" + ", ".join([f"*{p}"] * 9) + "]" for p, c in zip("abcdefgh",
+                                                                              "bcdefghi")]
+    f = tmp_path / "laughs.yaml"
+    f.write_text("\n".join(bomb) + "\n" + HW.replace("stroke: [0 mm, 4 in]", "stroke: *i"))
+    r, seconds = timed(["inspect", str(f)])
+    one_clean_error(r, "laughs.yaml (line 5, column 8): must be at most 10,000 values expanded "
+                       "from aliases")
+    assert seconds < 2
+
+
+def test_50_mb_file_is_refused_at_once(tmp_path):
+    f = tmp_path / "big.yaml"
+    row = "  - [1.0, 2.0, 3.0]\n"
+    with f.open("w") as out:
+        out.write(HW + "base_points:\n")
+        for _ in range(50):
+            out.write(row * (2**20 // len(row)))
+    assert f.stat().st_size > 50e6
+    r, seconds = timed(["inspect", str(f)])
+    one_clean_error(r, "big.yaml: must be at most 1,048,576 bytes")
+    assert seconds < 2
+
+
+def test_50000_brackets_are_refused_at_once(tmp_path):
+    f = tmp_path / "deep.yaml"
+    f.write_text("name: " + "[" * 50_000 + "]" * 50_000 + "\n")
+    r, seconds = timed(["inspect", str(f)])
+    one_clean_error(r, "deep.yaml (line 1, column 106): must be nested at most 100 levels")
+    assert seconds < 2
+
+
+def test_utf16_without_a_byte_order_mark(tmp_path):
+    f = tmp_path / "utf16.yaml"
+    f.write_bytes(HW.encode("utf-16-le"))
+    one_clean_error(runner.invoke(app, ["inspect", str(f)]), "utf16.yaml (line 1, column 2): "
+                    "must be UTF-8 text (or UTF-16 with a byte-order mark)")
+
+
+def test_one_line_in_a_real_process_on_a_narrow_terminal():
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[1] / "src"), "COLUMNS": "60"}
+    p = subprocess.run([sys.executable, "-m", "pkmlab.cli", "validate",
+                        str(BAD_DIR / "unknown-key-typo.yaml")], capture_output=True, text=True,
+                       env=env, timeout=120)
+    assert p.returncode == 2
+    assert p.stderr.count("\n") == 1 and "Traceback" not in p.stderr, p.stderr
+    assert p.stderr.startswith("error: evaluate.workspace.resolutoin (unknown-key-typo.yaml, "
+                               "line 10, column 5): must be a known key (did you mean "
+                               "'resolution'?")

@@ -155,3 +155,160 @@ def test_python_constructor_validates_too():
         PSU6(m.base_points, m.platform_points, -1.0, (0, 100))
     with pytest.raises(ParameterError, match=r"^stroke: must be \[min, max\] with min < max"):
         PSU6(m.base_points, m.platform_points, 225.0, (100, 0))
+
+
+# ---- reading YAML (pkmlab.yamlio) and pydantic's errors in plain words ----------------------
+
+ROOT = MECH_DIR.parents[1]
+
+
+def test_load_yaml_reads_what_safe_load_reads():
+    from pkmlab.yamlio import load_yaml
+
+    files = sorted((ROOT / "studies").rglob("*.yaml"))
+    assert len(files) >= 5
+    for f in files:
+        assert load_yaml(f)[0] == yaml.safe_load(f.read_text()), f.name
+
+
+def test_load_yaml_locates_fields(tmp_path):
+    from pkmlab.yamlio import load_yaml
+
+    f = tmp_path / "s.yaml"
+    f.write_text("study: s\nevaluate:\n  workspace:\n    kind: constant\n"
+                 "    resolution: 5 mm\n  box: [1, {a: 2}]\n")
+    data, locate = load_yaml(f)
+    assert data["evaluate"]["workspace"]["resolution"] == "5 mm"
+    assert locate(("evaluate", "workspace", "resolution")) == (5, 5)
+    assert locate(("evaluate", "box", 1, "a")) == (6, 13)
+    assert locate(("evaluate", "box", 1)) == (6, 12)
+    assert locate(("evaluate", "workspace", "samples")) == (3, 3)   # nearest present
+    assert locate(("evaluate", "workspace", "samples"), nearest=False) is None
+
+
+def test_merge_keys_read_as_safe_load_reads_them(tmp_path):
+    from pkmlab.yamlio import load_yaml
+
+    text = ("a: &a {x: 1, y: 2}\nb: &b {y: 3, w: 4}\nc:\n  y: 9\n  <<: [*a, *b]\n"
+            "d: {<<: *a, x: 5}\n")
+    (tmp_path / "m.yaml").write_text(text)
+    data = load_yaml(tmp_path / "m.yaml")[0]
+    assert data == yaml.safe_load(text)
+    assert list(data["c"]) == list(yaml.safe_load(text)["c"])
+
+
+def test_utf16_with_a_byte_order_mark_is_read(tmp_path):
+    src = MECH_DIR / "hopkins-williams-6psu.yaml"
+    f = tmp_path / "utf16.yaml"
+    f.write_bytes(src.read_text().encode("utf-16"))
+    assert pkmlab.load_mechanism(f) == pkmlab.load_mechanism(src)
+
+
+def test_limits_are_configurable(tmp_path, monkeypatch):
+    from pkmlab import yamlio
+
+    f = tmp_path / "m.yaml"
+    f.write_text("a: [[[1]]]\nb: &x [1, 2, 3]\nc: [*x, *x]\n")
+    assert yamlio.load_yaml(f)[0]["c"] == [[1, 2, 3]] * 2
+    with pytest.raises(ParameterError, match=r"m\.yaml: must be at most 10 bytes"):
+        yamlio.load_yaml(f, max_bytes=10)
+    with pytest.raises(ParameterError, match=r"\(line 1, column 5\): must be nested at most 2 "):
+        yamlio.load_yaml(f, max_depth=2)
+    monkeypatch.setattr(yamlio, "MAX_ALIAS_NODES", 5)
+    with pytest.raises(ParameterError, match=r"\(line 3, column 9\): must be at most 5 values "
+                                             r"expanded from aliases"):
+        yamlio.load_yaml(f)
+
+
+def test_format_value_cost_does_not_grow_with_the_value():
+    import time
+
+    from pkmlab.errors import format_value
+
+    nested = ["lol"] * 9
+    for _ in range(6):
+        nested = [nested] * 9        # 9**7 strings, shared as an alias bomb shares them
+    for value in (nested, "x" * 10**7, {i: [i] * 1000 for i in range(10**4)}, 10**5000):
+        t = time.perf_counter()
+        text = format_value(value)
+        assert time.perf_counter() - t < 0.05
+        assert len(text) <= 200
+    assert format_value([1, "a", (2,), {"k": None}]) == "[1, 'a', (2,), {'k': None}]"
+
+
+_WS = {"kind": "constant"}
+WORDING = [
+    ({"samples": "x"}, "samples: must be an integer; got 'x'"),
+    ({"samples": 1.5}, "samples: must be an integer; got 1.5"),
+    ({"samples": 0}, "samples: must be an integer ≥ 1; got 0"),
+    ({"samples": 500}, "samples: must be an integer ≤ 101; got 500"),
+    ({"kind": "foo"}, "kind: must be 'constant', 'reachable' or 'dexterous'; got 'foo'"),
+    ({"constraints": {"connected": "maybe"}},
+     "constraints.connected: must be true or false; got 'maybe'"),
+    ({"constraints": {"kappa_max": 0.5}}, "constraints.kappa_max: must be a number ≥ 1; got 0.5"),
+    ({"constraints": 3}, "constraints: must be a mapping (keys: stroke, joint_limits, "
+                         "link_diameter, kappa_max, characteristic_length, connected); got 3"),
+    ({"resolutoin": 2, "samples": "x"}, "resolutoin: must be a known key (did you mean "
+                                        "'resolution'? known keys: box, constraints, kind, "),
+]
+
+
+@pytest.mark.parametrize("change, message", WORDING, ids=[m.split(":")[0] + str(i)
+                                                          for i, (_, m) in enumerate(WORDING)])
+def test_pydantic_errors_in_plain_words(change, message):
+    with pytest.raises(ParameterError) as info:
+        pkmlab.config.workspace_spec({**_WS, **change})
+    assert str(info.value).startswith(message), str(info.value)
+    assert "Input should" not in str(info.value)
+
+
+MECH_WORDING = [
+    ("luzi-3chain", {"tool_offset": [1, 2]},
+     "tool_offset: must be a list of 3 lengths (mm or with units) or 'centroid'; got [1, 2]"),
+    ("luzi-3chain", {"strok": [1, 2], "stroke": None},
+     "strok: must be a known key (did you mean 'stroke'? known keys: base_points, family, "),
+    ("luzi-3chain", {"family": None}, "family: must be given (one of 'psu6', 'ups6', 'luzi3'); "
+                                      "got nothing"),
+    ("luzi-3chain", {"family": "luzi"}, "family: must be one of 'psu6', 'ups6', 'luzi3'; "
+                                        "got 'luzi'"),
+    ("hopkins-williams-6psu", {"name": [1]}, "name: must be text; got [1]"),
+    ("hopkins-williams-6psu", {"generator": {"pairing": "x"}},
+     "generator.pairing: must be 'same' or 'crossed'; got 'x'"),
+    ("hopkins-williams-6psu", {"generator": {"phi": 1}},
+     "generator.phi: must be a known key (known keys: base_pair_angle, base_pair_separation, "),
+]
+
+
+@pytest.mark.parametrize("name, change, message", MECH_WORDING,
+                         ids=[m.split(":")[0] for _, _, m in MECH_WORDING])
+def test_mechanism_errors_name_the_key_the_user_wrote(name, change, message):
+    d = spec(name)
+    for k, v in change.items():
+        if isinstance(v, dict):
+            d[k].update(v)
+        elif v is None:
+            d.pop(k)
+        else:
+            d[k] = v
+    with pytest.raises(ParameterError) as info:
+        pkmlab.load_mechanism(d)
+    assert str(info.value).startswith(message), str(info.value)
+    assert "function-" not in str(info.value) and "Input should" not in str(info.value)
+
+
+def test_study_errors_carry_the_line_and_column(tmp_path):
+    f = tmp_path / "s.yaml"
+    f.write_text(f"study: s\nmechanism: {{file: {MECH_DIR / 'luzi-3chain.yaml'}}}\n"
+                 "design: {upper_link: {low: 90 mm, high: 110 mm}}\nevaluate: {}\n"
+                 "objectives: []\noptimizer: {method: sobol}\n")
+    with pytest.raises(ParameterError) as info:
+        pkmlab.study.load_study(f)
+    assert info.value.field == "objectives"
+    assert str(info.value) == ("objectives (s.yaml, line 5, column 1): must be a list of at "
+                               "least 1 item; got []")
+    # the same content as a mapping, not read from a file: no position
+    f.write_text((MECH_DIR / "luzi-3chain.yaml").read_text().replace("family: luzi3", "family: x"))
+    with pytest.raises(ParameterError, match=r"^family \(s\.yaml, line \d+, column 1\): must be"):
+        pkmlab.load_mechanism(f)
+    with pytest.raises(ParameterError, match=r"^family: must be one of"):
+        pkmlab.load_mechanism(yaml.safe_load(f.read_text()))

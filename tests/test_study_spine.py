@@ -334,3 +334,12 @@ def test_unexpected_errors_print_one_line_unless_debug(tmp_path):
     r = subprocess.run([sys.executable, "-c", code, "--debug", *args], capture_output=True,
                        text=True)
     assert r.returncode != 0 and "Traceback" in r.stderr and "kaput" in r.stderr
+
+
+@pytest.mark.parametrize("args", [["ik", str(HOPKINS)], ["workspace", str(HOPKINS), "--samples",
+                                                         "abc"], ["nosuch"]])
+def test_usage_errors_are_one_line_with_exit_2(args):
+    code = "import sys; from pkmlab.cli import main; sys.argv = ['pkmlab'] + sys.argv[1:]; main()"
+    r = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True)
+    assert r.returncode == 2, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and r.stderr.startswith("error: ")

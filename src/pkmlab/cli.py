@@ -19,22 +19,23 @@ import sys
 from pathlib import Path
 from typing import Annotated
 
-import click
 import numpy as np
 import typer
 from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
+from rich.text import Text
 
 from .config import load_mechanism
 from .errors import ParameterError
 from .mechanisms import Mechanism
 from .units import parse_angle, parse_length
+from .yamlio import locate_error
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="pkmlab: design-optimisation workbench for parallel manipulators.")
 out = Console()
-err = Console(stderr=True)
+err = Console(stderr=True, soft_wrap=True)  # one line per error, whatever the width
 
 POSE_KEYS = ("x", "y", "z", "theta_x", "theta_y", "theta_z")
 JSON_HELP = ("Print JSON. Pose keys: x, y, z (mm), theta_x, theta_y, theta_z (deg, Z-Y-X Euler); "
@@ -42,7 +43,9 @@ JSON_HELP = ("Print JSON. Pose keys: x, y, z (mm), theta_x, theta_y, theta_z (de
 
 
 def _fail(exc: Exception) -> None:
-    err.print(f"[bold red]error[/]: {exc}", highlight=False)
+    if isinstance(exc, ParameterError):
+        locate_error(exc)  # the line and column of its field, when it came from a file
+    err.print(Text("error", style="bold red") + Text(": " + " ".join(str(exc).split())))
     raise typer.Exit(code=2)
 
 
@@ -116,12 +119,12 @@ def inspect(mech_file: MechArg, as_json: JsonOpt = False) -> None:
     if as_json:
         _emit(data)
         return
-    out.print(f"[bold]{mech.name or mech_file.stem}[/] — family [cyan]{mech.family}[/]")
+    out.print(f"[bold]{escape(mech.name or mech_file.stem)}[/] — family [cyan]{mech.family}[/]")
     g = mech.describe()
     for key, val in g.items():
         if key.endswith("points_mm") or key in ("family", "name"):
             continue
-        out.print(f"  {key}: {val}")
+        out.print(f"  {key}: {escape(str(val))}")
     pts = [k for k in g if k.endswith("points_mm")]
     table = Table("joint", *[k.removesuffix("_mm") + " (mm)" for k in pts])
     for i in range(max(len(g[k]) for k in pts)):
@@ -226,7 +229,7 @@ def demo(folder: Annotated[Path, typer.Argument(help="Folder of mechanism YAML f
     if not files:
         _fail(ParameterError("folder", "a folder containing mechanism YAML files", str(folder)))
     for f in files:
-        out.rule(f"[bold]{f.name}")
+        out.rule(f"[bold]{escape(f.name)}")
         inspect(f)
         mech = _load(f)
         X = mech.nominal_pose + np.array([10.0, -5.0, 8.0, *np.radians([5.0, -4.0, 10.0])])
@@ -730,7 +733,7 @@ def workspaces(
     if as_json:
         _emit({"study": spec.study, "mechanism": mech.name, "workspaces": rows})
         return
-    table = Table(title=f"{spec.study}: {mech.name}")
+    table = Table(title=escape(f"{spec.study}: {mech.name}"))
     for col in ("workspace", "kind", "orientations", "volume cm³", "z range mm", "components"):
         table.add_column(col)
     for name, m in rows.items():
@@ -740,7 +743,7 @@ def workspaces(
             else f"tilt {o['tilt_deg']:g}°, torsion ±{o['torsion_deg']:g}°")
         z = "—" if m["empty"] else f"{m['z_range_mm'][0]:.1f} … {m['z_range_mm'][1]:.1f}"
         vol = "empty" if m["empty"] else f"{m['volume_cm3']:.2f} ± {m['volume_error_cm3']:.2f}"
-        table.add_row(name, m["kind"], oset, vol, z, str(m["components"]))
+        table.add_row(escape(name), m["kind"], oset, vol, z, str(m["components"]))
     out.print(table)
     out.print(f"outputs under {escape(str(out_dir / spec.study))}/<workspace>/")
 
@@ -1004,7 +1007,7 @@ def compare(
                                                     "compare_dexterous_slices.png",
                                                     "compare_level_slices.png")]})
         return
-    out.print(md)
+    out.print(md, markup=False, highlight=False)
     out.print(f"wrote {escape(str(out_dir))}/compare.md and overlaid slice plots")
 
 
@@ -1038,13 +1041,17 @@ def main() -> None:
     from .study.run import CandidateError
 
     try:
-        app(standalone_mode=False)
-    except click.exceptions.Exit as exc:
+        code = app(standalone_mode=False)      # click returns an Exit's code in this mode
+        raise SystemExit(code if isinstance(code, int) else 0)
+    except typer.Exit as exc:
         raise SystemExit(exc.exit_code) from None
-    except click.ClickException as exc:
-        exc.show()
+    except typer.TyperException as exc:           # a usage error: one line, exit 2
+        ctx = getattr(exc, "ctx", None)
+        sys.stderr.write(f"error: {exc.format_message()}"
+                         + (f" (see: {ctx.command_path} --help)" if ctx is not None
+                            else "") + "\n")
         raise SystemExit(2) from None
-    except (click.exceptions.Abort, KeyboardInterrupt):
+    except (typer.Abort, KeyboardInterrupt):
         sys.stderr.write("interrupted\n")
         raise SystemExit(130) from None
     except CandidateError as exc:

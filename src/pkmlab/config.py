@@ -13,7 +13,6 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-import yaml
 from pydantic import (
     BaseModel,
     BeforeValidator,
@@ -25,9 +24,10 @@ from pydantic import (
 )
 
 from . import limits
-from .errors import ParameterError, format_value
+from .errors import ParameterError, format_value, from_validation_error
 from .mechanisms import PSU6, UPS6, Luzi3, Mechanism
 from .units import ANGLE_UNITS, LENGTH_UNITS, parse_angle, parse_length
+from .yamlio import load_yaml, remember, where
 
 __all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec", "workspace_spec", "WorkspaceSpec",
            "load_workspace_study", "WorkspaceStudySpec", "to_display", "read_yaml",
@@ -244,33 +244,10 @@ _ADAPTER = TypeAdapter(MechanismSpec)
 _GENERATOR_FIELDS = set(PairedCircles.model_fields) | set(Luzi3Generator.model_fields) | {"phi"}
 
 
-def _loc(loc: tuple) -> str:
-    parts = [str(p) for p in loc if p not in ("psu6", "ups6", "luzi3")]
-    out = ""
-    for p in parts:
-        out += f"[{p}]" if p.isdigit() else (f".{p}" if out else p)
-    return out or "(top level)"
-
-
 def _translate(exc: ValidationError, prefix: str = "") -> ParameterError:
-    err = exc.errors()[0]
-    field = prefix + _loc(err["loc"])
-    kind, msg, got = err["type"], err["msg"], err.get("input")
-    if kind == "value_error":
-        text = msg.removeprefix("Value error, ")
-        allowed, _, given = text.removeprefix("must be ").partition("; got ")
-        return ParameterError(field, allowed, _Shown(given) if given else got)
-    if kind == "missing":
-        return ParameterError(field, "given (required)", None)
-    if kind == "extra_forbidden":
-        return ParameterError(field, "a known key (unknown keys are not allowed)",
-                              field.rsplit(".", 1)[-1])
-    if kind in ("union_tag_invalid", "union_tag_not_found"):
-        return ParameterError(prefix + "family", "one of ['luzi3', 'psu6', 'ups6']",
-                              err.get("ctx", {}).get("tag", got))
-    if kind == "literal_error":
-        return ParameterError(field, msg.removeprefix("Input should be "), got)
-    return ParameterError(field, msg, got)
+    """Pydantic's errors → ``<field> (<file>, line, column): must be …; got …``."""
+    root = globals().get(exc.title, MechanismSpec)  # a model's name, or the mechanism union
+    return from_validation_error(exc, root, prefix, where)
 
 
 # ---- workspace requests ------------------------------------------------------------------------
@@ -411,10 +388,7 @@ class WorkspaceStudySpec(_Model):
 def _read_yaml(path: Path, what: str) -> Any:
     if not path.is_file():
         raise ParameterError("path", f"an existing {what} YAML file", str(path))
-    try:
-        return yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise ParameterError(str(path), "valid YAML", str(exc).splitlines()[0]) from None
+    return remember(*load_yaml(path))  # bounded, positions kept for the caller's errors
 
 
 def load_workspace_study(source: str | Path):
@@ -534,9 +508,9 @@ def to_display(model: BaseModel) -> dict:
     return out
 
 
-def read_yaml(path: Path, what: str) -> Any:
-    """The YAML file ``path`` (a ``what`` file), parsed; errors as :class:`ParameterError`."""
-    return _read_yaml(path, what)
+#: ``read_yaml(path, what)``: the YAML file ``path`` (a ``what`` file), parsed and bounded;
+#: while the calling function runs, errors on its values can name their line and column.
+read_yaml = _read_yaml
 
 
 def validate_model(model: type[BaseModel], data: Any, prefix: str = ""):
@@ -545,4 +519,4 @@ def validate_model(model: type[BaseModel], data: Any, prefix: str = ""):
     try:
         return model.model_validate(data)
     except ValidationError as exc:
-        raise _translate(exc, prefix) from None
+        raise from_validation_error(exc, model, prefix, where) from None

@@ -290,11 +290,12 @@ def study_from_mapping(data: Any, base: Path | None = None,
             raise ParameterError("mechanism.file", "a mechanism YAML mapping", src.file)
     else:
         mech_data = dict(src.inline)
-    mech_spec = mechanism_spec(_merge(mech_data, src.overrides), prefix="mechanism.")
     try:
+        mech_spec = mechanism_spec(_merge(mech_data, src.overrides))
         mech_spec.build()
-    except ParameterError as exc:
-        raise ParameterError(f"mechanism.{exc.field}", exc.allowed, exc.got) from None
+    except ParameterError as exc:     # keeps the position in the file the value came from
+        raise ParameterError(f"mechanism.{exc.field}", exc.allowed, exc.got,
+                             where=exc.where) from None
     family = mech_spec.family
     variables = tuple(_variable(n, v, family, mech_spec) for n, v in spec.design.items())
     names = {v.name for v in variables}
