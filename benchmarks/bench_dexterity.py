@@ -42,7 +42,7 @@ def main() -> None:
     t = time.perf_counter()
     cl = dx.characteristic_length(mech)
     t_cl = time.perf_counter() - t
-    r_mean = dx.default_length(mech)
+    r_mean = dx.joint_radius(mech)
     k_mean = dx.condition_number(mech.jacobian(mech.nominal_pose), r_mean)[0]
     print(f"Angeles characteristic length L = {cl.length:.4f} mm, κ(nominal) = {cl.kappa:.5f} "
           f"({t_cl * 1e3:.1f} ms)")

@@ -92,7 +92,7 @@ def test_condition_number_matches_independent_computation(family):
     mech = THREE[family]
     X = random_valid_poses(mech, 50, seed=11)
     J = mech.jacobian(X)
-    L = dx.default_length(mech)
+    L = dx.joint_radius(mech)
     Jh = dx.homogenised_jacobian(J, L)
     np.testing.assert_array_equal(Jh[..., :3], J[..., :3])
     np.testing.assert_allclose(Jh[..., 3:] * L, J[..., 3:], rtol=1e-15)
@@ -139,7 +139,7 @@ def test_kappa_invariant_to_base_rotation_about_z(deg):
     J, J2 = PSU.jacobian(X), rot.jacobian(X2)
     # Twists rotate with the frame: J2 = J · blockdiag(Qᵀ, Qᵀ); κ must not change.
     np.testing.assert_allclose(J2[..., :3], J[..., :3] @ Q.T, atol=1e-9)
-    for L in (30.0, dx.default_length(PSU)):
+    for L in (30.0, dx.joint_radius(PSU)):
         np.testing.assert_allclose(dx.condition_number(J2, L), dx.condition_number(J, L),
                                    rtol=1e-9)
     np.testing.assert_allclose(dx.manipulability(J2), dx.manipulability(J), rtol=1e-9)
@@ -155,7 +155,7 @@ def test_characteristic_length_minimises_kappa(family):
     assert (L, kappa) == (res.length, res.kappa)
     J = mech.jacobian(mech.nominal_pose)
     np.testing.assert_allclose(dx.condition_number(J, res.length)[0], res.kappa, rtol=1e-12)
-    r = dx.default_length(mech)
+    r = dx.joint_radius(mech)
     kap = np.array([dx.condition_number(J, L)[0] for L in r * np.logspace(-3, 3, 601)])
     assert res.kappa <= kap.min() * (1 + 1e-9)
     for f in (0.99, 1.01):
