@@ -58,6 +58,7 @@ from .singularity import (
     singularity_flags,
 )
 from .stiffness import Stiffness, stiffness
+from .worst import WorstCase, worst_case
 
 __all__ = [
     "SINGULAR_RTOL", "KAPPA_SINGULAR", "jacobian_ok", "is_singular", "homogenised_jacobian",
@@ -71,5 +72,5 @@ __all__ = [
     "Stiffness", "stiffness",
     "GCIResult", "KappaGrid", "KappaStatistics", "WellConditionedVolume", "kappa_grid",
     "gci_grid", "gci_monte_carlo", "sample_orientations", "kappa_statistics",
-    "well_conditioned_volume",
+    "well_conditioned_volume", "WorstCase", "worst_case",
 ]
