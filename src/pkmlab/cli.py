@@ -899,13 +899,17 @@ def compare(
         help="a study's pareto.csv: compare its rows (with --rows)")] = None,
     rows: Annotated[str | None, typer.Option(help='Pareto ranks, e.g. "1,3"')] = None,
     box: Annotated[float, typer.Option(help="dexterous set: ±box° simultaneous")] = 15.0,
+    samples: SamplesOpt = 7,
     resolution: ResolutionOpt = "2.5",
     out_dir: Annotated[Path, typer.Option("--out", help="output folder")]
     = Path("results/compare"),
     as_json: JsonOpt = False,
 ) -> None:
     """Compare designs side by side: volumes, inscribed shapes, GCI, κ, force, footprint,
-    stroke use on the paper's motion; writes compare.md and overlaid slice plots."""
+    stroke use on the paper's motion; writes compare.md and overlaid slice plots.
+
+    Each figure is the library's, with the request of the other commands (``workspace
+    --inscribed``, ``dexterity``): see pkmlab.study.compare."""
     import csv as csv_mod
 
     from .config import load_mechanism as load_map
@@ -944,7 +948,9 @@ def compare(
         _fail(exc)
     if not (0 <= box <= 90):
         _fail(ParameterError("--box", "an angle in [0, 90] deg", box))
-    table_rows = compare_designs(designs, box_deg=box, resolution=h)
+    if not 1 <= samples <= 101:
+        _fail(ParameterError("--samples", "an integer in [1, 101]", samples))
+    table_rows = compare_designs(designs, box_deg=box, resolution=h, samples=samples)
     out_dir.mkdir(parents=True, exist_ok=True)
     md = comparison_markdown(table_rows, box)
     (out_dir / "compare.md").write_text(md)
