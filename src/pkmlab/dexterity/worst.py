@@ -325,8 +325,10 @@ def worst_case(mech, result, L: float | CharacteristicLength | None = None,
         if hit.any():
             q, m = np.argwhere(hit)[0]
             a, b = unit_pos[spatial[q, 0]], unit_pos[spatial[q, 1]]
+            e = np.degrees(matrix_to_euler(Rs[m][None])[0])
             example = (f"between positions {np.round(a, 3).tolist()} and "
-                       f"{np.round(b, 3).tolist()} mm at orientation sample {m}")
+                       f"{np.round(b, 3).tolist()} mm at orientation "
+                       f"{np.round(e, 3).tolist()} deg (Z-Y-X Euler)")
             example_poses = np.stack([_pose(a, Rs[m]), _pose(b, Rs[m])])
     opairs = _orientation_pairs(result.orientations)
     if len(opairs):
