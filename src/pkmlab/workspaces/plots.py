@@ -17,11 +17,9 @@ __all__ = ["plot_slices", "slice_figure"]
 def slice_figure(result, window: float = 152.4, spacing: float = 12.7, centre=None,
                  columns: int | None = None, values: np.ndarray | None = None,
                  cmap: str = "viridis", label: str = ""):
-    """Build the figure; ``values (nx, ny, nz)`` colours the sections (nearest voxel layer)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """Build the figure (a :class:`matplotlib.figure.Figure`, no pyplot state, no global
+    backend); ``values (nx, ny, nz)`` colours the sections (nearest voxel layer)."""
+    from matplotlib.figure import Figure
 
     levels = result.slice_levels(spacing)
     n = max(len(levels), 1)
@@ -30,8 +28,8 @@ def slice_figure(result, window: float = 152.4, spacing: float = 12.7, centre=No
     cx, cy = centre if centre is not None else result.mechanism.nominal_pose[:2]
     half = window / 2
     h = result.resolution
-    fig, axes = plt.subplots(rows, cols, figsize=(2.2 * cols, 2.2 * rows + 0.6),
-                             squeeze=False, constrained_layout=True)
+    fig = Figure(figsize=(2.2 * cols, 2.2 * rows + 0.6), layout="constrained")
+    axes = fig.subplots(rows, cols, squeeze=False)
     extent = (result.xs[0] - h / 2, result.xs[-1] + h / 2, result.ys[0] - h / 2,
               result.ys[-1] + h / 2) if len(result.xs) else (0, 1, 0, 1)
     im = None
@@ -74,10 +72,6 @@ def slice_figure(result, window: float = 152.4, spacing: float = 12.7, centre=No
 
 def plot_slices(result, path, **kw) -> Path:
     """Write the slice grid to ``path`` (PNG). An empty workspace gets a labelled blank."""
-    import matplotlib.pyplot as plt
-
-    fig = slice_figure(result, **kw)
     path = Path(path)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    slice_figure(result, **kw).savefig(path, dpi=120)
     return path
