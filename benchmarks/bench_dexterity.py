@@ -3,7 +3,10 @@
 Workspace: simultaneous dexterous, Z-Y-X Euler box ±15° with 7 × 7 × 7 orientations, 2.5 mm
 grid. Reports Angeles' characteristic length and κ at the nominal pose, the Monte-Carlo GCI
 (median time of several seeded runs after a warm-up that loads the numba kernels) with a
-breakdown by stage, and, for reference, the equal-weight grid GCI.
+breakdown by stage, and, for reference, the equal-weight grid GCI. Then the workspace worst case
+(:func:`pkmlab.dexterity.worst_case`, every voxel × orientation) on that workspace and on the
+6-UPS (Kotlarski) ±10° dexterous workspace at the 6-UPS study's grid (20 mm, 3 samples per
+angle) and with 7 samples per angle, wall and CPU time.
 
 Run: .venv/bin/python benchmarks/bench_dexterity.py
 """
@@ -42,7 +45,7 @@ def main() -> None:
     t = time.perf_counter()
     cl = dx.characteristic_length(mech)
     t_cl = time.perf_counter() - t
-    r_mean = dx.default_length(mech)
+    r_mean = dx.joint_radius(mech)
     k_mean = dx.condition_number(mech.jacobian(mech.nominal_pose), r_mean)[0]
     print(f"Angeles characteristic length L = {cl.length:.4f} mm, κ(nominal) = {cl.kappa:.5f} "
           f"({t_cl * 1e3:.1f} ms)")
@@ -81,6 +84,28 @@ def main() -> None:
     grid = dx.gci_grid(mech, res, cl.length)
     print(f"grid GCI (equal weights, {grid.samples} poses): {grid.gci:.5f} "
           f"({(time.perf_counter() - t) * 1e3:.0f} ms)")
+
+    bench_worst_case(mech, res, cl)
+    ups = pkmlab.load_mechanism(ROOT / "studies" / "mechanisms" / "gough-stewart-6ups.yaml")
+    for n in (3, 7):
+        r = workspace(ups, "dexterous", OrientationSet.box(np.radians([10.0] * 3), samples=n),
+                      resolution=20.0)
+        bench_worst_case(ups, r, dx.resolve_length(ups), runs=3)
+
+
+def bench_worst_case(mech, res, length, runs: int = 7) -> None:
+    """Median wall and CPU time of dx.worst_case after a warm-up, and its result."""
+    w = dx.worst_case(mech, res, length)                                  # warm-up
+    wall, cpu = [], []
+    for _ in range(runs):
+        t, c = time.perf_counter(), time.process_time()
+        w = dx.worst_case(mech, res, length)
+        wall.append(time.perf_counter() - t)
+        cpu.append(time.process_time() - c)
+    worst = "inf (singular)" if not np.isfinite(w.worst_kappa) else f"{w.worst_kappa:.4f}"
+    print(f"worst case, {mech.name}: κ {worst}, force {w.min_force:.2f} N; wall median "
+          f"{np.median(wall) * 1e3:.0f} ms, CPU median {np.median(cpu) * 1e3:.0f} ms "
+          f"({runs} runs)\n  {w.method}" + (f"\n  {w.reason}" if w.reason else ""))
 
 
 if __name__ == "__main__":

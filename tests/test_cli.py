@@ -32,13 +32,13 @@ def test_inspect_json(path):
     assert d["nominal_pose"]["theta_z"] == pytest.approx(math.degrees(m.nominal_pose[5]))
     assert list(d["nominal_actuators"]) == list(m.actuator_names)
     assert d["nominal_valid"] is True
-    assert d["jacobian_condition_number"] > 1
+    assert d["kappa"] > 1 and d["characteristic_length"]["status"] == "angeles"
 
 
 def test_inspect_text():
     r = runner.invoke(app, ["inspect", HOPKINS])
     assert r.exit_code == 0
-    assert "Jacobian condition number" in r.stdout and "nominal pose" in r.stdout
+    assert "κ = " in r.stdout and "homogenised with L = " in r.stdout and "nominal pose" in r.stdout
 
 
 def test_ik_json_in_mm_and_degrees():
@@ -49,6 +49,12 @@ def test_ik_json_in_mm_and_degrees():
     expect = m.inverse(np.array([5, -3, 300, *np.radians([10, -5, 20])])).q[0]
     assert [d["actuators"][f"q{i}"] for i in range(1, 7)] == pytest.approx(expect)
     assert d["valid"] is True and d["reason"] == "ok"
+    # κ of the Jacobian homogenised with the stated L (it was the unscaled condition number)
+    L = d["characteristic_length"]["length_mm"]
+    assert d["characteristic_length"]["status"] == "angeles"
+    J = m.jacobian(np.array([5, -3, 300, *np.radians([10, -5, 20])]))[0]
+    J[:, 3:] /= L
+    assert d["kappa"] == pytest.approx(np.linalg.cond(J), rel=1e-10)
 
 
 def test_ik_unreachable_is_data_not_error():

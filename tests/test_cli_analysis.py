@@ -28,9 +28,16 @@ def test_dexterity_cli_reports_independently_checkable_figures(tmp_path):
     J = mech.jacobian(mech.nominal_pose)[0]
     J[:, 3:] /= 60.0
     assert d["nominal"]["kappa"] == pytest.approx(np.linalg.cond(J), rel=1e-10)
-    assert d["nominal"]["characteristic_length_source"] == "given"
+    assert d["nominal"]["characteristic_length"]["status"] == "given"
+    assert d["characteristic_length"]["length_mm"] == 60.0
     a = d["aggregates"]
     assert a["kappa"]["min"] <= d["nominal"]["kappa"] <= a["kappa"]["max"]
+    # the worst case is over the same grid: its κ is the grid's largest, its force the map's
+    w = a["worst_case"]
+    assert w["status"] == "ok" and not w["singular"]
+    assert w["worst_kappa"] == pytest.approx(a["kappa"]["max"], rel=1e-12)
+    assert w["min_force_N"] == pytest.approx(a["force_all_directions_N"]["min"], rel=1e-9)
+    assert w["characteristic_length"]["length_mm"] == 60.0
     assert abs(a["gci_monte_carlo"] - a["gci_grid"]) < 0.05
     assert 0 < a["well_conditioned_volume_cm3"] <= a["workspace_volume_cm3"] + 1e-9
     names = {p.name for p in out.iterdir()}

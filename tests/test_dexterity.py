@@ -92,7 +92,7 @@ def test_condition_number_matches_independent_computation(family):
     mech = THREE[family]
     X = random_valid_poses(mech, 50, seed=11)
     J = mech.jacobian(X)
-    L = dx.default_length(mech)
+    L = dx.joint_radius(mech)
     Jh = dx.homogenised_jacobian(J, L)
     np.testing.assert_array_equal(Jh[..., :3], J[..., :3])
     np.testing.assert_allclose(Jh[..., 3:] * L, J[..., 3:], rtol=1e-15)
@@ -139,7 +139,7 @@ def test_kappa_invariant_to_base_rotation_about_z(deg):
     J, J2 = PSU.jacobian(X), rot.jacobian(X2)
     # Twists rotate with the frame: J2 = J · blockdiag(Qᵀ, Qᵀ); κ must not change.
     np.testing.assert_allclose(J2[..., :3], J[..., :3] @ Q.T, atol=1e-9)
-    for L in (30.0, dx.default_length(PSU)):
+    for L in (30.0, dx.joint_radius(PSU)):
         np.testing.assert_allclose(dx.condition_number(J2, L), dx.condition_number(J, L),
                                    rtol=1e-9)
     np.testing.assert_allclose(dx.manipulability(J2), dx.manipulability(J), rtol=1e-9)
@@ -155,7 +155,7 @@ def test_characteristic_length_minimises_kappa(family):
     assert (L, kappa) == (res.length, res.kappa)
     J = mech.jacobian(mech.nominal_pose)
     np.testing.assert_allclose(dx.condition_number(J, res.length)[0], res.kappa, rtol=1e-12)
-    r = dx.default_length(mech)
+    r = dx.joint_radius(mech)
     kap = np.array([dx.condition_number(J, L)[0] for L in r * np.logspace(-3, 3, 601)])
     assert res.kappa <= kap.min() * (1 + 1e-9)
     for f in (0.99, 1.01):
@@ -508,3 +508,61 @@ def test_well_conditioned_volume(psu_dexterous, psu_L):
     assert mid.well_conditioned == int(np.sum(worst <= km))
     assert mid.volume == pytest.approx(psu_dexterous.volume * np.mean(worst <= km))
     assert 0.3 < mid.fraction < 0.7
+
+
+# ---- characteristic length: statuses, no silent fallback ------------------------------------
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class _SingularEverywhere(PSU6):
+    """Hopkins geometry with two equal Jacobian columns at every pose: Angeles' length is
+    undefined (κ = inf for every L)."""
+
+    def _jacobian(self, p, R):
+        J = super()._jacobian(p, R)
+        J[..., 5] = J[..., 4]
+        return J
+
+
+def test_characteristic_length_failure_is_a_status_and_every_user_says_so():
+    mech = _SingularEverywhere(PSU.base_points, PSU.platform_points, PSU.link_length,
+                               PSU.stroke, PSU.tool_offset)
+    cl = dx.characteristic_length(mech)
+    assert cl.status == "failed" and not cl.ok and math.isnan(cl.length)
+    assert "singular" in cl.reason and cl.kappa == math.inf
+    r = dx.resolve_length(mech)
+    radius = float(np.mean(np.linalg.norm(mech.platform_points - mech.tool_offset, axis=1)))
+    assert r.status == "fallback" and r.length == pytest.approx(radius, rel=1e-12)
+    assert "Angeles' length failed" in r.reason and cl.reason in r.reason
+    d = r.as_dict()
+    assert d["length_mm"] == pytest.approx(radius) and d["kappa_at_pose"] is None
+    # the workspace κ constraint says which L it used and why (it fell back without a word)
+    res = workspace(mech, "constant", resolution=10.0,
+                    constraints=pkmlab.Constraints(kappa_max=50.0))
+    assert res.empty                                   # singular everywhere: κ = inf > 50
+    assert any("fallback" in n and "Angeles' length failed" in n for n in res.notes)
+    assert res.constraints.characteristic_length == pytest.approx(radius)
+    # aggregates and the trajectory check carry the record
+    plain = workspace(mech, "dexterous", OrientationSet.box(np.radians([5] * 3), samples=3), 10.0)
+    w = dx.worst_case(mech, plain)
+    assert w.length.status == "fallback" and w.singular and w.worst_kappa == math.inf
+    g = dx.gci_monte_carlo(mech, plain, samples=50)
+    assert g.length.status == "fallback" and g.gci == 0.0 and g.singular == g.samples
+    from pkmlab.trajectory import check_trajectory
+
+    X = np.tile(mech.nominal_pose, (3, 1))
+    rep = check_trajectory(mech, [0.0, 1.0, 2.0], X)
+    assert rep.length.status == "fallback" and not np.isfinite(rep.condition).any()
+    assert rep.summary()["characteristic_length"]["status"] == "fallback"
+
+
+def test_characteristic_length_given_and_angeles_records():
+    given = dx.resolve_length(PSU, 42.0)
+    assert given.status == "given" and given.length == 42.0 and not given.ok
+    J = PSU.jacobian(PSU.nominal_pose)
+    assert given.kappa == pytest.approx(dx.condition_number(J, 42.0)[0])
+    auto = dx.resolve_length(PSU)
+    assert auto.status == "angeles" and auto.ok and auto == dx.characteristic_length(PSU)
+    assert dx.resolve_length(PSU, auto) is auto
+    with pytest.raises(pkmlab.ParameterError):
+        dx.resolve_length(PSU, -1.0)

@@ -273,7 +273,8 @@ def test_compare_files_and_pareto_rows(tmp_path, serial_run):
     out = Path(res.output)
     write_report(out, res, records)
     r = CliRunner().invoke(app, ["compare", str(HOPKINS), "--pareto", str(out / "pareto.csv"),
-                                 "--rows", "1", "--box", "10", "--resolution", "5",
+                                 "--rows", "1", "--box", "10", "--samples", "5",
+                                 "--resolution", "5",
                                  "--out", str(tmp_path / "cmp"), "--json"])
     assert r.exit_code == 0, r.output
     d = json.loads(r.stdout)["designs"]

@@ -8,9 +8,11 @@ from dataclasses import dataclass
 
 import numpy as np
 import pytest
+from conftest import MECH_DIR
 
 import pkmlab
 from pkmlab import PSU6, ParameterError
+from pkmlab import dexterity as dx
 from pkmlab.poses import as_frames, exp_so3
 from pkmlab.trajectory import (
     PAPER_AXES,
@@ -22,7 +24,7 @@ from pkmlab.trajectory import (
     plot_actuators,
 )
 
-HOPKINS = pkmlab.load_mechanism("/work/main/studies/mechanisms/hopkins-williams-6psu.yaml")
+HOPKINS = pkmlab.load_mechanism(MECH_DIR / "hopkins-williams-6psu.yaml")
 A_MM, A_RAD = 50.8, math.radians(30.0)
 
 
@@ -290,6 +292,27 @@ def test_singular_jacobian_is_reported_not_raised():
     assert all("singular Jacobian" in s for s in rep.status[6:])
     assert np.isnan(rep.force[6:]).all() and np.isfinite(rep.force[:6]).all()
     assert rep.violations["stroke"] is None and not rep.fits
+
+
+def test_condition_is_the_dexterity_kappa_with_its_length():
+    # κ along a trajectory is pkmlab's one κ: the Jacobian homogenised with Angeles' length
+    # (it was the unscaled 2-norm condition number, mixing mm and rad columns)
+    t, X = paper_motion(HOPKINS)
+    rep = check_trajectory(HOPKINS, t, X)
+    L = dx.resolve_length(HOPKINS)
+    J = HOPKINS.jacobian(X)
+    Jh = J.copy()
+    Jh[..., 3:] /= L.length
+    np.testing.assert_allclose(rep.condition, np.linalg.cond(Jh), rtol=1e-9)
+    np.testing.assert_allclose(rep.condition, dx.condition_number(J, L), rtol=1e-12)
+    assert not np.allclose(rep.condition, np.linalg.cond(J), rtol=1e-2)
+    assert rep.length.status == "angeles" and rep.length.length == L.length
+    s = rep.summary()
+    assert s["characteristic_length"]["length_mm"] == pytest.approx(L.length)
+    assert s["kappa_max"] == pytest.approx(rep.condition.max()) and s["singular_samples"] == 0
+    given = check_trajectory(HOPKINS, t[:50], X[:50], characteristic_length=80.0)
+    assert given.length.status == "given"
+    np.testing.assert_allclose(given.condition, dx.condition_number(J[:50], 80.0), rtol=1e-12)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -305,6 +305,7 @@ def test_inscribed_box_and_cylinder_hold_on_a_fresh_sample(name, kind, h):
     box = res.inscribed_box()
     cyl = res.inscribed_cylinder()
     assert box.volume >= start.volume and box.iterations >= 1
+    assert start.status == "ok" and box.ok and cyl.ok     # verified ("not converged" may be)
     assert box.volume < res.volume and cyl.volume < res.volume
     for shape in (box, cyl):
         pts = shape.sample(4000, seed=123)          # not the seed used to verify
@@ -326,6 +327,40 @@ def test_inscribed_box_respects_extra_constraints(hopkins):
     R = np.broadcast_to(Rn[0], (len(pts), 3, 3))
     ab, ap = joint_angles(hopkins, pts, R, cons.joint_limits)
     assert np.all(ab <= math.radians(12)) and np.all(ap <= math.radians(12))
+
+
+def test_inscribed_cylinder_converges_when_a_convex_sub_problem_fails(hopkins):
+    # With 5 samples per angle Clarabel could not solve the first SCP sub-problem posed in mm;
+    # the enlargement stopped there and returned a shape 17 % smaller as if it were the
+    # largest. The 5-sample set contains the 3-sample one, so its cylinder can be no larger,
+    # and here the corner orientations (common to both) decide it: the two must agree.
+    box = OrientationSet.box(np.radians([15.0] * 3), samples=5)
+    five = workspace(hopkins, "dexterous", box, 5.0).inscribed_cylinder(samples=2000)
+    three = workspace(hopkins, "dexterous", box.with_samples(3), 5.0).inscribed_cylinder(
+        samples=2000)
+    assert five.status == three.status == "ok" and "converged" in five.reason
+    assert five.volume <= three.volume * (1 + 1e-6)
+    assert five.volume >= 0.99 * three.volume
+    assert five.as_dict()["status"] == "ok"
+
+
+def test_inscribed_shapes_that_verification_shrinks_away_are_not_results(hopkins):
+    import dataclasses
+
+    res = workspace(hopkins, "dexterous", BOX15, 5.0)
+    # the same voxels, checked against a stroke window that no pose of them satisfies
+    lo, hi = hopkins.stroke
+    other = dataclasses.replace(hopkins, stroke_window=(hi + 50.0, hi + 60.0))
+    bad = dataclasses.replace(res, mechanism=other)
+    for shape in (bad.inscribed_box(samples=500, optimise=False),
+                  bad.inscribed_cylinder(samples=500, optimise=False)):
+        assert shape.status == "failed" and not shape.ok
+        assert "verification failed at every scale" in shape.reason
+        assert shape.volume == 0.0 and shape.verified_samples == 0
+    empty = workspace(hopkins, "dexterous", OrientationSet.box(np.radians([30.0] * 3),
+                                                               samples=3), 5.0)
+    e = empty.inscribed_box()
+    assert e.status == "empty" and not e.ok and e.as_dict()["volume_cm3"] is None
 
 
 def test_refined_extremes_are_the_limit_of_finer_sampling(hopkins):

@@ -98,23 +98,33 @@ MechArg = Annotated[Path, typer.Argument(help="Mechanism YAML file.")]
 JsonOpt = Annotated[bool, typer.Option("--json", help=JSON_HELP)]
 
 
+def _kappa_text(rep: dict) -> str:
+    """One line: κ with its characteristic length and status (from a pose report)."""
+    cl = rep["characteristic_length"]
+    k = "inf (singular)" if rep["kappa"] is None else f"{rep['kappa']:.4g}"
+    return (f"κ = {k} (Jacobian homogenised with L = {cl['length_mm']:.2f} mm, "
+            f"{cl['status']})")
+
+
 @app.command()
 def inspect(mech_file: MechArg, as_json: JsonOpt = False) -> None:
-    """Geometry, nominal pose, its actuator values and the Jacobian condition number."""
+    """Geometry, nominal pose, its actuator values and κ (homogenised, Angeles' L)."""
+    from .dexterity.report import pose_report
+
     mech = _load(mech_file)
     nominal = mech.nominal_pose
-    ik = mech.inverse(nominal)
-    J = mech.jacobian(nominal)[0]
-    cond = float(np.linalg.cond(J)) if np.all(np.isfinite(J)) else None
+    rep = pose_report(mech, nominal)
     data = {
         "geometry": mech.describe(),
         "nominal_pose": _pose_json(nominal),
-        "nominal_actuators": _act_json(mech, ik.q[0]),
-        "nominal_valid": bool(ik.valid[0]),
-        "nominal_reason": str(ik.reason_text[0]),
+        "nominal_actuators": rep["actuators"],
+        "nominal_valid": rep["valid"],
+        "nominal_reason": rep["reason"],
         "actuator_limits": {n: list(map(float, lim))
                             for n, lim in zip(mech.actuator_names, mech.actuator_limits)},
-        "jacobian_condition_number": cond,
+        "kappa": rep["kappa"],
+        "singular": rep["singular"],
+        "characteristic_length": rep["characteristic_length"],
     }
     if as_json:
         _emit(data)
@@ -133,10 +143,11 @@ def inspect(mech_file: MechArg, as_json: JsonOpt = False) -> None:
     out.print(table)
     out.print(f"nominal pose: {_pose_str(nominal)}")
     out.print("nominal actuators (mm): " + ", ".join(
-        f"{n}={v:.4f}" for n, v in zip(mech.actuator_names, ik.q[0]))
-        + escape(f"  [{ik.reason_text[0]}]"))
-    out.print(f"Jacobian condition number at nominal (unscaled, mm and rad): {cond:.4g}"
-              if cond is not None else "Jacobian undefined at nominal")
+        f"{n}={v:.4f}" for n, v in zip(mech.actuator_names, mech.inverse(nominal).q[0]))
+        + escape(f"  [{rep['reason']}]"))
+    out.print(escape(f"at nominal: {_kappa_text(rep)}"), highlight=False)
+    if rep["characteristic_length"]["status"] not in ("angeles", "given"):
+        out.print(escape(f"  note: {rep['characteristic_length']['reason']}"), highlight=False)
 
 
 @app.command()
@@ -144,28 +155,26 @@ def ik(mech_file: MechArg,
        pose: Annotated[str, typer.Option(help='Tool pose "x,y,z,θx,θy,θz" in mm and deg '
                                               '(units may be given, e.g. "2 in").')],
        as_json: JsonOpt = False) -> None:
-    """Inverse kinematics: actuator values of one pose, with validity and reason."""
+    """Inverse kinematics: actuator values of one pose, with validity, reason and κ."""
+    from .dexterity.report import pose_report
+
     mech = _load(mech_file)
     X = _parse_pose(pose)
-    res = mech.inverse(X)
-    J = mech.jacobian(X)[0]
-    cond = float(np.linalg.cond(J)) if np.all(np.isfinite(J)) else None
-    legs = [str(res.reason_text[0])] if res.valid[0] else [
-        f"{n}: {s}" for n, s in zip(mech.actuator_names,
-                                    [mech_status(c) for c in res.leg_status[0]]) if s != "ok"]
-    data = {"pose": _pose_json(X), "actuators": _act_json(mech, res.q[0]),
-            "valid": bool(res.valid[0]), "reason": str(res.reason_text[0]),
-            "leg_status": {n: mech_status(c) for n, c in zip(mech.actuator_names,
-                                                              res.leg_status[0])},
-            "jacobian_condition_number": cond}
+    rep = pose_report(mech, X)
+    legs = [rep["reason"]] if rep["valid"] else [
+        f"{n}: {st}" for n, st in rep["leg_status"].items() if st != "ok"]
+    data = {"pose": _pose_json(X), "actuators": rep["actuators"], "valid": rep["valid"],
+            "reason": rep["reason"], "leg_status": rep["leg_status"], "kappa": rep["kappa"],
+            "singular": rep["singular"], "characteristic_length": rep["characteristic_length"]}
     if as_json:
         _emit(data)
         return
     out.print(f"pose: {_pose_str(X)}")
-    out.print("actuators (mm): " + ", ".join(f"{n}={v:.6f}" for n, v in
-                                            zip(mech.actuator_names, res.q[0])))
-    out.print(("[green]valid[/]" if res.valid[0] else "[red]invalid[/]") + ": "
+    out.print("actuators (mm): " + ", ".join(
+        f"{n}=" + ("none" if v is None else f"{v:.6f}") for n, v in rep["actuators"].items()))
+    out.print(("[green]valid[/]" if rep["valid"] else "[red]invalid[/]") + ": "
               + escape("; ".join(legs)))
+    out.print(escape(_kappa_text(rep)), highlight=False)
 
 
 def mech_status(code: int) -> str:
@@ -433,11 +442,6 @@ def workspace(
     _workspace_summary(res, written, as_json, extra)
 
 
-def _finite_or_none(v):
-    v = float(v)
-    return v if math.isfinite(v) else None
-
-
 @app.command()
 def dexterity(
     mech_file: MechArg,
@@ -475,15 +479,15 @@ def dexterity(
 ) -> None:
     """Conditioning, force and stiffness at the nominal pose and over a workspace.
 
-    Writes dexterity.json, <metric>_slices.png and workspace_<metric>.ply/.glb (the workspace
-    mesh coloured by the metric's worst value over the orientation set) into --out.
+    The analysis is pkmlab.dexterity.report.dexterity_report. Writes dexterity.json,
+    <metric>_slices.png and workspace_<metric>.ply/.glb (the workspace mesh coloured by the
+    metric's worst value over the orientation set) into --out.
     """
     import shutil
     import tempfile
 
-    from . import dexterity as dx
-    from .dexterity.maps import METRICS, mesh_colours, metric_map
-    from .workspaces import workspace as compute
+    from .dexterity.maps import METRICS, mesh_colours
+    from .dexterity.report import dexterity_report
     from .workspaces.plots import slice_figure
 
     mech = _load(mech_file)
@@ -491,10 +495,8 @@ def dexterity(
                          link_diameter, joint_limit, kappa_max, all_components, stroke)
     if metric not in METRICS:
         _fail(ParameterError("--metric", f"one of {list(METRICS)}", metric))
-    if characteristic_length.strip().lower() == "auto":
-        cl = dx.characteristic_length(mech)
-        L, L_source = cl.length, "Angeles (minimises κ at the nominal pose)"
-    else:
+    L = None
+    if characteristic_length.strip().lower() != "auto":
         try:
             L = parse_length(characteristic_length, "--characteristic-length")
         except ParameterError as exc:
@@ -502,7 +504,6 @@ def dexterity(
         if not L > 0:
             _fail(ParameterError("--characteristic-length", "a length > 0 mm or 'auto'",
                                  characteristic_length))
-        L_source = "given"
     for name, v, lo in (("--force-limit", force_limit, 0), ("--actuator-stiffness",
                                                               actuator_stiffness, 0),
                         ("--well-conditioned", well_conditioned, 1),
@@ -512,74 +513,27 @@ def dexterity(
     if not 10 <= gci_samples <= 10_000_000:
         _fail(ParameterError("--gci-samples", "an integer in [10, 10000000]", gci_samples))
 
-    res = compute(mech, **req)
-    mech = res.mechanism          # carries a --stroke window, if one was given
-    # nominal pose
-    X = mech.nominal_pose
-    J = mech.jacobian(X)
-    flags = dx.singularity_flags(mech, X)
-    wt, wr = dx.manipulability(J)
-    st = dx.stiffness(J, actuator_stiffness)
-    nominal = {
-        "pose": _pose_json(X),
-        "characteristic_length_mm": L, "characteristic_length_source": L_source,
-        "kappa": _finite_or_none(dx.condition_number(J, L)[0]),
-        "lci": float(dx.lci(J, L)[0]),
-        "sigma_min": _finite_or_none(dx.smallest_singular_value(J, L)[0]),
-        "manipulability_translational": _finite_or_none(wt[0]),
-        "manipulability_rotational": _finite_or_none(wr[0]),
-        "singularity": str(flags.kind[0]),
-        "force_all_directions_N": _finite_or_none(dx.max_force_all_directions(J, force_limit)[0]),
-        "moment_all_directions_Nmm": _finite_or_none(
-            dx.max_moment_all_directions(J, force_limit)[0]),
-        "stiffness_translational_min_N_per_mm": _finite_or_none(st.translational_min[0]),
-        "stiffness_rotational_min_Nmm_per_rad": _finite_or_none(st.rotational_min[0]),
-    }
-    agg: dict = {"workspace_volume_cm3": res.volume / 1e3, "empty": res.empty}
-    mmap = None
-    if not res.empty:
-        g = dx.kappa_grid(mech, res, L)
-        ks = dx.kappa_statistics(g.kappa[g.valid])
-        grid_gci = dx.gci_grid(mech, res, L)
-        mc = dx.gci_monte_carlo(mech, res, L, samples=gci_samples, seed=seed)
-        wc = dx.well_conditioned_volume(mech, res, well_conditioned, L)
-        mmap = metric_map(mech, res, metric, L, force_limit, actuator_stiffness)
-        fmap = mmap if metric == "force" else metric_map(mech, res, "force", L, force_limit)
-        agg.update({
-            "gci_grid": grid_gci.gci, "gci_monte_carlo": mc.gci,
-            "gci_monte_carlo_std_error": mc.std_error, "gci_samples": mc.samples,
-            "gci_rejected": mc.rejected,
-            "kappa": {"min": ks.min, "mean": ks.mean, "p5": ks.p5, "p50": ks.p50,
-                      "p95": ks.p95, "max": _finite_or_none(ks.max)},
-            "well_conditioned_kappa_max": well_conditioned,
-            "well_conditioned_volume_cm3": wc.volume / 1e3,
-            "well_conditioned_fraction": wc.fraction,
-            "force_all_directions_N": {
-                "min": float(fmap.values.min()), "mean": float(fmap.values.mean()),
-                "p5": float(np.percentile(fmap.values, 5)),
-                "p50": float(np.percentile(fmap.values, 50)),
-                "max": float(fmap.values.max())},
-            "force_required_N": force_required,
-            "force_capable_volume_cm3": float(np.mean(fmap.values >= force_required))
-            * res.volume / 1e3,
-        })
+    try:
+        rep = dexterity_report(mech, req, L=L, metric=metric,
+                               well_conditioned=well_conditioned, force_limit=force_limit,
+                               force_required=force_required,
+                               actuator_stiffness=actuator_stiffness, gci_samples=gci_samples,
+                               seed=seed)
+    except ParameterError as exc:
+        _fail(exc)
+    res, mmap, report = rep.result, rep.map, rep.data
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
     with tempfile.TemporaryDirectory(dir=out_dir, prefix=".partial-") as tmp:
         tmp = Path(tmp)
-        report = {"mechanism": mech.name, "workspace": res.metrics(), "nominal": nominal,
-                  "aggregates": agg, "metric": metric}
         files = [tmp / "dexterity.json"]
         files[0].write_text(json.dumps(report, indent=2, default=float) + "\n")
         if mmap is not None:
-            import matplotlib.pyplot as plt
-
             vals = np.where(np.isfinite(mmap.grid), mmap.grid, np.nan)
             fig = slice_figure(res, window=spec.slice_window, spacing=spec.slice_spacing,
                                values=vals, label=mmap.label)
             files.append(tmp / f"{metric}_slices.png")
             fig.savefig(files[-1], dpi=120)
-            plt.close(fig)
             m = res.mesh()
             m.visual.vertex_colors = mesh_colours(m, mmap)
             for fmt in ("ply", "glb"):
@@ -592,24 +546,45 @@ def dexterity(
         report["files"] = [str(p) for p in written]
         _emit(report)
         return
-    n = nominal
+    _print_dexterity(rep, force_limit, well_conditioned, force_required, written)
+
+
+def _print_dexterity(rep, force_limit, well_conditioned, force_required, written) -> None:
+    """Text output of ``dexterity`` (everything printed is in ``rep.data``)."""
+    def g(v, fmt):
+        return "—" if v is None else format(v, fmt)
+
+    d, mech = rep.data, rep.mechanism
+    n, agg, cl = d["nominal"], d["aggregates"], d["characteristic_length"]
     out.print(f"[bold]{escape(mech.name or mech.family)}[/] at the nominal pose "
-              f"{_pose_str(X)}:")
-    out.print(f"  κ = {n['kappa']:.4g} (L = {L:.2f} mm, {L_source}), LCI = {n['lci']:.4f}, "
-              f"σ_min = {n['sigma_min']:.4g}; singularity: {n['singularity']}")
-    out.print(f"  force in every direction {n['force_all_directions_N']:.1f} N, moment "
-              f"{n['moment_all_directions_Nmm'] / 1e3:.2f} N·m (actuators ±{force_limit:g} N); "
-              f"stiffness ≥ {n['stiffness_translational_min_N_per_mm']:.0f} N/mm")
-    if res.empty:
+              f"{_pose_str(mech.nominal_pose)}:")
+    out.print(escape(f"  {_kappa_text(n)}, LCI = {n['lci']:.4f}, σ_min = "
+                     f"{g(n['sigma_min'], '.4g')}; singularity: {n['singularity']}"),
+              highlight=False)
+    if cl["status"] not in ("angeles", "given"):
+        out.print(escape(f"  note: {cl['reason']}"), highlight=False)
+    moment = n["moment_all_directions_Nmm"]
+    out.print(f"  force in every direction {g(n['force_all_directions_N'], '.1f')} N, moment "
+              f"{g(None if moment is None else moment / 1e3, '.2f')} "
+              f"N·m (actuators ±{force_limit:g} N); stiffness ≥ "
+              f"{g(n['stiffness_translational_min_N_per_mm'], '.0f')} N/mm")
+    if agg["empty"]:
         out.print("  workspace: [bold]empty[/] — no aggregates")
     else:
-        k = agg["kappa"]
-        out.print(f"  over the {res.kind} workspace ({agg['workspace_volume_cm3']:.2f} cm³): "
-                  f"GCI {agg['gci_monte_carlo']:.4f} ± {agg['gci_monte_carlo_std_error']:.4f} "
-                  f"(Monte-Carlo, {agg['gci_samples']} samples), {agg['gci_grid']:.4f} (grid)")
-        out.print(f"  κ min {k['min']:.3g}, mean {k['mean']:.3g}, p95 {k['p95']:.3g}, max "
-                  f"{k['max'] if k['max'] is None else format(k['max'], '.3g')}; κ ≤ "
-                  f"{well_conditioned:g} in {agg['well_conditioned_volume_cm3']:.2f} cm³ "
+        k, w = agg["kappa"], agg["worst_case"]
+        out.print(f"  over the {rep.result.kind} workspace ({agg['workspace_volume_cm3']:.2f} "
+                  f"cm³): GCI {g(agg['gci_grid'], '.4f')} (every voxel × orientation), "
+                  f"{g(agg['gci_monte_carlo'], '.4f')} ± "
+                  f"{g(agg['gci_monte_carlo_std_error'], '.4f')} (Monte-Carlo, "
+                  f"{agg['gci_samples']} samples)")
+        worst = "inf" if w["worst_kappa"] is None else f"{w['worst_kappa']:.4g}"
+        out.print(f"  worst case over every voxel × orientation: κ {worst}, force "
+                  f"{g(w['min_force_N'], '.1f')} N"
+                  + ("" if not w["singular"] else escape(f" — singular: {w['reason']}")),
+                  highlight=False)
+        out.print(f"  κ min {g(k['min'], '.3g')}, mean {g(k['mean'], '.3g')}, p95 "
+                  f"{g(k['p95'], '.3g')}; κ ≤ {well_conditioned:g} in "
+                  f"{agg['well_conditioned_volume_cm3']:.2f} cm³ "
                   f"({100 * agg['well_conditioned_fraction']:.1f} %)")
         f = agg["force_all_directions_N"]
         out.print(f"  force held in every direction: min {f['min']:.1f} N, median "
@@ -954,13 +929,17 @@ def compare(
         help="a study's pareto.csv: compare its rows (with --rows)")] = None,
     rows: Annotated[str | None, typer.Option(help='Pareto ranks, e.g. "1,3"')] = None,
     box: Annotated[float, typer.Option(help="dexterous set: ±box° simultaneous")] = 15.0,
+    samples: SamplesOpt = 7,
     resolution: ResolutionOpt = "2.5",
     out_dir: Annotated[Path, typer.Option("--out", help="output folder")]
     = Path("results/compare"),
     as_json: JsonOpt = False,
 ) -> None:
     """Compare designs side by side: volumes, inscribed shapes, GCI, κ, force, footprint,
-    stroke use on the paper's motion; writes compare.md and overlaid slice plots."""
+    stroke use on the paper's motion; writes compare.md and overlaid slice plots.
+
+    Each figure is the library's, with the request of the other commands (``workspace
+    --inscribed``, ``dexterity``): see pkmlab.study.compare."""
     import csv as csv_mod
 
     from .study.compare import compare_designs, comparison_markdown, plot_overlaid_slices
@@ -994,7 +973,9 @@ def compare(
         _fail(exc)
     if not (0 <= box <= 90):
         _fail(ParameterError("--box", "an angle in [0, 90] deg", box))
-    table_rows = compare_designs(designs, box_deg=box, resolution=h)
+    if not 1 <= samples <= 101:
+        _fail(ParameterError("--samples", "an integer in [1, 101]", samples))
+    table_rows = compare_designs(designs, box_deg=box, resolution=h, samples=samples)
     out_dir.mkdir(parents=True, exist_ok=True)
     md = comparison_markdown(table_rows, box)
     (out_dir / "compare.md").write_text(md)

@@ -6,9 +6,11 @@ workspace-wide aggregates on a :class:`pkmlab.workspaces.WorkspaceResult`. Units
 N·mm. Numerical failure is reported through masks and status fields, never raised; invalid
 *arguments* raise :class:`pkmlab.ParameterError`.
 
-Modules: :mod:`.metrics` (pointwise Jacobian metrics, characteristic length),
-:mod:`.singularity`, :mod:`.force`, :mod:`.stiffness`, :mod:`.aggregate` (GCI, κ statistics,
-well-conditioned volume).
+Modules: :mod:`.metrics` (pointwise Jacobian metrics, the one definition of κ, "singular" and
+the default characteristic length), :mod:`.singularity`, :mod:`.force`, :mod:`.stiffness`,
+:mod:`.aggregate` (GCI, κ statistics, well-conditioned volume), :mod:`.worst` (worst κ, smallest
+force and singularities over a whole workspace grid), :mod:`.maps` (per-voxel worst-case maps),
+:mod:`.report` (the analyses behind the ``inspect``, ``ik`` and ``dexterity`` commands).
 """
 
 from .aggregate import (
@@ -32,15 +34,19 @@ from .force import (
     transpose_inverse,
 )
 from .metrics import (
+    KAPPA_SINGULAR,
+    LENGTH_STATUS,
     SINGULAR_RTOL,
     CharacteristicLength,
     characteristic_length,
     condition_number,
-    default_length,
     homogenised_jacobian,
+    is_singular,
     jacobian_ok,
+    joint_radius,
     lci,
     manipulability,
+    resolve_length,
     singular_values,
     smallest_singular_value,
 )
@@ -52,11 +58,13 @@ from .singularity import (
     singularity_flags,
 )
 from .stiffness import Stiffness, stiffness
+from .worst import WorstCase, worst_case
 
 __all__ = [
-    "SINGULAR_RTOL", "jacobian_ok", "homogenised_jacobian", "singular_values",
-    "condition_number", "lci", "smallest_singular_value", "manipulability",
-    "CharacteristicLength", "characteristic_length", "default_length",
+    "SINGULAR_RTOL", "KAPPA_SINGULAR", "jacobian_ok", "is_singular", "homogenised_jacobian",
+    "singular_values", "condition_number", "lci", "smallest_singular_value", "manipulability",
+    "CharacteristicLength", "LENGTH_STATUS", "characteristic_length", "resolve_length",
+    "joint_radius",
     "SingularityFlags", "singularity_flags", "direct_kinematic_matrix", "link_vectors",
     "as_pose_frames",
     "ForceAlong", "max_force_all_directions", "max_moment_all_directions", "force_along",
@@ -64,5 +72,5 @@ __all__ = [
     "Stiffness", "stiffness",
     "GCIResult", "KappaGrid", "KappaStatistics", "WellConditionedVolume", "kappa_grid",
     "gci_grid", "gci_monte_carlo", "sample_orientations", "kappa_statistics",
-    "well_conditioned_volume",
+    "well_conditioned_volume", "WorstCase", "worst_case",
 ]

@@ -14,10 +14,15 @@ Global conditioning index (Gosselin & Angeles 1991): ``GCI = ∫ LCI dW / ∫ dW
   (density ∝ sin θ) and uniform torsion for ``tilt-torsion`` sets, and the one orientation of a
   ``fixed`` set.
 
-:func:`gci_grid` evaluates it on voxel centres × the set's sample orientations with equal
-weights (a quadrature of that integral); :func:`gci_monte_carlo` estimates it by sampling.
-Poses whose inverse kinematics is invalid (outside the stroke, no real solution) are excluded
-and counted, never averaged as zero.
+One estimator family, two members: :func:`gci_grid` evaluates it on voxel centres × the set's
+sample orientations with equal weights (a quadrature of that integral); :func:`gci_monte_carlo`
+estimates it by sampling. In both, a singular pose (:func:`pkmlab.dexterity.is_singular`,
+κ = inf) counts with ``LCI = 0`` and is counted in ``GCIResult.singular``; poses whose inverse
+kinematics is invalid (outside the stroke, no real solution) are not part of the workspace:
+they are excluded and counted in ``rejected``, never averaged as zero.
+
+The extremes the estimators meet (``GCIResult.sampled_max_kappa``) are sample statistics; the
+worst case over the whole workspace grid is :func:`pkmlab.dexterity.worst_case`.
 """
 
 from __future__ import annotations
@@ -29,8 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..workspaces.orientations import rotations_from_parameters
-from .metrics import _as_length, condition_number, lci
+from .metrics import CharacteristicLength, condition_number, lci, resolve_length
 
 log = logging.getLogger(__name__)
 
@@ -39,14 +43,6 @@ __all__ = ["GCIResult", "KappaGrid", "KappaStatistics", "WellConditionedVolume",
            "well_conditioned_volume"]
 
 _CHUNK = 100_000
-
-
-def _length(mech, L) -> float:
-    if L is None:
-        from .metrics import characteristic_length
-
-        return float(characteristic_length(mech).length)
-    return _as_length(L)
 
 
 def _voxels(result) -> tuple[np.ndarray, np.ndarray]:
@@ -88,6 +84,7 @@ class KappaGrid:
         index: ``(V, 3)`` voxel indices into ``result.occupancy``.
         rotations: ``(M, 3, 3)`` the orientation set's sample.
         L: characteristic length used (mm).
+        length: ``L`` with its status and reason (:func:`pkmlab.dexterity.resolve_length`).
     """
 
     kappa: np.ndarray
@@ -96,9 +93,10 @@ class KappaGrid:
     index: np.ndarray
     rotations: np.ndarray
     L: float
+    length: CharacteristicLength | None = None
 
 
-def kappa_grid(mech, result, L: float | None = None) -> KappaGrid:
+def kappa_grid(mech, result, L: float | CharacteristicLength | None = None) -> KappaGrid:
     """κ(J_h) at every occupied voxel centre and every sample orientation of ``result``.
 
     For column-invariant families (the 6-PSU: the Jacobian does not depend on z at fixed x, y
@@ -108,19 +106,21 @@ def kappa_grid(mech, result, L: float | None = None) -> KappaGrid:
     Args:
         mech: the mechanism of ``result``.
         result: a :class:`pkmlab.workspaces.WorkspaceResult`.
-        L: characteristic length in mm; default Angeles' (:func:`characteristic_length`).
+        L: characteristic length in mm; default :func:`pkmlab.dexterity.resolve_length`
+            (Angeles').
 
     Returns:
         :class:`KappaGrid` (V occupied voxels × M orientations).
     """
-    L = _length(mech, L)
+    length = resolve_length(mech, L)
+    L = length.length
     idx, pos = _voxels(result)
     Rs = result.orientations.rotations()
     V, M = len(pos), len(Rs)
     kap = np.full((V, M), np.inf)
     valid = np.zeros((V, M), dtype=bool)
     if V == 0:
-        return KappaGrid(kap, valid, pos, idx, Rs, L)
+        return KappaGrid(kap, valid, pos, idx, Rs, L, length)
     if mech.column_invariant:
         cols, inv = np.unique(idx[:, :2], axis=0, return_inverse=True)
         inv = inv.ravel()
@@ -140,7 +140,7 @@ def kappa_grid(mech, result, L: float | None = None) -> KappaGrid:
     for m0, k, pv, Rv in orientation_batches(pos, Rs):
         valid[:, m0:m0 + k] = _ik_valid(mech, pv, Rv).reshape(k, V).T
     kap = np.where(valid, kap_e[inv], np.inf)
-    return KappaGrid(kap, valid, pos, idx, Rs, L)
+    return KappaGrid(kap, valid, pos, idx, Rs, L, length)
 
 
 @dataclass(frozen=True)
@@ -148,17 +148,23 @@ class GCIResult:
     """A global conditioning index estimate.
 
     Attributes:
-        gci: mean LCI over the accepted samples (NaN only when ``ok`` is False).
+        gci: mean LCI over the accepted samples, singular ones counting 0 (NaN only when
+            ``ok`` is False; ``reason`` then says why).
         std_error: standard error of the mean (Monte Carlo: sample std / √n); 0.0 for the
             deterministic grid quadrature (its error is discretisation, not sampling).
         lci_std: standard deviation of LCI over the accepted samples.
-        samples: number of poses averaged.
-        rejected: poses excluded because their inverse kinematics is invalid or their
-            Jacobian is not finite.
+        samples: number of poses averaged (singular ones included).
+        rejected: poses excluded because their inverse kinematics is invalid (not in the
+            workspace).
         method: ``'grid'`` or ``'monte-carlo'``.
         L: characteristic length used (mm).
         ok: at least one pose was accepted.
-        lci_min: smallest accepted LCI (1/lci_min is the worst κ met), NaN if none.
+        sampled_min_lci: smallest LCI among the samples (0 if one is singular), NaN if none.
+            A sample statistic: the worst case over the workspace is
+            :func:`pkmlab.dexterity.worst_case`.
+        singular: samples that are singular (κ = inf), counted with LCI 0.
+        length: ``L`` with its status and reason.
+        reason: why ``ok`` is False ("" otherwise).
     """
 
     gci: float
@@ -169,44 +175,64 @@ class GCIResult:
     method: str
     L: float
     ok: bool
-    lci_min: float = float("nan")
+    sampled_min_lci: float = float("nan")
+    singular: int = 0
+    length: CharacteristicLength | None = None
+    reason: str = ""
+
+    @property
+    def sampled_max_kappa(self) -> float:
+        """Largest κ among the samples (``inf`` if one is singular, NaN if none): a sample
+        statistic, ≤ the worst case over the workspace (:func:`pkmlab.dexterity.worst_case`)."""
+        m = self.sampled_min_lci
+        return float("nan") if not math.isfinite(m) else (math.inf if m == 0 else 1.0 / m)
+
+    @property
+    def lci_min(self) -> float:
+        """Deprecated alias of :attr:`sampled_min_lci` (kept for existing callers)."""
+        return self.sampled_min_lci
 
 
-def _summarise(values: np.ndarray, rejected: int, method: str, L: float) -> GCIResult:
+def _summarise(values: np.ndarray, rejected: int, method: str,
+               length: CharacteristicLength) -> GCIResult:
+    """``values``: the LCI of every accepted sample, 0 for singular ones."""
     n = int(values.size)
+    L = length.length
     if n == 0:
-        log.warning("GCI (%s): no valid pose to average (%d rejected)", method, rejected)
+        reason = (f"no pose of the workspace to average: all {rejected} samples have invalid "
+                  "inverse kinematics" if rejected else "the workspace is empty")
+        log.warning("GCI (%s): %s", method, reason)
         return GCIResult(float("nan"), float("nan"), float("nan"), 0, rejected, method, L,
-                         False)
+                         False, length=length, reason=reason)
     std = float(values.std(ddof=1)) if n > 1 else 0.0
     se = 0.0 if method == "grid" else (std / math.sqrt(n) if n > 1 else float("inf"))
     return GCIResult(float(values.mean()), se, std, n, rejected, method, L, True,
-                     float(values.min()))
+                     float(values.min()), int(np.sum(values == 0.0)), length)
 
 
-def gci_grid(mech, result, L: float | None = None) -> GCIResult:
+def gci_grid(mech, result, L: float | CharacteristicLength | None = None, *,
+             grid: KappaGrid | None = None) -> GCIResult:
     """GCI by equal-weight quadrature over occupied voxel centres × sample orientations.
 
     ``GCI = mean of 1/κ`` over every (voxel, orientation) pair of :func:`kappa_grid` whose
     inverse kinematics is valid (in a dexterous workspace all are; in a reachable one, only the
-    orientations reachable at the voxel count). Equal weights: every voxel has volume h³ and
-    every sample orientation stands for an equal share of the set.
+    orientations reachable at the voxel count); singular pairs count with ``1/κ = 0``. Equal
+    weights: every voxel has volume h³ and every sample orientation stands for an equal share
+    of the set.
 
     Args:
         mech: the mechanism of ``result``.
         result: a :class:`pkmlab.workspaces.WorkspaceResult`.
-        L: characteristic length in mm; default Angeles'.
+        L: characteristic length in mm; default :func:`pkmlab.dexterity.resolve_length`.
+        grid: the :func:`kappa_grid` of ``result`` if already computed (then ``L`` is its).
 
     Returns:
         :class:`GCIResult` with ``method='grid'`` and ``std_error=0``.
     """
-    g = kappa_grid(mech, result, L)
-    vals = 1.0 / g.kappa[g.valid]
-    vals = vals[np.isfinite(vals)]
-    # Singular but valid poses have κ = inf, LCI = 0: they count (with LCI 0).
-    n_sing = int(np.sum(g.valid & ~np.isfinite(g.kappa)))
-    vals = np.concatenate([vals, np.zeros(n_sing)]) if n_sing else vals
-    return _summarise(vals, int(np.sum(~g.valid)), "grid", g.L)
+    g = kappa_grid(mech, result, L) if grid is None else grid
+    vals = 1.0 / g.kappa[g.valid]                  # κ = inf (singular) → LCI 0, counted
+    length = g.length or resolve_length(mech, g.L)
+    return _summarise(vals, int(np.sum(~g.valid)), "grid", length)
 
 
 def sample_orientations(oset, n: int, rng: np.random.Generator) -> np.ndarray:
@@ -231,12 +257,12 @@ def sample_orientations(oset, n: int, rng: np.random.Generator) -> np.ndarray:
             if h.sum() > 0:
                 axis = rng.choice(3, size=n, p=h / h.sum())
                 P[np.arange(n), axis] = rng.uniform(-1.0, 1.0, n) * h[axis]
-        return rotations_from_parameters(oset, P)
+        return oset.rotations_at(P)
     beta, gamma = oset.tilt, oset.torsion
     phi = rng.uniform(0.0, 2.0 * np.pi, n)
     theta = np.arccos(1.0 - rng.uniform(0.0, 1.0, n) * (1.0 - math.cos(beta)))
     sigma = rng.uniform(-gamma, gamma, n) if gamma > 0 else np.zeros(n)
-    return rotations_from_parameters(oset, np.stack([phi, theta, sigma], axis=1))
+    return oset.rotations_at(np.stack([phi, theta, sigma], axis=1))
 
 
 def sample_poses(result, samples: int, rng: np.random.Generator):
@@ -254,40 +280,38 @@ def sample_poses(result, samples: int, rng: np.random.Generator):
     return p, sample_orientations(result.orientations, samples, rng)
 
 
-def gci_monte_carlo(mech, result, L: float | None = None, samples: int = 2000,
-                    seed: int | None = 0) -> GCIResult:
+def gci_monte_carlo(mech, result, L: float | CharacteristicLength | None = None,
+                    samples: int = 2000, seed: int | None = 0) -> GCIResult:
     """GCI by Monte Carlo over the workspace volume × orientation set.
 
     Positions: an occupied voxel chosen uniformly (all have volume h³), then a point uniform
     within it. Orientations: :func:`sample_orientations`. Samples whose inverse kinematics is
     invalid (a boundary voxel only partly inside, or an orientation between the set's samples
-    that the dexterous check did not cover) or whose Jacobian is not finite are rejected and
-    counted in ``rejected``; the estimate is the mean LCI of the rest.
+    that the dexterous check did not cover) are not in the workspace: they are rejected and
+    counted in ``rejected``. Every other sample counts, a singular one (κ = inf, including a
+    Jacobian that is not finite at a serial singularity) with LCI 0; the estimate is the mean.
 
     Args:
         mech: the mechanism of ``result``.
         result: a :class:`pkmlab.workspaces.WorkspaceResult`.
-        L: characteristic length in mm; default Angeles'.
+        L: characteristic length in mm; default :func:`pkmlab.dexterity.resolve_length`.
         samples: number of poses drawn (≥ 1).
         seed: seed of ``numpy.random.default_rng``.
 
     Returns:
         :class:`GCIResult` with ``method='monte-carlo'``.
     """
-    L = _length(mech, L)
+    length = resolve_length(mech, L)
     samples = int(samples)
     if samples < 1:
         raise ParameterError("samples", "an integer >= 1", samples)
     rng = np.random.default_rng(seed)
     if not result.occupancy.any():
-        return _summarise(np.empty(0), samples, "monte-carlo", L)
+        return _summarise(np.empty(0), 0, "monte-carlo", length)
     p, R = sample_poses(result, samples, rng)
     valid = _ik_valid(mech, p, R)
-    J = mech.jacobian((p[valid], R[valid]))
-    vals = lci(J, L)
-    finite_J = np.all(np.isfinite(J), axis=(1, 2))
-    vals = vals[finite_J]
-    return _summarise(vals, samples - len(vals), "monte-carlo", L)
+    vals = lci(mech.jacobian((p[valid], R[valid])), length.length)
+    return _summarise(vals, samples - len(vals), "monte-carlo", length)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -347,6 +371,7 @@ class WellConditionedVolume:
         worst_kappa: ``(V,)`` worst κ per occupied voxel (inf where an orientation of the set is
             not reachable there or is singular).
         kappa_max, L: the bound and the characteristic length (mm) used.
+        length: ``L`` with its status and reason.
     """
 
     volume: float
@@ -356,10 +381,12 @@ class WellConditionedVolume:
     worst_kappa: np.ndarray
     kappa_max: float
     L: float
+    length: CharacteristicLength | None = None
 
 
 def well_conditioned_volume(mech, result, kappa_max: float,
-                            L: float | None = None) -> WellConditionedVolume:
+                            L: float | CharacteristicLength | None = None, *,
+                            grid: KappaGrid | None = None) -> WellConditionedVolume:
     """Volume (mm³) of the occupied voxels whose worst κ over the orientation set ≤ κ_max.
 
     A voxel passes when *every* sample orientation is reachable there (valid inverse
@@ -371,16 +398,17 @@ def well_conditioned_volume(mech, result, kappa_max: float,
         mech: the mechanism of ``result``.
         result: a :class:`pkmlab.workspaces.WorkspaceResult`.
         kappa_max: bound on κ (≥ 1).
-        L: characteristic length in mm; default Angeles'.
+        L: characteristic length in mm; default :func:`pkmlab.dexterity.resolve_length`.
+        grid: the :func:`kappa_grid` of ``result`` if already computed (then ``L`` is its).
     """
     km = float(kappa_max)
     if not (km >= 1):
         raise ParameterError("kappa_max", "a number >= 1", kappa_max)
-    g = kappa_grid(mech, result, L)
+    g = kappa_grid(mech, result, L) if grid is None else grid
     worst = g.kappa.max(axis=1) if g.kappa.shape[1] else np.full(len(g.kappa), np.inf)
     V = len(worst)
     n_ok = int(np.sum(worst <= km))
     frac = n_ok / V if V else 0.0
     return WellConditionedVolume(volume=frac * float(result.volume), fraction=frac, voxels=V,
                                  well_conditioned=n_ok, worst_kappa=worst, kappa_max=km,
-                                 L=g.L)
+                                 L=g.L, length=g.length)

@@ -24,7 +24,10 @@ For a square, invertible ``J`` the actuator forces are unique, ``f = G w`` with 
 number of actuators m ≥ 6); the closed form is its exact square-case solution.
 
 Every function takes a stack ``(N, 6, 6)`` (a single ``(6, 6)`` counts as N = 1) and returns
-per-pose arrays of length N.
+per-pose arrays of length N. "Singular" is pkmlab's one rule
+(:func:`pkmlab.dexterity.is_singular`) applied with the characteristic length ``L`` the caller
+passes (``None``: ``J`` as given, i.e. ``L = 1 mm``); a singular pose holds no force in some
+direction and is reported as 0 N.
 """
 
 from __future__ import annotations
@@ -35,8 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ._linalg import singular_values
-from .metrics import SINGULAR_RTOL
+from .metrics import is_singular
 
 log = logging.getLogger(__name__)
 
@@ -87,21 +89,22 @@ def _payload(payload, n: int) -> np.ndarray:
     return np.broadcast_to(w, (n, 6)).copy()
 
 
-def transpose_inverse(J: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def transpose_inverse(J: np.ndarray, L: float | None = None
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``G = J⁻ᵀ`` for a stack of square Jacobians, with masks.
 
     Args:
         J: ``(N, 6, 6)`` twist-to-joint Jacobians.
+        L: characteristic length (mm) of the singular rule; ``None``: ``J`` as given.
 
     Returns:
         ``(G, finite, singular)``: ``G (N, 6, 6)`` (NaN where not computed), ``finite (N,)``
-        every entry of ``J`` finite, ``singular (N,)`` finite but σmin ≤ 1e-12·σmax.
+        every entry of ``J`` finite, ``singular (N,)`` finite but singular by
+        :func:`pkmlab.dexterity.is_singular`.
     """
     J = _jac(J)
     finite = np.all(np.isfinite(J), axis=(1, 2))
-    singular = np.zeros(len(J), dtype=bool)
-    s = singular_values(J[finite])
-    singular[finite] = s[:, -1] <= SINGULAR_RTOL * s[:, 0]
+    singular = finite & is_singular(J, L)
     G = np.full(J.shape, np.nan)
     good = finite & ~singular
     if np.any(good):
@@ -109,8 +112,8 @@ def transpose_inverse(J: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
     return G, finite, singular
 
 
-def _isotropic(J, f_max, cols: slice) -> np.ndarray:
-    G, finite, singular = transpose_inverse(J)
+def _isotropic(J, f_max, cols: slice, L) -> np.ndarray:
+    G, finite, singular = transpose_inverse(J, L)
     f = _fmax(f_max, 6)
     norm = np.linalg.norm(G[:, :, cols], axis=-1)                      # (N, 6)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -119,7 +122,7 @@ def _isotropic(J, f_max, cols: slice) -> np.ndarray:
     return np.where(finite, cap, np.nan)
 
 
-def max_force_all_directions(J: np.ndarray, f_max) -> np.ndarray:
+def max_force_all_directions(J: np.ndarray, f_max, L: float | None = None) -> np.ndarray:
     """Largest force magnitude (N) that can be held in *every* direction with zero moment.
 
     ``F_iso = min_i f_max_i / ‖(J⁻ᵀ)_{i,0:3}‖`` (exact for a square invertible J; see the
@@ -128,22 +131,23 @@ def max_force_all_directions(J: np.ndarray, f_max) -> np.ndarray:
     Args:
         J: ``(6, 6)`` or ``(N, 6, 6)`` twist-to-joint Jacobian.
         f_max: actuator force limit(s) in N, scalar or ``(6,)``.
+        L: characteristic length (mm) of the singular rule; ``None``: ``J`` as given.
 
     Returns:
-        ``(N,)`` force in N; 0 where J is numerically singular (a parallel singularity leaves
-        some wrench unbalanced — reported conservatively as no capability); NaN exactly where
-        J has a non-finite entry.
+        ``(N,)`` force in N; 0 where J is singular (a parallel singularity leaves some wrench
+        unbalanced — reported conservatively as no capability); NaN exactly where J has a
+        non-finite entry.
     """
-    return _isotropic(J, f_max, slice(0, 3))
+    return _isotropic(J, f_max, slice(0, 3), L)
 
 
-def max_moment_all_directions(J: np.ndarray, f_max) -> np.ndarray:
+def max_moment_all_directions(J: np.ndarray, f_max, L: float | None = None) -> np.ndarray:
     """Largest moment magnitude (N·mm) that can be held about every axis with zero force.
 
     ``M_iso = min_i f_max_i / ‖(J⁻ᵀ)_{i,3:6}‖``; conventions as
     :func:`max_force_all_directions`.
     """
-    return _isotropic(J, f_max, slice(3, 6))
+    return _isotropic(J, f_max, slice(3, 6), L)
 
 
 @dataclass(frozen=True)
@@ -155,8 +159,9 @@ class ForceAlong:
             ``|f_i| ≤ f_max_i``; NaN exactly where ``ok`` is False.
         actuator_forces: ``(N, m)`` actuator forces (N) at that optimum; NaN where not ok.
         status: ``'optimal'``; ``'infeasible'`` (the payload alone cannot be held);
-            ``'undefined'`` (non-finite J); ``'singular'`` (closed form only: J numerically
-            singular — use :func:`force_along`); otherwise the solver's status string
+            ``'undefined'`` (non-finite J); ``'singular'`` (closed form only: J singular by
+            :func:`pkmlab.dexterity.is_singular` — use :func:`force_along`); otherwise the
+            solver's status string
             (``'optimal_inaccurate'``, ``'solver_error'``, ...).
         ok: ``status == 'optimal'``.
     """
@@ -167,7 +172,8 @@ class ForceAlong:
     ok: np.ndarray
 
 
-def force_along_closed_form(J: np.ndarray, f_max, direction, payload=None) -> ForceAlong:
+def force_along_closed_form(J: np.ndarray, f_max, direction, payload=None,
+                            L: float | None = None) -> ForceAlong:
     """Largest force along ``direction`` for square, invertible Jacobians (vectorised).
 
     With ``G = J⁻ᵀ``, ``g = G[:, :3] u`` and ``f_p = G w_p``, actuator i requires
@@ -181,6 +187,7 @@ def force_along_closed_form(J: np.ndarray, f_max, direction, payload=None) -> Fo
         payload: optional wrench ``(6,)`` or ``(N, 6)`` ``[F (N); M (N·mm)]`` the actuators
             must exert at the same time (e.g. ``[0, 0, m·g, 0, 0, 0]`` to carry a weight
             ``m·g`` acting at the tool point).
+        L: characteristic length (mm) of the singular rule; ``None``: ``J`` as given.
 
     Returns:
         :class:`ForceAlong`.
@@ -190,7 +197,7 @@ def force_along_closed_form(J: np.ndarray, f_max, direction, payload=None) -> Fo
     f = _fmax(f_max, 6)
     u = _directions(direction, n)
     wp = _payload(payload, n)
-    G, finite, singular = transpose_inverse(J)
+    G, finite, singular = transpose_inverse(J, L)
     g = np.einsum("nij,nj->ni", G[:, :, :3], u)                      # (N, 6)
     fp = np.einsum("nij,nj->ni", G, wp)
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -3,7 +3,10 @@
 A map reduces a metric over the orientation set at every occupied voxel to its worst case
 (the value a designer can count on at that position): the largest κ, the smallest LCI, the
 smallest isotropic force capability, the smallest translational stiffness eigenvalue.
-Unreachable (voxel, orientation) pairs count as the worst possible value.
+Unreachable (voxel, orientation) pairs count as the worst possible value. κ, "singular" and
+the default characteristic length are those of :mod:`pkmlab.dexterity.metrics`; the extreme of
+a map over the whole workspace, with singularities between samples, is
+:func:`pkmlab.dexterity.worst_case`.
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ import numpy as np
 from ..errors import ParameterError
 from .aggregate import _ik_valid, _voxels, orientation_batches
 from .force import max_force_all_directions
-from .metrics import condition_number
+from .metrics import CharacteristicLength, condition_number, resolve_length
 from .stiffness import stiffness
 
 __all__ = ["METRICS", "MetricMap", "metric_map", "mesh_colours"]
@@ -39,6 +42,8 @@ class MetricMap:
         index: ``(V, 3)`` voxel indices into the workspace grid.
         positions: ``(V, 3)`` voxel centres (mm).
         grid: ``(nx, ny, nz)`` values on the workspace grid, NaN outside.
+        length: the characteristic length used (κ, LCI, and the singular rule of the force),
+            with its status and reason.
     """
 
     metric: str
@@ -46,6 +51,7 @@ class MetricMap:
     index: np.ndarray
     positions: np.ndarray
     grid: np.ndarray
+    length: CharacteristicLength | None = None
 
     @property
     def label(self) -> str:
@@ -53,19 +59,23 @@ class MetricMap:
         return f"{name} ({unit})" if unit else name
 
 
-def metric_map(mech, result, metric: str = "kappa", L: float = 1.0, f_max=150.0,
+def metric_map(mech, result, metric: str = "kappa",
+               L: float | CharacteristicLength | None = None, f_max=150.0,
                k=1.0e4) -> MetricMap:
     """Worst-case ``metric`` over ``result``'s orientation set at every occupied voxel.
 
     Args:
         mech, result: the mechanism and its :class:`~pkmlab.WorkspaceResult`.
         metric: ``"kappa"``, ``"lci"``, ``"force"`` or ``"stiffness"``.
-        L: characteristic length (mm) for κ and LCI.
+        L: characteristic length (mm) for κ, LCI and the singular rule; default
+            :func:`pkmlab.dexterity.resolve_length` (Angeles').
         f_max: actuator force limit(s) in N for ``"force"``.
         k: actuator stiffness(es) in N/mm for ``"stiffness"``.
     """
     if metric not in METRICS:
         raise ParameterError("metric", f"one of {list(METRICS)}", metric)
+    length = resolve_length(mech, L)
+    L = length.length
     idx, pos = _voxels(result)
     R = result.orientations.rotations()
     V = len(pos)
@@ -80,7 +90,7 @@ def metric_map(mech, result, metric: str = "kappa", L: float = 1.0, f_max=150.0,
             if metric == "lci":
                 val = 1.0 / val
         elif metric == "force":
-            val = np.where(valid, np.nan_to_num(max_force_all_directions(J, f_max)), 0.0)
+            val = np.where(valid, np.nan_to_num(max_force_all_directions(J, f_max, L)), 0.0)
         else:
             ok = np.all(np.isfinite(J), axis=(1, 2))
             val = np.zeros(len(J))
@@ -92,7 +102,7 @@ def metric_map(mech, result, metric: str = "kappa", L: float = 1.0, f_max=150.0,
             np.minimum(worst, val.min(axis=0))
     grid = np.full(result.occupancy.shape, np.nan)
     grid[idx[:, 0], idx[:, 1], idx[:, 2]] = worst
-    return MetricMap(metric, worst, idx, pos, grid)
+    return MetricMap(metric, worst, idx, pos, grid, length)
 
 
 def mesh_colours(mesh, mmap: MetricMap, vmin=None, vmax=None, cmap: str = "viridis"):

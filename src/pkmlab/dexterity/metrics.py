@@ -12,11 +12,27 @@ Conventions (all of :mod:`pkmlab.dexterity`):
   :func:`jacobian_ok`. Where a result is a float array, undefined matrices give the documented
   sentinel (κ = inf, LCI = 0) or NaN exactly where ``jacobian_ok`` is False — never elsewhere.
 
-Homogenisation: with a characteristic length ``L`` (mm), ``ω' = L·ω`` has units of mm/s and
-``q̇ = J_v v + (J_ω / L) ω'``, so the homogenised Jacobian ``J_h`` divides columns 3:6 by ``L``
-(:func:`homogenised_jacobian`). Its condition number is the usual isotropy measure; Angeles'
-characteristic length (:func:`characteristic_length`) is the ``L`` that minimises it at the
-nominal pose.
+Definitions used everywhere in pkmlab (there is no second copy anywhere else):
+
+* **Homogenised Jacobian.** With a characteristic length ``L`` (mm), ``ω' = L·ω`` has units of
+  mm/s and ``q̇ = J_v v + (J_ω / L) ω'``, so ``J_h`` divides columns 3:6 by ``L``
+  (:func:`homogenised_jacobian`).
+* **κ** (:func:`condition_number`) is the 2-norm condition number ``σmax / σmin`` of ``J_h``;
+  every κ pkmlab reports states the ``L`` it used.
+* **Singular** (:func:`is_singular`): ``J`` has a non-finite entry (a leg at a serial
+  singularity or without a real solution) or ``σmin(J_h) <= SINGULAR_RTOL · σmax(J_h)``
+  (``SINGULAR_RTOL = 1e-12``); equivalently ``κ = inf``, ``LCI = 1/κ = 0``. Functions that
+  have no ``L`` (force capability, manipulability) apply the same rule to ``J`` as given
+  (``L = 1 mm``) unless one is passed. The proximity flags of
+  :func:`pkmlab.dexterity.singularity_flags` (serial / parallel *within a tolerance*) are a
+  classification of near-singular poses, not this rule.
+* **Default L** (:func:`resolve_length`): Angeles' characteristic length, the ``L`` that
+  minimises κ at the nominal pose (:func:`characteristic_length`). When that optimisation
+  fails (Jacobian singular or undefined at the nominal pose) the mean platform joint radius
+  (:func:`joint_radius`) is used instead, and the returned :class:`CharacteristicLength` says
+  so in its ``status`` and ``reason``; every output that uses ``L`` carries that record.
+* **GCI**: see :mod:`pkmlab.dexterity.aggregate` (mean of ``1/κ`` over the workspace ×
+  orientation set, singular poses counting 0).
 """
 
 from __future__ import annotations
@@ -36,7 +52,9 @@ log = logging.getLogger(__name__)
 
 __all__ = [
     "SINGULAR_RTOL",
+    "KAPPA_SINGULAR",
     "jacobian_ok",
+    "is_singular",
     "homogenised_jacobian",
     "singular_values",
     "condition_number",
@@ -45,11 +63,15 @@ __all__ = [
     "manipulability",
     "CharacteristicLength",
     "characteristic_length",
-    "default_length",
+    "resolve_length",
+    "joint_radius",
+    "LENGTH_STATUS",
 ]
 
-#: A matrix counts as numerically singular when σmin <= SINGULAR_RTOL · σmax.
+#: A Jacobian counts as singular when σmin(J_h) <= SINGULAR_RTOL · σmax(J_h).
 SINGULAR_RTOL = 1e-12
+#: κ at and above which a Jacobian is singular (``1 / SINGULAR_RTOL``); reported as ``inf``.
+KAPPA_SINGULAR = 1.0 / SINGULAR_RTOL
 
 
 def _as_jacobian(J) -> np.ndarray:
@@ -60,6 +82,9 @@ def _as_jacobian(J) -> np.ndarray:
 
 
 def _as_length(L) -> float:
+    """A length argument (mm, or a :class:`CharacteristicLength`) as a float > 0."""
+    if isinstance(L, CharacteristicLength):
+        L = L.length
     try:
         val = float(L)
     except (TypeError, ValueError):
@@ -74,12 +99,12 @@ def jacobian_ok(J: np.ndarray) -> np.ndarray:
     return np.all(np.isfinite(_as_jacobian(J)), axis=(-2, -1))
 
 
-def default_length(mech) -> float:
+def joint_radius(mech) -> float:
     """Mean distance (mm) of the platform joints from the tool point.
 
-    The scale used to bracket :func:`characteristic_length` and the default homogenising
-    length of :func:`pkmlab.dexterity.singularity_flags` (the workspace constraint
-    ``kappa_max`` uses the same default).
+    Not a default ``L`` (that is :func:`resolve_length`): the scale that brackets the search of
+    :func:`characteristic_length`, and the documented fallback when Angeles' length is
+    undefined.
     """
     return float(np.linalg.norm(mech.tool_points, axis=1).mean())
 
@@ -105,6 +130,14 @@ def _sv(J: np.ndarray, L: float | None) -> np.ndarray:
     return singular_values(J if L is None else homogenised_jacobian(J, L))
 
 
+def _kappa_from_sv(s: np.ndarray) -> np.ndarray:
+    """κ from descending singular values ``(..., n)``: the singular rule in one place."""
+    smax, smin = s[..., 0], s[..., -1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = smax / smin
+    return np.where(np.isfinite(smax) & (smin > SINGULAR_RTOL * smax), k, np.inf)
+
+
 def condition_number(J: np.ndarray, L: float) -> np.ndarray:
     """2-norm condition number κ = σmax / σmin of the homogenised Jacobian.
 
@@ -113,14 +146,24 @@ def condition_number(J: np.ndarray, L: float) -> np.ndarray:
         L: characteristic length in mm.
 
     Returns:
-        ``(...,)`` κ ≥ 1; ``inf`` where ``J`` has a non-finite entry (no real leg solution or a
-        serial singularity) or is numerically singular (σmin ≤ 1e-12·σmax).
+        ``(...,)`` κ ≥ 1; ``inf`` exactly where the pose is singular (:func:`is_singular`: a
+        non-finite entry, or σmin ≤ 1e-12·σmax).
     """
-    s = _sv(J, L)
-    smax, smin = s[..., 0], s[..., -1]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        k = smax / smin
-    return np.where(np.isfinite(smax) & (smin > SINGULAR_RTOL * smax), k, np.inf)
+    return _kappa_from_sv(_sv(J, L))
+
+
+def is_singular(J: np.ndarray, L: float | None = None) -> np.ndarray:
+    """``(...,)`` bool: the pose is singular by pkmlab's one rule (module docstring).
+
+    True where ``J`` has a non-finite entry or ``σmin(J_h) <= SINGULAR_RTOL · σmax(J_h)``,
+    i.e. exactly where :func:`condition_number` is ``inf``.
+
+    Args:
+        J: ``(..., 6, 6)`` twist-to-joint Jacobian.
+        L: characteristic length in mm; ``None`` applies the rule to ``J`` as given
+            (``L = 1 mm``).
+    """
+    return ~np.isfinite(condition_number(J, 1.0 if L is None else L))
 
 
 def lci(J: np.ndarray, L: float) -> np.ndarray:
@@ -157,8 +200,8 @@ def manipulability(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     Returns:
         ``(w_t, w_r)``, each ``(...,)``. ``w_t`` is dimensionless ((mm/s)³ per (mm/s)³), ``w_r``
         in (rad/mm)³. NaN exactly where :func:`jacobian_ok` is False; ``inf`` where ``J`` is
-        numerically singular (σmin ≤ 1e-12·σmax: the ellipsoid is unbounded — in the rare case
-        that its unbounded axis is purely rotational, ``w_t`` is in truth finite).
+        singular (:func:`is_singular` with ``L = 1 mm``: the ellipsoid is unbounded — in the
+        rare case that its unbounded axis is purely rotational, ``w_t`` is in truth finite).
     """
     J = _as_jacobian(J)
     lead = J.shape[:-2]
@@ -168,7 +211,7 @@ def manipulability(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     wr = np.full(flat.shape[0], np.nan)
     if np.any(ok):
         _, s, Vh = np.linalg.svd(flat[ok])
-        sing = s[:, -1] <= SINGULAR_RTOL * s[:, 0]
+        sing = ~np.isfinite(_kappa_from_sv(s))                    # the rule at L = 1 mm
         inv2 = 1.0 / np.where(sing[:, None], 1.0, s) ** 2        # (n, 6)
         V = np.swapaxes(Vh, -1, -2)                               # columns = right sing. vectors
         out = []
@@ -181,32 +224,64 @@ def manipulability(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return wt.reshape(lead), wr.reshape(lead)
 
 
+#: ``CharacteristicLength.status`` values.
+LENGTH_STATUS = {
+    "angeles": "Angeles' length: the L minimising κ at the pose",
+    "angeles-at-bound": "Angeles' length on the edge of its search bracket",
+    "given": "given by the caller",
+    "fallback": "Angeles' length undefined: mean platform joint radius used instead",
+    "failed": "Angeles' length undefined",
+}
+
+
 @dataclass(frozen=True)
 class CharacteristicLength:
-    """Result of :func:`characteristic_length`; unpacks as ``L, kappa = ...``.
+    """A characteristic length and why it is what it is; unpacks as ``L, kappa = ...``.
 
     Attributes:
-        length: L in mm (NaN when ``ok`` is False).
-        kappa: κ of ``J_h`` at that L (inf when ``ok`` is False).
-        ok: the pose has a finite, non-singular Jacobian.
+        length: L in mm; NaN only when ``status == "failed"``.
+        kappa: κ of ``J_h`` at that L at the pose it was determined for (the nominal pose by
+            default); ``inf`` where the Jacobian is singular there.
+        ok: Angeles' optimisation succeeded (``status`` is ``"angeles"`` or
+            ``"angeles-at-bound"``).
         at_bound: the minimum lies on the edge of the search bracket (the optimum may be
             outside it; κ is then monotone in L over the bracket).
+        status: a key of :data:`LENGTH_STATUS`: ``"angeles"``, ``"angeles-at-bound"``,
+            ``"given"``, ``"fallback"`` (:func:`resolve_length` only) or ``"failed"``
+            (:func:`characteristic_length` only).
+        reason: one sentence on how L was obtained, or why Angeles' length failed.
     """
 
     length: float
     kappa: float
     ok: bool
     at_bound: bool
+    status: str = "angeles"
+    reason: str = ""
 
     def __iter__(self):
         return iter((self.length, self.kappa))
+
+    @property
+    def source(self) -> str:
+        """Short human-readable source of L (``LENGTH_STATUS[status]``)."""
+        return LENGTH_STATUS.get(self.status, self.status)
+
+    def as_dict(self) -> dict:
+        """JSON-ready record: ``length_mm``, ``status``, ``source``, ``reason``,
+        ``kappa_at_pose`` (``None`` where not finite)."""
+        def fin(v):
+            return float(v) if math.isfinite(v) else None
+
+        return {"length_mm": fin(self.length), "status": self.status, "source": self.source,
+                "reason": self.reason, "kappa_at_pose": fin(self.kappa)}
 
 
 def characteristic_length(mech, pose=None) -> CharacteristicLength:
     """Angeles' characteristic length: the L minimising κ(J_h(L)) at one pose.
 
     Search in ``log L`` over ``[1e-3, 1e3] × r̄``, with ``r̄`` the mean platform joint radius
-    about the tool point (:func:`default_length`): a 121-point scan locates the basin (κ(L)
+    about the tool point (:func:`joint_radius`): a 121-point scan locates the basin (κ(L)
     need not be unimodal), then ``scipy.optimize.minimize_scalar`` (bounded) refines it
     between the scan neighbours.
 
@@ -215,34 +290,38 @@ def characteristic_length(mech, pose=None) -> CharacteristicLength:
         pose: ``(6,)`` pose (mm, rad) or ``(4, 4)`` transform; default ``mech.nominal_pose``.
 
     Returns:
-        :class:`CharacteristicLength` ``(length, kappa, ok, at_bound)``.
+        :class:`CharacteristicLength` with status ``"angeles"``, ``"angeles-at-bound"``, or
+        ``"failed"`` (length NaN, κ inf, ``ok`` False, and the reason: the Jacobian is
+        undefined or singular for every L at the pose). Never raises for a numerical failure.
     """
     X = mech.nominal_pose if pose is None else pose
     p, R = as_frames(X, "pose")
     if len(p) != 1:
         raise ParameterError("pose", "a single pose, shape (6,) or (4, 4)", np.shape(X))
+    where = "the nominal pose" if pose is None else f"pose {np.round(np.asarray(X), 6)}"
     J = mech.jacobian((p, R))[0]
-    r = default_length(mech)
+    r = joint_radius(mech)
     if not np.all(np.isfinite(J)):
-        log.warning("characteristic_length: Jacobian undefined at pose %s", np.asarray(X))
-        return CharacteristicLength(float("nan"), float("inf"), False, False)
+        reason = (f"the Jacobian is undefined at {where} (a leg has no real solution or is at "
+                  "a serial singularity)")
+        log.warning("characteristic_length: %s", reason)
+        return CharacteristicLength(float("nan"), float("inf"), False, False, "failed", reason)
     lo, hi = math.log(1e-3 * r), math.log(1e3 * r)
     grid = np.linspace(lo, hi, 121)
     Js = np.broadcast_to(J, (len(grid), 6, 6)).copy()
     Js[..., 3:] /= np.exp(grid)[:, None, None]
-    s = singular_values(Js)
-    with np.errstate(divide="ignore"):
-        kap = np.where(s[:, -1] > SINGULAR_RTOL * s[:, 0], s[:, 0] / s[:, -1], np.inf)
+    kap = _kappa_from_sv(singular_values(Js))
     if not np.any(np.isfinite(kap)):
-        log.warning("characteristic_length: Jacobian singular at pose %s", np.asarray(X))
-        return CharacteristicLength(float("nan"), float("inf"), False, False)
+        reason = (f"the Jacobian is singular at {where} for every L in [1e-3, 1e3] × "
+                  f"{r:.4g} mm (σmin <= {SINGULAR_RTOL:g}·σmax)")
+        log.warning("characteristic_length: %s", reason)
+        return CharacteristicLength(float("nan"), float("inf"), False, False, "failed", reason)
     k = int(np.argmin(kap))
 
     def f(logL: float) -> float:
         Jh = J.copy()
         Jh[:, 3:] /= math.exp(logL)
-        sv = singular_values(Jh)
-        return float(sv[0] / sv[-1]) if sv[-1] > SINGULAR_RTOL * sv[0] else math.inf
+        return float(_kappa_from_sv(singular_values(Jh)))
 
     a, b = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
     res = minimize_scalar(f, bounds=(a, b), method="bounded",
@@ -250,7 +329,47 @@ def characteristic_length(mech, pose=None) -> CharacteristicLength:
     x, val = (float(res.x), float(res.fun)) if res.fun <= kap[k] else (float(grid[k]),
                                                                          float(kap[k]))
     at_bound = bool(min(x - lo, hi - x) < 1e-3 * (hi - lo))
+    L = math.exp(x)
     if at_bound:
-        log.warning("characteristic_length: minimum at the bracket edge (L = %.6g mm)",
-                    math.exp(x))
-    return CharacteristicLength(math.exp(x), val, True, at_bound)
+        reason = (f"κ at {where} is smallest on the edge of the search bracket [1e-3, 1e3] × "
+                  f"{r:.4g} mm (L = {L:.6g} mm, κ = {val:.6g}); the optimum may lie outside")
+        log.warning("characteristic_length: %s", reason)
+        return CharacteristicLength(L, val, True, True, "angeles-at-bound", reason)
+    return CharacteristicLength(L, val, True, False, "angeles",
+                                f"Angeles: L = {L:.6g} mm minimises κ at {where} "
+                                f"(κ = {val:.6g})")
+
+
+def resolve_length(mech, L=None) -> CharacteristicLength:
+    """The characteristic length every pkmlab output uses, with its status and reason.
+
+    Args:
+        mech: a mechanism.
+        L: ``None`` for the default (Angeles' length at the nominal pose), a length in mm
+            (> 0), or a :class:`CharacteristicLength` (returned unchanged when it has a length).
+
+    Returns:
+        :class:`CharacteristicLength`: status ``"given"`` for a given length; ``"angeles"``
+        or ``"angeles-at-bound"`` for the default; ``"fallback"`` when Angeles' length fails:
+        L is then :func:`joint_radius` and ``reason`` says why Angeles' failed. Never NaN.
+    """
+    if isinstance(L, CharacteristicLength):
+        if math.isfinite(L.length) and L.length > 0:
+            return L
+        L = None
+    if L is not None:
+        val = _as_length(L)
+        J = mech.jacobian(mech.nominal_pose)
+        return CharacteristicLength(val, float(condition_number(J, val)[0]), False, False,
+                                    "given", f"L = {val:.6g} mm given by the caller")
+    cl = characteristic_length(mech)
+    if cl.ok:
+        return cl
+    r = joint_radius(mech)
+    J = mech.jacobian(mech.nominal_pose)
+    reason = (f"Angeles' length failed ({cl.reason}); using the mean platform joint radius "
+              f"about the tool point, {r:.6g} mm")
+    log.warning("resolve_length: %s", reason)
+    return CharacteristicLength(r, float(condition_number(J, r)[0]), False, False, "fallback",
+                                reason)
+

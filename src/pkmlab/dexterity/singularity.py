@@ -17,7 +17,12 @@ rank — the platform gains a motion with the actuators locked.
   row norm of ``J`` over the largest (0 if a row is non-finite), i.e. a leg whose joint speed
   per unit twist blows up relative to the others.
 
-Parallel measure: ``1/κ`` of the homogenised direct matrix (columns 3:6 divided by ``L``).
+Parallel measure: ``1/κ`` of the homogenised direct matrix (columns 3:6 divided by ``L``,
+by default pkmlab's default length, :func:`pkmlab.dexterity.resolve_length`).
+
+These flags classify poses *near* a singularity, within a tolerance. Whether a pose *is*
+singular is decided by one rule everywhere else in pkmlab (κ, GCI, forces, worst cases,
+trajectories): :func:`pkmlab.dexterity.is_singular`.
 """
 
 from __future__ import annotations
@@ -30,7 +35,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..mechanisms import NO_STROKE, _kernels
 from ..poses import as_frames
-from .metrics import _as_length, default_length, lci
+from .metrics import CharacteristicLength, lci, resolve_length
 
 log = logging.getLogger(__name__)
 
@@ -109,6 +114,7 @@ class SingularityFlags:
         parallel_measure: ``1/κ`` of the homogenised direct matrix, in [0, 1]. NaN also where
             the direct matrix is not finite (only possible for families that use ``J`` itself,
             at a serial singularity; ``parallel`` is then False).
+        length: the characteristic length used for the parallel measure, with its status.
     """
 
     serial: np.ndarray
@@ -117,10 +123,11 @@ class SingularityFlags:
     defined: np.ndarray
     serial_measure: np.ndarray
     parallel_measure: np.ndarray
+    length: CharacteristicLength | None = None
 
 
 def singularity_flags(mech, poses, tol: float = 1e-3, *, parallel_tol: float | None = None,
-                      L: float | None = None) -> SingularityFlags:
+                      L: float | CharacteristicLength | None = None) -> SingularityFlags:
     """Classify poses as serial / parallel singular (see the module docstring).
 
     Args:
@@ -130,8 +137,8 @@ def singularity_flags(mech, poses, tol: float = 1e-3, *, parallel_tol: float | N
             0.06° of horizontal on the 6-PSU).
         parallel_tol: threshold of the parallel measure (``1/κ`` of the direct matrix);
             default ``tol``.
-        L: homogenising length in mm for the direct matrix; default the mean platform joint
-            radius about the tool point (:func:`pkmlab.dexterity.default_length`).
+        L: homogenising length in mm for the direct matrix; default pkmlab's default length
+            (:func:`pkmlab.dexterity.resolve_length`: Angeles').
 
     Returns:
         :class:`SingularityFlags`. The stroke window is ignored: singularities are geometric.
@@ -141,7 +148,8 @@ def singularity_flags(mech, poses, tol: float = 1e-3, *, parallel_tol: float | N
     ptol = tol if parallel_tol is None else float(parallel_tol)
     if not (np.isfinite(ptol) and ptol > 0):
         raise ParameterError("parallel_tol", "a threshold > 0", parallel_tol)
-    L = default_length(mech) if L is None else _as_length(L)
+    length = resolve_length(mech, L)
+    L = length.length
     p, R = as_pose_frames(poses)
     n = len(p)
     defined = _defined(mech, p, R)
@@ -171,4 +179,4 @@ def singularity_flags(mech, poses, tol: float = 1e-3, *, parallel_tol: float | N
         log.debug("singularity_flags: %d of %d poses have a leg without a real solution",
                   int(np.sum(~defined)), n)
     return SingularityFlags(serial=serial, parallel=parallel, kind=kind, defined=defined,
-                            serial_measure=s_meas, parallel_measure=p_meas)
+                            serial_measure=s_meas, parallel_measure=p_meas, length=length)

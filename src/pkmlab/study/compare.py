@@ -1,11 +1,37 @@
-"""Side-by-side comparison of candidate designs under one evaluation protocol."""
+"""Side-by-side comparison of candidate designs under one evaluation protocol.
+
+Every number comes from the library function that computes it elsewhere, with the same
+request, so a compare row can be reproduced with the other commands:
+
+* workspaces: :func:`pkmlab.workspace` — the level constant-orientation workspace and the
+  ±``box_deg`` simultaneous dexterous one with ``samples`` per angle (default 7, as
+  ``pkmlab workspace`` and ``pkmlab dexterity``);
+* inscribed box and cylinder: :meth:`WorkspaceResult.inscribed_box` /
+  :meth:`~WorkspaceResult.inscribed_cylinder` with their defaults — the call of
+  ``pkmlab workspace --inscribed`` — with their status;
+* L: :func:`pkmlab.dexterity.resolve_length` (Angeles'), with its status;
+* GCI: :func:`pkmlab.dexterity.gci_grid` (every voxel × orientation sample, singular poses
+  counting 0); κ range: the grid's smallest κ … :func:`pkmlab.dexterity.worst_case`'s worst κ
+  (inf with a singular pose inside); force: ``worst_case``'s smallest all-direction force;
+* the paper's ±2 in / ±30° motion: :func:`pkmlab.trajectory.check_trajectory`.
+
+The inscribed shapes, GCI, κ and force are over the dexterous workspace, or over the level one
+when the dexterous one is empty (the row's ``reference`` says which).
+"""
 
 from __future__ import annotations
 
+import logging
 import math
 from pathlib import Path
 
 import numpy as np
+
+from .. import dexterity as dx
+from ..trajectory import check_trajectory, paper_motion
+from ..workspaces import OrientationSet, workspace
+
+log = logging.getLogger(__name__)
 
 __all__ = ["compare_designs", "comparison_markdown", "plot_overlaid_slices", "COLUMNS"]
 
@@ -16,60 +42,86 @@ COLUMNS = [
     ("dexterous_volume_cm3", "dexterous ±a (cm³)", "{:.2f}"),
     ("box_mm", "inscribed box (mm)", "{}"),
     ("cylinder_mm", "inscribed cylinder r × h (mm)", "{}"),
-    ("gci", "GCI", "{:.4f}"),
-    ("kappa_range", "κ range", "{}"),
-    ("force_N", "force, every direction (N)", "{:.1f}"),
+    ("L_mm", "characteristic length L (mm)", "{}"),
+    ("gci", "GCI (grid; singular poses count 0)", "{:.4f}"),
+    ("kappa_range", "κ range (grid min … worst case)", "{}"),
+    ("force_N", "force, every direction: worst case (N)", "{:.1f}"),
+    ("singular", "singular pose inside", "{}"),
     ("paper_motion", "paper motion: stroke used / margin", "{}"),
 ]
 
 
+def _shape_text(shape, text: str) -> str:
+    return text if shape.status == "ok" else f"{shape.status}: {text}"
+
+
 def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
-                    resolution: float = 2.5, samples: int = 5, force_limit: float = 150.0,
+                    resolution: float = 2.5, samples: int = 7, force_limit: float = 150.0,
                     seed: int = 0) -> list[dict]:
     """Evaluate each ``(label, mechanism)`` with the same protocol → one row per design.
 
-    Protocol: the level constant-orientation workspace; the ±``box_deg`` simultaneous
-    dexterous workspace (falling back to the level one for the inscribed shapes and the
-    conditioning when it is empty); Angeles' characteristic length; 1,000 Monte-Carlo poses
-    for GCI, κ and force; the paper's ±2 in / ±30° motion for stroke use.
-    """
-    from .. import dexterity as dx
-    from ..trajectory import check_trajectory, paper_motion
-    from ..workspaces import OrientationSet, workspace
+    Args:
+        designs: ``(label, mechanism)`` pairs.
+        box_deg: half-range (deg) of the simultaneous Euler box of the dexterous workspace.
+        resolution: grid spacing (mm).
+        samples: orientation samples per angle of the box.
+        force_limit: actuator force limit (N) of the force capability.
+        seed: seed of the inscribed shapes' verification sample.
 
+    Returns:
+        One dict per design: the :data:`COLUMNS` values (text or numbers), plus
+        ``request`` (the workspace request), ``characteristic_length``, ``worst_case``,
+        ``gci_result``, ``inscribed_box``, ``inscribed_cylinder`` (JSON-ready dicts with
+        their statuses), ``reference``, and ``mechanism`` / ``results`` (the objects).
+    """
+    oset = OrientationSet.box(np.radians([box_deg] * 3), samples=samples)
+    request = {"dexterous_set": f"±{box_deg:g}° simultaneous Euler box, {samples} samples per "
+                                f"angle ({samples ** 3} orientations)",
+               "resolution_mm": float(resolution), "force_limit_N": float(force_limit),
+               "inscribed": f"inscribed_box() / inscribed_cylinder() defaults (seed {seed})"}
     rows = []
     for label, mech in designs:
         const = workspace(mech, "constant", None, resolution)
-        dex = workspace(mech, "dexterous",
-                        OrientationSet.box(np.radians([box_deg] * 3), samples=samples),
-                        resolution)
+        dex = workspace(mech, "dexterous", oset, resolution)
         ref = dex if not dex.empty else const
-        box = ref.inscribed_box(samples=4000, seed=seed)
-        cyl = ref.inscribed_cylinder(samples=4000, seed=seed)
-        L = dx.characteristic_length(mech).length
-        rng = np.random.default_rng(seed)
-        p, R = dx.aggregate.sample_poses(ref, 1000, rng)
-        valid = mech.inverse((p, R)).valid
-        J = mech.jacobian((p[valid], R[valid]))
-        kap = dx.condition_number(J, L)
-        kap = kap[np.isfinite(kap)]
-        force = dx.max_force_all_directions(J, force_limit)
+        box = ref.inscribed_box(seed=seed)
+        cyl = ref.inscribed_cylinder(seed=seed)
+        length = dx.resolve_length(mech)
+        grid = dx.kappa_grid(mech, ref, length)
+        gci = dx.gci_grid(mech, ref, grid=grid)
+        kmin = dx.kappa_statistics(grid.kappa[grid.valid]).min
+        wc = dx.worst_case(mech, ref, length, force_limit)
         t, X = paper_motion(mech)
-        rep = check_trajectory(mech, t, X)
+        rep = check_trajectory(mech, t, X, characteristic_length=length)
         q = rep.q[np.all(np.isfinite(rep.q), axis=1)]
         used = (q.max() - q.min()) / (mech.stroke[1] - mech.stroke[0]) if len(q) else math.nan
         margin = min(rep.margin_low.min(), rep.margin_high.min())
+        L_text = f"{length.length:.2f} ({length.status})"
         rows.append({
             "label": label,
             "mechanism": mech,
-            "footprint_mm": float(np.max(np.linalg.norm(mech.base_points[:, :2], axis=1))),
+            "request": request,
+            "footprint_mm": mech.footprint()["base_radius"],
             "constant_volume_cm3": const.volume / 1e3,
             "dexterous_volume_cm3": dex.volume / 1e3,
-            "box_mm": " × ".join(f"{s:.1f}" for s in box.size),
-            "cylinder_mm": f"{cyl.radius:.1f} × {cyl.height:.1f}",
-            "gci": float(np.mean(1.0 / kap)) if len(kap) else 0.0,
-            "kappa_range": f"{kap.min():.2f} … {kap.max():.2f}" if len(kap) else "—",
-            "force_N": float(np.nanmin(force)) if len(force) else 0.0,
+            "box_mm": _shape_text(box, " × ".join(f"{s:.1f}" for s in box.size)
+                                  if box.ok else box.reason),
+            "cylinder_mm": _shape_text(cyl, f"{cyl.radius:.1f} × {cyl.height:.1f}"
+                                       if cyl.ok else cyl.reason),
+            "inscribed_box": box.as_dict(),
+            "inscribed_cylinder": cyl.as_dict(),
+            "L_mm": L_text,
+            "characteristic_length": length.as_dict(),
+            "gci": gci.gci if gci.ok else gci.reason,
+            "gci_result": {"gci": gci.gci if gci.ok else None, "samples": gci.samples,
+                           "singular": gci.singular, "rejected": gci.rejected,
+                           "method": gci.method, "reason": gci.reason},
+            "kappa_range": (f"{kmin:.2f} … {wc.worst_kappa:.2f}" if wc.ok and not wc.singular
+                            else f"{kmin:.2f} … inf" if wc.ok else wc.reason),
+            "force_N": wc.min_force if wc.ok else wc.reason,
+            "singular": ("no" if not wc.singular else f"yes: {wc.reason}") if wc.ok
+            else wc.status,
+            "worst_case": wc.as_dict(),
             "paper_motion": (f"{100 * used:.0f} % / {margin:.2f} mm"
                              + ("" if rep.fits else " (does not fit)")),
             "results": (const, dex),
@@ -78,8 +130,11 @@ def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
     return rows
 
 
-def comparison_markdown(rows: list[dict], box_deg: float) -> str:
-    lines = [f"# Design comparison (dexterous set: ±{box_deg:g}° simultaneous)", "",
+def comparison_markdown(rows: list[dict], box_deg: float | None = None) -> str:
+    """The rows as a Markdown table, with the request they were evaluated under."""
+    req = rows[0]["request"] if rows else {}
+    lines = [f"# Design comparison (dexterous set: {req.get('dexterous_set', '')}, grid "
+             f"{req.get('resolution_mm', float('nan')):g} mm)", "",
              "| | " + " | ".join(r["label"] for r in rows) + " |",
              "|---" * (len(rows) + 1) + "|"]
     for key, header, fmt in COLUMNS:
@@ -87,16 +142,23 @@ def comparison_markdown(rows: list[dict], box_deg: float) -> str:
             fmt.format(r[key]) if not isinstance(r[key], str) else r[key] for r in rows) + " |")
     lines.append("| inscribed shapes / GCI / κ / force over | "
                  + " | ".join(r["reference"] for r in rows) + " |")
+    lines += ["", f"Inscribed shapes: {req.get('inscribed', '')}, the call of "
+              "`pkmlab workspace --inscribed`. L: Angeles' characteristic length (status in "
+              "brackets). GCI: every voxel × orientation sample. κ range and force: the grid's "
+              "smallest κ and `pkmlab.dexterity.worst_case` (every voxel × orientation sample; "
+              "inf / 0 N when a singular pose lies inside, found at a sample or by a sign change "
+              "of det J between neighbouring samples)."]
     return "\n".join(lines) + "\n"
 
 
 def plot_overlaid_slices(rows: list[dict], path: Path, which: int = 1, window: float = 152.4,
                          spacing: float = 12.7) -> Path:
-    """Outlines of every design's workspace (``which``: 0 level, 1 dexterous) per slice."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """Outlines of every design's workspace (``which``: 0 level, 1 dexterous) per slice, as a
+    PNG at ``path`` (Agg canvas: pyplot and the global backend are not touched)."""
+    import matplotlib as mpl
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
 
     res = [r["results"][which] for r in rows]
     spans = [x.metrics()["z_range_mm"] for x in res if not x.empty]
@@ -109,9 +171,10 @@ def plot_overlaid_slices(rows: list[dict], path: Path, which: int = 1, window: f
     levels = lo + 0.5 * ((hi - lo) - (n - 1) * spacing) + spacing * np.arange(n)
     cols = int(math.ceil(math.sqrt(n)))
     nrows = int(math.ceil(n / cols))
-    fig, axes = plt.subplots(nrows, cols, figsize=(2.4 * cols, 2.4 * nrows + 0.8),
-                             squeeze=False, constrained_layout=True)
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    fig = Figure(figsize=(2.4 * cols, 2.4 * nrows + 0.8), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(nrows, cols, squeeze=False)
+    colours = mpl.rcParams["axes.prop_cycle"].by_key()["color"]
     for a, ax in enumerate(axes.ravel()):
         ax.set_xlim(-window / 2, window / 2)
         ax.set_ylim(-window / 2, window / 2)
@@ -129,11 +192,10 @@ def plot_overlaid_slices(rows: list[dict], path: Path, which: int = 1, window: f
                 ax.contour(w.xs, w.ys, sec.T, levels=[0.5], colors=[colours[k % len(colours)]],
                            linewidths=1.2)
         ax.set_title(f"z = {z:.1f} mm", fontsize=7)
-    handles = [plt.Line2D([], [], color=colours[k % len(colours)], label=r["label"])
+    handles = [Line2D([], [], color=colours[k % len(colours)], label=r["label"])
                for k, r in enumerate(rows)]
     fig.legend(handles=handles, loc="lower center", ncol=min(len(rows), 4), fontsize=8)
     fig.suptitle(f"{'dexterous' if which else 'level'} workspaces, {window:g} mm windows every "
                  f"{spacing:g} mm (lowest top-left)", fontsize=9)
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return Path(path)

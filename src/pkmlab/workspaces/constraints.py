@@ -11,11 +11,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..dexterity.metrics import condition_number, resolve_length
 from ..errors import ParameterError
 from ..poses import as_frames
 
-__all__ = ["Constraints", "JointLimits", "check", "kappa", "segment_distances",
-           "joint_angles"]
+__all__ = ["Constraints", "JointLimits", "check", "segment_distances", "joint_angles"]
 
 
 @dataclass(frozen=True)
@@ -63,10 +63,12 @@ class Constraints:
         joint_limits: passive joint cones, or ``None``.
         link_diameter: legs are cylinders of this diameter (mm); two legs interfere when
             their axes come closer than it. ``None`` = not checked.
-        kappa_max: largest admissible homogenised condition number, or ``None``.
+        kappa_max: largest admissible κ (:func:`pkmlab.dexterity.condition_number`), or
+            ``None``.
         characteristic_length: L_c (mm) dividing the rotational Jacobian columns for κ;
-            ``None`` = Angeles' (the L minimising κ at the nominal pose, resolved by
-            :func:`pkmlab.workspace` and shown in the result's metrics).
+            ``None`` = pkmlab's default (:func:`pkmlab.dexterity.resolve_length`: Angeles',
+            resolved by :func:`pkmlab.workspace`, which states the L used and its status in
+            the result's notes).
         connected: keep only the region connected to the nominal position (drops mirror
             regions that the stroke alone admits).
     """
@@ -114,27 +116,6 @@ class Constraints:
             "characteristic_length_mm": self.characteristic_length,
             "connected": self.connected,
         }
-
-
-def default_characteristic_length(mech) -> float:
-    """Mean distance of the platform joints from the tool point (mm)."""
-    return float(np.mean(np.linalg.norm(mech.tool_points, axis=1)))
-
-
-def kappa(mech, p: np.ndarray, R: np.ndarray, characteristic_length: float) -> np.ndarray:
-    """Homogenised condition number ``(N,)`` of ``J·diag(1, 1, 1, 1/L, 1/L, 1/L)``.
-
-    ``inf`` where the Jacobian is singular or undefined (no real leg solution).
-    """
-    J = mech.jacobian((p, R)).copy()
-    J[..., 3:] /= characteristic_length
-    out = np.full(len(p), np.inf)
-    ok = np.all(np.isfinite(J), axis=(1, 2))
-    if np.any(ok):
-        s = np.linalg.svd(J[ok], compute_uv=False)
-        with np.errstate(divide="ignore"):
-            out[ok] = np.where(s[:, -1] > 0, s[:, 0] / s[:, -1], np.inf)
-    return out
 
 
 def joint_angles(mech, p, R, limits: JointLimits) -> tuple[np.ndarray, np.ndarray]:
@@ -202,8 +183,8 @@ def check(mech, p: np.ndarray, R: np.ndarray, cons: Constraints) -> np.ndarray:
         d = segment_distances(start, end)
         ok &= np.all(d >= cons.link_diameter, axis=1)
     if cons.kappa_max is not None:
-        L = cons.characteristic_length or default_characteristic_length(mech)
+        L = resolve_length(mech, cons.characteristic_length).length
         idx = np.nonzero(ok)[0]
-        k = kappa(mech, p[idx], R[idx], L)
+        k = condition_number(mech.jacobian((p[idx], R[idx])), L)
         ok[idx] &= k <= cons.kappa_max
     return ok

@@ -20,6 +20,7 @@ import numpy as np
 from scipy import ndimage
 
 from .._intervals import label_pieces
+from ..dexterity.metrics import resolve_length
 from ..errors import ParameterError
 from ..limits import RESOLUTION_MM
 from ..mechanisms import NO_STROKE
@@ -72,12 +73,12 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
     if cons.stroke is not True:
         # the same geometry with another actuator window (the family re-validates it)
         mech = dataclasses.replace(mech, stroke_window=cons.stroke)
-    if cons.kappa_max is not None and cons.characteristic_length is None:
-        from ..dexterity import characteristic_length
-
-        cl = characteristic_length(mech)          # Angeles': the L minimising κ at nominal
-        if cl.ok:
-            cons = dataclasses.replace(cons, characteristic_length=cl.length)
+    notes: list[str] = []
+    if cons.kappa_max is not None:
+        length = resolve_length(mech, cons.characteristic_length)
+        cons = dataclasses.replace(cons, characteristic_length=length.length)
+        notes.append(f"kappa_max: L = {length.length:.6g} mm ({length.status}): "
+                     f"{length.reason}")
     oset = orientations or OrientationSet.fixed()
     if kind == "constant" and oset.kind != "fixed":
         raise ParameterError("orientations", "a single fixed orientation for kind 'constant'",
@@ -94,7 +95,6 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
 
     xs, ys, zb = _grid_xy(mech, R, mode, h)
     timings = {}
-    notes: list[str] = []
     lo = hi = field = None
     p_nom = mech.nominal_pose[:3]
     if use_columns and len(xs) and len(ys):

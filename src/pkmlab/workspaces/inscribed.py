@@ -16,6 +16,12 @@ Both are valid for the continuous workspace, not just its voxels:
    request (stroke, joint cones, interference, κ) for every orientation of the set (for a
    reachable workspace, at least one). Any failure shrinks the shape about its centre by 2 %
    and the check repeats.
+
+Every shape carries a ``status`` and a ``reason``: ``"ok"`` (verified; the enlargement
+converged, or was not asked for), ``"not converged"`` (verified, but the enlargement stopped on
+a solver or kinematics problem or its iteration cap: it may not be the largest), ``"failed"``
+(no scaled copy of the shape passed verification: its size is 0 and it is not a result) or
+``"empty"`` (the workspace is empty).
 """
 
 from __future__ import annotations
@@ -33,20 +39,39 @@ from .constraints import check
 
 log = logging.getLogger(__name__)
 
-__all__ = ["InscribedBox", "InscribedCylinder", "inscribed_box", "inscribed_cylinder"]
+__all__ = ["InscribedBox", "InscribedCylinder", "inscribed_box", "inscribed_cylinder",
+           "STATUSES"]
 
 _POLY = 16
 
 
+STATUSES = ("ok", "not converged", "failed", "empty")
+
+
+def _fin(v):
+    return float(v) if math.isfinite(v) else None
+
+
 @dataclass(frozen=True)
 class InscribedBox:
-    """Axis-aligned box ``[lower, upper]`` (mm) verified inside the workspace."""
+    """Axis-aligned box ``[lower, upper]`` (mm) verified inside the workspace.
+
+    ``status`` and ``reason``: see the module docstring; only ``"ok"`` and ``"not converged"``
+    shapes are results (``ok``).
+    """
 
     lower: np.ndarray
     upper: np.ndarray
     verified_samples: int
     iterations: int
     shrink: float = 1.0
+    status: str = "ok"
+    reason: str = ""
+
+    @property
+    def ok(self) -> bool:
+        """A verified shape of positive size (status ``"ok"`` or ``"not converged"``)."""
+        return self.status in ("ok", "not converged")
 
     @property
     def size(self) -> np.ndarray:
@@ -65,14 +90,17 @@ class InscribedBox:
         return self.lower + rng.random((n, 3)) * self.size
 
     def as_dict(self) -> dict:
-        return {"centre_mm": self.centre.tolist(), "size_mm": self.size.tolist(),
-                "volume_cm3": self.volume / 1e3, "verified_samples": self.verified_samples,
+        return {"status": self.status, "reason": self.reason,
+                "centre_mm": [_fin(v) for v in self.centre],
+                "size_mm": [_fin(v) for v in self.size],
+                "volume_cm3": _fin(self.volume / 1e3), "verified_samples": self.verified_samples,
                 "scp_iterations": self.iterations, "verification_shrink": self.shrink}
 
 
 @dataclass(frozen=True)
 class InscribedCylinder:
-    """Vertical cylinder (mm) verified inside the workspace."""
+    """Vertical cylinder (mm) verified inside the workspace (``status``, ``reason``: see the
+    module docstring)."""
 
     centre_xy: np.ndarray
     radius: float
@@ -80,6 +108,13 @@ class InscribedCylinder:
     verified_samples: int
     iterations: int
     shrink: float = 1.0
+    status: str = "ok"
+    reason: str = ""
+
+    @property
+    def ok(self) -> bool:
+        """A verified shape of positive size (status ``"ok"`` or ``"not converged"``)."""
+        return self.status in ("ok", "not converged")
 
     @property
     def height(self) -> float:
@@ -98,9 +133,10 @@ class InscribedCylinder:
                          z], axis=1)
 
     def as_dict(self) -> dict:
-        return {"centre_xy_mm": self.centre_xy.tolist(), "radius_mm": self.radius,
-                "z_range_mm": list(self.z_range), "height_mm": self.height,
-                "volume_cm3": self.volume / 1e3, "verified_samples": self.verified_samples,
+        return {"status": self.status, "reason": self.reason,
+                "centre_xy_mm": [_fin(v) for v in self.centre_xy], "radius_mm": _fin(self.radius),
+                "z_range_mm": [_fin(v) for v in self.z_range], "height_mm": _fin(self.height),
+                "volume_cm3": _fin(self.volume / 1e3), "verified_samples": self.verified_samples,
                 "scp_iterations": self.iterations, "verification_shrink": self.shrink}
 
 
@@ -127,16 +163,37 @@ def points_feasible(result, points: np.ndarray) -> np.ndarray:
     return ok
 
 
+_SHRINKS = 60
+
+
 def _verify(result, shape_points, seed: int, n_random: int):
-    """Shrink factor loop: returns (scale, samples checked) with every sample feasible."""
+    """Shrink factor loop → ``(scale, samples checked, reason)`` with every sample feasible;
+    ``(0.0, 0, reason)`` when even the smallest copy (0.98^60 ≈ 30 %) fails."""
     scale = 1.0
-    for _ in range(60):
+    for _ in range(_SHRINKS):
         pts = shape_points(scale, n_random, seed)
         ok = points_feasible(result, pts)
         if ok.all():
-            return scale, len(pts)
+            return scale, len(pts), ""
         scale *= 0.98
-    return 0.0, 0
+    reason = (f"verification failed at every scale down to {scale / 0.98:.0%} of the shape: "
+              f"{int(np.sum(~ok))} of {len(ok)} points still violate the request there")
+    return 0.0, 0, reason
+
+
+def _status(optimised: bool, scp, verified_reason: str, what: str) -> tuple[str, str]:
+    """Status and reason of a shape from its SCP outcome and its verification."""
+    if verified_reason:
+        return "failed", f"no {what} fits: {verified_reason}"
+    if scp is None:
+        return "ok", ("the voxel start, verified (the enlargement runs only for constant and "
+                      "dexterous workspaces)" if optimised else
+                      "the voxel start, verified (optimise=False)")
+    x, it, accepted, converged, problem = scp
+    if converged:
+        return "ok", f"enlarged by {accepted} SCP steps in {it} iterations, converged, verified"
+    return "not converged", (f"the SCP enlargement stopped after {it} iterations ({accepted} "
+                             f"steps accepted): {problem}; verified, but maybe not the largest")
 
 
 # ---- starting shapes on the voxel grid ----------------------------------------------------------
@@ -195,8 +252,15 @@ def _scp(result, x0, points_of, jac_of, objective, lower_bounds, iters=30):
     Every iteration evaluates the actuator values at the shape's lattice points for every
     orientation, keeps for each (orientation, leg) the lattice points with the smallest and
     the largest value, linearises those two with the translational Jacobian and solves the
-    convex program; a step is accepted (backtracking on its length) only when the true
-    stroke holds at every lattice point.
+    convex program for the step ``x' = x + ρ·d`` with ``|d| <= 1`` (the trust region ρ in mm;
+    solving for ``d`` keeps the program well scaled); a step is accepted (backtracking on its
+    length) only when the true stroke holds at every lattice point. A sub-problem the solver
+    cannot solve halves the trust region, as a rejected step does.
+
+    Returns:
+        ``(x, iterations, accepted, converged, problem)``: the shape, the iterations run, the
+        steps accepted, whether the last step was below 1e-3 mm, and the last solver or
+        kinematics problem met ("" if none).
     """
     import cvxpy as cp
 
@@ -211,51 +275,63 @@ def _scp(result, x0, points_of, jac_of, objective, lower_bounds, iters=30):
         q, _ = _linearise(mech, points_of(xc), R)
         return bool(np.all(np.isfinite(q)) and np.all(q >= qlo) and np.all(q <= qhi))
 
-    it = 0
+    it = accepted = 0
+    problem = ""
+    converged = False
     for it in range(1, iters + 1):  # noqa: B007
         V = points_of(x)                                       # (n, 3)
         q, G = _linearise(mech, V, R)                          # (n, M, 6), (n, M, 6, 3)
         if not (np.all(np.isfinite(q)) and np.all(np.isfinite(G))):
+            problem = "the inverse kinematics or Jacobian is undefined at a lattice point"
             break
         M = len(R)
         mi, li = np.meshgrid(np.arange(M), np.arange(6), indexing="ij")
-        rows, lo_b, hi_b = [], [], []
+        rows, slack = [], []
         for pick, is_low in ((np.argmin(q, axis=0), True), (np.argmax(q, axis=0), False)):
             g = G[pick, mi, li]                                 # (M, 6, 3)
             r = np.einsum("mic,micx->mix", g, A[pick]).reshape(-1, len(x))
-            base = q[pick, mi, li].reshape(-1) - r @ x
-            rows.append(r)
-            (lo_b if is_low else hi_b).append((qlo - base) if is_low else (qhi - base))
-        xv = cp.Variable(len(x))
-        cons = [rows[0] @ xv >= lo_b[0], rows[1] @ xv <= hi_b[0], cp.abs(xv - x) <= rho]
-        cons += [xv[k] >= lb for k, lb in lower_bounds.items()]
-        prob = cp.Problem(cp.Maximize(objective(xv)), cons)
+            qv = q[pick, mi, li].reshape(-1)
+            rows.append(r * rho)
+            slack.append((qv - qlo) if is_low else (qhi - qv))  # >= 0: x is feasible
+        d = cp.Variable(len(x))
+        cons = [rows[0] @ d >= -slack[0], rows[1] @ d <= slack[1], cp.abs(d) <= 1.0]
+        cons += [x[k] + rho * d[k] >= lb for k, lb in lower_bounds.items()]
+        prob = cp.Problem(cp.Maximize(objective(x + rho * d)), cons)
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", UserWarning)   # "may be inaccurate": checked
                 prob.solve(solver=cp.CLARABEL)
-        except cp.SolverError:
-            break
-        log.debug("SCP iteration %d: %s, trust region %.3g", it, prob.status, rho)
-        if xv.value is None or prob.status not in ("optimal", "optimal_inaccurate"):
+            status = prob.status
+        except cp.SolverError as exc:
+            status = f"solver error ({exc})"
+        log.debug("SCP iteration %d: %s, trust region %.3g", it, status, rho)
+        if d.value is None or status not in ("optimal", "optimal_inaccurate"):
+            problem = f"convex sub-problem not solved: {status}"
             rho *= 0.5
             if rho < 1e-3:
                 break
             continue
-        step = np.asarray(xv.value) - x
+        step = rho * np.asarray(d.value)
         for _ in range(8):                                     # backtracking line search
             if stroke_ok(x + step):
                 break
             step *= 0.5
         else:
+            problem = "no step along the sub-problem's solution keeps the stroke"
             rho *= 0.5
             if rho < 1e-3:
                 break
             continue
         x = x + step
+        accepted += 1
         if float(np.max(np.abs(step))) < 1e-3:
+            converged = True
             break
-    return x, it
+    else:
+        problem = f"iteration cap ({iters}) reached" + (f", last: {problem}" if problem else "")
+    if not converged and not problem:
+        problem = "trust region shrank below 1e-3 mm"
+    return x, it, accepted, converged, problem
 
 
 _LAT = np.array([[i, j, k] for i in np.linspace(-0.5, 0.5, 5) for j in np.linspace(-0.5, 0.5, 5)
@@ -283,21 +359,28 @@ def inscribed_box(result, *, samples: int = 20000, seed: int = 0,
             edge and face centres).
         seed: seed of the verification sample.
         optimise: run the SCP enlargement (otherwise the voxel start, verified).
+
+    Returns:
+        :class:`InscribedBox` with its ``status`` and ``reason`` (module docstring): an empty
+        workspace or a box that verification shrinks away is reported, not raised.
     """
     import cvxpy as cp
 
     if result.empty:
-        raise ValueError("the workspace is empty: no box fits")
+        nan = np.full(3, np.nan)
+        return InscribedBox(nan, nan, 0, 0, 0.0, "empty", "the workspace is empty: no box fits")
     h = result.resolution
     i0, i1 = _voxel_box(result)
     lower = np.array([result.xs[i0[0]], result.ys[i0[1]], result.zs[i0[2]]])
     upper = np.array([result.xs[i1[0] - 1], result.ys[i1[1] - 1], result.zs[i1[2] - 1]])
     size = np.maximum(upper - lower, 1e-3 * h)
     x = np.concatenate([0.5 * (lower + upper), size])
-    it = 0
+    scp = None
     if optimise and result.kind != "reachable":
-        x, it = _scp(result, x, _box_points, _box_jac, lambda v: cp.sum(cp.log(v[3:])),
-                     {3: 1e-3, 4: 1e-3, 5: 1e-3})
+        scp = _scp(result, x, _box_points, _box_jac, lambda v: cp.sum(cp.log(v[3:])),
+                   {3: 1e-3, 4: 1e-3, 5: 1e-3})
+        x = scp[0]
+    it = 0 if scp is None else scp[1]
     c, s = x[:3], x[3:]
     grid = np.array([[i, j, k] for i in (-0.5, 0, 0.5) for j in (-0.5, 0, 0.5)
                      for k in (-0.5, 0, 0.5)])
@@ -306,18 +389,26 @@ def inscribed_box(result, *, samples: int = 20000, seed: int = 0,
         rng = np.random.default_rng(sd)
         return np.vstack([c + grid * s * scale, c + (rng.random((n, 3)) - 0.5) * s * scale])
 
-    scale, checked = _verify(result, pts, seed, samples)
+    scale, checked, failed = _verify(result, pts, seed, samples)
+    status, reason = _status(optimise, scp, failed, "box")
+    if status == "failed":
+        log.warning("inscribed box: %s", reason)
     s = s * scale
-    return InscribedBox(c - s / 2, c + s / 2, checked, it, scale)
+    return InscribedBox(c - s / 2, c + s / 2, checked, it, scale, status, reason)
 
 
 def inscribed_cylinder(result, *, samples: int = 20000, seed: int = 0,
                        optimise: bool = True) -> InscribedCylinder:
-    """Largest vertical cylinder (by volume) inside ``result``'s workspace, verified."""
+    """Largest vertical cylinder (by volume) inside ``result``'s workspace, verified.
+
+    Arguments as :func:`inscribed_box`; returns :class:`InscribedCylinder` with its
+    ``status`` and ``reason``.
+    """
     import cvxpy as cp
 
     if result.empty:
-        raise ValueError("the workspace is empty: no cylinder fits")
+        return InscribedCylinder(np.full(2, np.nan), 0.0, (math.nan, math.nan), 0, 0, 0.0,
+                                 "empty", "the workspace is empty: no cylinder fits")
     box = inscribed_box(result, samples=2000, seed=seed, optimise=False)
     c = box.centre
     r0 = 0.5 * min(box.size[0], box.size[1])
@@ -343,10 +434,12 @@ def inscribed_cylinder(result, *, samples: int = 20000, seed: int = 0,
         A[:, 2, 4] = lat[:, 2]
         return A
 
-    it = 0
+    scp = None
     if optimise and result.kind != "reachable":
-        x, it = _scp(result, x, lattice, jac, lambda v: 2 * cp.log(v[2]) + cp.log(v[4] - v[3]),
-                     {2: 1e-3})
+        scp = _scp(result, x, lattice, jac, lambda v: 2 * cp.log(v[2]) + cp.log(v[4] - v[3]),
+                   {2: 1e-3})
+        x = scp[0]
+    it = 0 if scp is None else scp[1]
     cx, cy, r, z0, z1 = x
     zc, hz = 0.5 * (z0 + z1), 0.5 * (z1 - z0)
 
@@ -363,7 +456,10 @@ def inscribed_cylinder(result, *, samples: int = 20000, seed: int = 0,
                                                                  zc + hz * scale]])
         return np.vstack(edge + [body, axis])
 
-    scale, checked = _verify(result, pts, seed, samples)
+    scale, checked, failed = _verify(result, pts, seed, samples)
+    status, reason = _status(optimise, scp, failed, "cylinder")
+    if status == "failed":
+        log.warning("inscribed cylinder: %s", reason)
     return InscribedCylinder(np.array([cx, cy]), float(r * scale),
                              (float(zc - hz * scale), float(zc + hz * scale)), checked, it,
-                             scale)
+                             scale, status, reason)

@@ -171,6 +171,11 @@ class OrientationSet:
         """``(M, 3, 3)`` rotation matrices of the sample."""
         return rotations_from_parameters(self, self.parameters())
 
+    def rotations_at(self, params: np.ndarray) -> np.ndarray:
+        """``(M, 3, 3)`` rotation matrices of set coordinates ``params (M, 3)``
+        (:func:`rotations_from_parameters`)."""
+        return rotations_from_parameters(self, params)
+
     def describe(self) -> dict:
         d: dict = {"kind": self.kind, "samples": self.samples,
                    "count": int(self.parameters().shape[0])}

@@ -1,0 +1,413 @@
+"""Worst case of κ and of the all-direction force over a whole workspace grid.
+
+:func:`worst_case` evaluates *every* occupied voxel centre of a
+:class:`~pkmlab.workspaces.WorkspaceResult` × *every* sample orientation of its set (the poses of
+:func:`pkmlab.dexterity.kappa_grid` and :mod:`pkmlab.dexterity.maps`), not a random subset:
+
+* ``worst_kappa`` — the largest κ(J_h) (:func:`pkmlab.dexterity.condition_number`) over those
+  poses, ``inf`` when the workspace holds a singular pose (below);
+* ``min_force`` — the smallest force held in every direction
+  (:func:`pkmlab.dexterity.max_force_all_directions`), 0 N when the workspace holds a singular
+  pose;
+* ``singular`` — a singular pose lies in the workspace: a sample is singular by pkmlab's one rule
+  (:func:`pkmlab.dexterity.is_singular`), **or** ``det J`` has opposite signs at two
+  neighbouring samples (voxels sharing a face, at the same orientation; or neighbouring
+  orientation samples — the same voxel, one set coordinate one step apart). ``det J`` is
+  continuous wherever every leg has a real solution, so by the intermediate value theorem it
+  vanishes — the pose is singular — somewhere on the path between two such samples (a serial
+  singularity, where a row of J grows without bound, is singular by the same rule). This catches
+  the parallel singularity surfaces that a grid crosses but never lands on exactly, where the
+  sampled κ is large but finite.
+
+What lies between samples: ``worst_kappa`` and ``min_force`` otherwise are extremes *of the
+sampled grid* — lower (upper) bounds on the supremum of κ (infimum of the force) over the
+continuous workspace × orientation set. κ and the force capability are continuous away from
+singularities, so the grid extremes converge to them as the resolution ``h → 0`` and the
+orientation samples per angle ``n → ∞`` (typically like ``h`` and ``1/n``; compare two
+resolutions to see how far). A singular set between samples that ``det J`` touches without
+changing sign (tangency) or crosses twice between two samples is not detected.
+
+Speed: for each pose one LU factorisation gives ``det J``, ``J⁻¹`` (the force capability) and a
+certified upper bound on κ (:func:`pkmlab.dexterity._linalg.sweep_bounds`, numba); the exact κ
+(singular values) is computed only for the poses whose bound reaches the largest exact κ found,
+in decreasing order of the bound. Families whose Jacobian does not depend on z at fixed (x, y)
+and orientation (``column_invariant``, the 6-PSU) are evaluated once per (x, y) column.
+Every (voxel, orientation) pair is checked with the inverse kinematics and only the feasible
+ones count: all of them in a dexterous or constant workspace except voxel centres on its
+boundary to rounding (e.g. the 6-UPS base plane, the edge of its working mode), and in a
+reachable workspace only the orientations reachable at each voxel.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..poses import matrix_to_euler
+from ._linalg import KAPPA_BRACKET, sweep_bounds
+from .aggregate import _CHUNK, _ik_valid, _voxels
+from .force import _fmax, max_force_all_directions
+from .metrics import KAPPA_SINGULAR, CharacteristicLength, condition_number, resolve_length
+
+log = logging.getLogger(__name__)
+
+__all__ = ["WorstCase", "worst_case", "MAX_POSES"]
+
+#: Default cap on the number of (voxel or column) × orientation poses :func:`worst_case`
+#: evaluates (about 1.5 µs each, one byte of memory each).
+MAX_POSES = 50_000_000
+
+_EXACT_BATCH = 256
+_ROUND = 1e-6          # relative allowance for rounding in the κ bound of sweep_bounds
+_SINGULAR_BOUND = KAPPA_SINGULAR / KAPPA_BRACKET / (1 + _ROUND) ** 2   # may be singular
+
+
+@dataclass(frozen=True)
+class WorstCase:
+    """Worst κ and smallest all-direction force over a workspace grid × orientation set.
+
+    Attributes:
+        worst_kappa: largest κ(J_h) over every feasible (voxel, orientation) sample; ``inf``
+            when ``singular``; NaN only when ``status`` is not ``"ok"`` (``reason`` says why).
+        min_force: smallest force (N) held in every direction over those samples; 0.0 when
+            ``singular``; NaN only when ``status`` is not ``"ok"``.
+        singular: a singular pose lies inside the workspace (module docstring).
+        reason: why ``singular`` (which test fired, where), or why ``status`` is not ``"ok"``;
+            "" otherwise.
+        grid_max_kappa: largest κ at a sample (``inf`` only if a sample itself is singular):
+            the value ``worst_kappa`` takes when there is no singularity.
+        grid_min_force: smallest force (N) at a sample (0 only at a singular sample).
+        worst_kappa_pose: ``(6,)`` the sample with ``grid_max_kappa`` (mm, rad, Z-Y-X Euler).
+        min_force_pose: ``(6,)`` the sample with ``grid_min_force``.
+        singular_samples: samples singular by :func:`pkmlab.dexterity.is_singular`.
+        sign_changes: neighbouring sample pairs with opposite signs of ``det J``.
+        sign_change_poses: ``(2, 6)`` the first such pair (mm, rad), or ``None``: a singular
+            pose lies on the path between them.
+        pairs_checked: neighbouring sample pairs compared.
+        voxels, orientations: the grid: occupied voxels × sample orientations.
+        poses: Jacobians evaluated (voxels, or (x, y) columns, × orientations).
+        feasible: feasible (voxel, orientation) samples (inverse kinematics valid).
+        exact: poses whose κ was computed exactly (the others were bounded below the maximum).
+        L: characteristic length used (mm); ``length``: with its status and reason.
+        force_limit: ``(6,)`` actuator force limits (N).
+        method: one line: what was maximised over, and the singularity tests.
+        status: ``"ok"``, ``"empty"`` (nothing to evaluate) or ``"too large"`` (more poses
+            than ``max_poses``; nothing evaluated).
+        seconds: wall time.
+    """
+
+    worst_kappa: float
+    min_force: float
+    singular: bool
+    reason: str
+    grid_max_kappa: float
+    grid_min_force: float
+    worst_kappa_pose: np.ndarray
+    min_force_pose: np.ndarray
+    singular_samples: int
+    sign_changes: int
+    pairs_checked: int
+    voxels: int
+    orientations: int
+    poses: int
+    feasible: int
+    exact: int
+    L: float
+    force_limit: np.ndarray
+    method: str
+    status: str = "ok"
+    seconds: float = 0.0
+    length: CharacteristicLength | None = field(default=None, repr=False)
+    sign_change_poses: np.ndarray | None = None
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    def as_dict(self) -> dict:
+        """JSON-ready summary (non-finite numbers as ``None``, poses in mm and deg)."""
+        def fin(v):
+            return float(v) if math.isfinite(v) else None
+
+        def pose(X):
+            X = np.asarray(X, dtype=float)
+            if not np.all(np.isfinite(X)):
+                return None
+            return {"position_mm": X[:3].tolist(), "euler_zyx_deg": np.degrees(X[3:]).tolist()}
+
+        return {
+            "status": self.status, "worst_kappa": fin(self.worst_kappa),
+            "min_force_N": fin(self.min_force), "singular": bool(self.singular),
+            "reason": self.reason, "grid_max_kappa": fin(self.grid_max_kappa),
+            "grid_min_force_N": fin(self.grid_min_force),
+            "worst_kappa_pose": pose(self.worst_kappa_pose),
+            "min_force_pose": pose(self.min_force_pose),
+            "singular_samples": self.singular_samples, "sign_changes": self.sign_changes,
+            "pairs_checked": self.pairs_checked, "voxels": self.voxels,
+            "orientations": self.orientations, "poses": self.poses, "feasible": self.feasible,
+            "exact_kappa_evaluations": self.exact, "force_limit_N": self.force_limit.tolist(),
+            "characteristic_length": (self.length.as_dict() if self.length is not None
+                                      else {"length_mm": self.L}),
+            "sign_change_poses": (None if self.sign_change_poses is None else
+                                  [pose(X) for X in self.sign_change_poses]),
+            "method": self.method, "seconds": self.seconds,
+        }
+
+
+def _nan_result(status, reason, V, M, L, length, fmax, t0, method) -> WorstCase:
+    nan = float("nan")
+    return WorstCase(nan, nan, False, reason, nan, nan, np.full(6, nan), np.full(6, nan), 0, 0,
+                     0, V, M, 0, 0, 0, L, fmax, method, status, time.perf_counter() - t0,
+                     length)
+
+
+def _units(mech, result, idx, pos):
+    """Evaluation units: voxels, or (x, y) columns for column-invariant families.
+
+    Returns ``(unit_pos (U, 3), voxel_unit (V,), shared)``.
+    """
+    if mech.column_invariant and len(idx):
+        cols, inv = np.unique(idx[:, :2], axis=0, return_inverse=True)
+        inv = inv.ravel()
+        first = np.zeros(len(cols), dtype=np.int64)
+        first[inv[::-1]] = np.arange(len(idx))[::-1]
+        return pos[first], inv, True
+    return pos, np.arange(len(idx)), False
+
+
+def _spatial_pairs(result, idx, voxel_unit, shared) -> np.ndarray:
+    """``(P, 2)`` unit pairs of face-neighbouring occupied voxels (distinct units only)."""
+    shape = result.occupancy.shape
+    lut = np.full(shape, -1, dtype=np.int64)
+    lut[idx[:, 0], idx[:, 1], idx[:, 2]] = np.arange(len(idx))
+    out = []
+    for ax in range(2 if shared else 3):          # J does not depend on z: no z pairs
+        inside = idx[:, ax] + 1 < shape[ax]
+        a = np.flatnonzero(inside)
+        nb = idx[a].copy()
+        nb[:, ax] += 1
+        b = lut[nb[:, 0], nb[:, 1], nb[:, 2]]
+        keep = b >= 0
+        out.append(np.stack([voxel_unit[a[keep]], voxel_unit[b[keep]]], axis=1))
+    pairs = np.concatenate(out) if out else np.empty((0, 2), dtype=np.int64)
+    if shared and len(pairs):
+        pairs = np.unique(pairs, axis=0)
+    return pairs
+
+
+def _orientation_pairs(oset) -> np.ndarray:
+    """``(Q, 2)`` sample pairs one step apart in one set coordinate, the others equal."""
+    P = np.round(oset.parameters(), 12)
+    out = []
+    for c in range(3):
+        others = [k for k in range(3) if k != c]
+        order = np.lexsort((P[:, c], P[:, others[1]], P[:, others[0]]))
+        a, b = order[:-1], order[1:]
+        same = np.all(P[a][:, others] == P[b][:, others], axis=1) & (P[a, c] != P[b, c])
+        out.append(np.stack([a[same], b[same]], axis=1))
+    return np.concatenate(out) if out else np.empty((0, 2), dtype=np.int64)
+
+
+def _pose(p, R) -> np.ndarray:
+    return np.concatenate([p, matrix_to_euler(R[None])[0]])
+
+
+def worst_case(mech, result, L: float | CharacteristicLength | None = None,
+               force_limit=150.0, *, max_poses: int = MAX_POSES) -> WorstCase:
+    """Worst κ, smallest all-direction force and any singularity over a whole workspace.
+
+    Every occupied voxel centre × every sample orientation of ``result`` is evaluated (module
+    docstring): the values are extremes of that grid, and ``singular`` also detects singular
+    poses *between* neighbouring samples through sign changes of ``det J``.
+
+    Args:
+        mech: the mechanism of ``result``: its inverse kinematics decides feasibility, so pass
+            ``result.mechanism`` when the request overrode the stroke window.
+        result: a :class:`pkmlab.workspaces.WorkspaceResult`.
+        L: characteristic length (mm) for κ; default :func:`pkmlab.dexterity.resolve_length`
+            (Angeles'), recorded with its status in ``length``.
+        force_limit: actuator force limit(s) in N, scalar or ``(6,)``.
+        max_poses: refuse (``status="too large"``, nothing evaluated) above this many
+            Jacobian evaluations.
+
+    Returns:
+        :class:`WorstCase`. Never raises for a numerical reason.
+    """
+    t0 = time.perf_counter()
+    length = resolve_length(mech, L)
+    L = length.length
+    fmax = _fmax(force_limit, 6)
+    idx, pos = _voxels(result)
+    Rs = result.orientations.rotations()
+    V, M = len(pos), len(Rs)
+    unit_pos, voxel_unit, shared = _units(mech, result, idx, pos)
+    U = len(unit_pos)
+    where = (f"{V:,} voxels × {M:,} orientations" + (f" ({U:,} (x, y) columns: J does not "
+                                                     "depend on z)" if shared else ""))
+    if V == 0 or M == 0:
+        return _nan_result("empty", "the workspace is empty: nothing to evaluate", V, M, L,
+                           length, fmax, t0, f"max over {where}")
+    if U * M > max_poses:
+        reason = (f"{U:,} × {M:,} = {U * M:,} poses exceed max_poses = {max_poses:,}: use a "
+                  "coarser resolution or fewer orientation samples, or raise max_poses")
+        log.warning("worst_case: %s", reason)
+        return _nan_result("too large", reason, V, M, L, length, fmax, t0, f"max over {where}")
+
+    # feasibility of every (voxel, orientation) pair; a unit is feasible if one of its voxels is
+    feas = np.zeros((U, M), dtype=bool)
+    n_feasible = 0
+    step = max(1, _CHUNK // V)
+    for m0 in range(0, M, step):
+        Rm = Rs[m0:m0 + step]
+        k = len(Rm)
+        ok = _ik_valid(mech, np.tile(pos, (k, 1)), np.repeat(Rm, V, axis=0)).reshape(k, V)
+        n_feasible += int(ok.sum())
+        rows, cols = np.nonzero(ok)
+        feas[voxel_unit[cols], m0 + rows] = True
+    if n_feasible < V * M:
+        log.debug("worst_case: %d of %d (voxel, orientation) samples infeasible",
+                  V * M - n_feasible, V * M)
+
+    sign = np.zeros((U, M), dtype=np.int8)            # sign of det J; 0: singular or infeasible
+    cand_idx, cand_up = [], []                        # poses whose κ bound may be the maximum
+    lower = -math.inf                                 # largest certified lower bound on κ
+    f_min, f_arg = math.inf, None
+    step = max(1, _CHUNK // U)
+    for m0 in range(0, M, step):
+        Rm = Rs[m0:m0 + step]
+        k = len(Rm)
+        J = mech.jacobian((np.tile(unit_pos, (k, 1)), np.repeat(Rm, U, axis=0)))
+        kup = np.empty(k * U)
+        force = np.empty(k * U)
+        det = np.empty(k * U)
+        sweep_bounds(np.ascontiguousarray(J), L, fmax, kup, force, det)
+        kup, force, det = (a.reshape(k, U).T for a in (kup, force, det))
+        fe = feas[:, m0:m0 + k]
+        kup = np.where(fe, kup, -np.inf)
+        force = np.where(fe, force, np.inf)
+        det = np.where(fe, det, 0.0)
+        # rounding allowance of the bound; above 1e8 it may exceed it: treat as unbounded
+        up = np.where(kup > 1e8, np.inf, kup * (1 + _ROUND))
+        fin = np.isfinite(up)
+        if fin.any():
+            lower = max(lower, float(up[fin].max()) / KAPPA_BRACKET / (1 + _ROUND) ** 2)
+        sel = np.argwhere(up >= min(lower, _SINGULAR_BOUND))
+        cand_idx.append(sel[:, 0] * M + m0 + sel[:, 1])
+        cand_up.append(up[sel[:, 0], sel[:, 1]])
+        fc = np.where(np.isnan(force), np.inf, force)  # NaN: J not finite (singular sample)
+        j = int(np.argmin(fc))
+        if fc.flat[j] < f_min:
+            f_min, f_arg = float(fc.flat[j]), (j // k, m0 + j % k)
+        sign[:, m0:m0 + k] = np.sign(np.nan_to_num(det, nan=0.0)).astype(np.int8)
+    cand_idx, cand_up = np.concatenate(cand_idx), np.concatenate(cand_up)
+    keep = cand_up >= min(lower, _SINGULAR_BOUND)
+
+    # exact κ where the bound reaches the maximum (decreasing bound, stop once below it)
+    kmax, k_arg, exact, n_sing = _exact_max(mech, unit_pos, Rs, cand_idx[keep], cand_up[keep],
+                                            L)
+
+    # sign changes of det J between neighbours
+    spatial = _spatial_pairs(result, idx, voxel_unit, shared)
+    s = sign
+    changes = 0
+    example = ""
+    example_poses = None
+    n_pairs = 0
+    if len(spatial):
+        prod = s[spatial[:, 0]].astype(np.int16) * s[spatial[:, 1]]
+        n_pairs += int(np.sum((s[spatial[:, 0]] != 0) & (s[spatial[:, 1]] != 0)))
+        hit = prod < 0
+        changes += int(hit.sum())
+        if hit.any():
+            q, m = np.argwhere(hit)[0]
+            a, b = unit_pos[spatial[q, 0]], unit_pos[spatial[q, 1]]
+            e = np.degrees(matrix_to_euler(Rs[m][None])[0])
+            example = (f"between positions {np.round(a, 3).tolist()} and "
+                       f"{np.round(b, 3).tolist()} mm at orientation "
+                       f"{np.round(e, 3).tolist()} deg (Z-Y-X Euler)")
+            example_poses = np.stack([_pose(a, Rs[m]), _pose(b, Rs[m])])
+    opairs = _orientation_pairs(result.orientations)
+    if len(opairs):
+        sa, sb = s[:, opairs[:, 0]], s[:, opairs[:, 1]]
+        n_pairs += int(np.sum((sa != 0) & (sb != 0)))
+        hit = sa.astype(np.int16) * sb < 0
+        changes += int(hit.sum())
+        if hit.any() and not example:
+            u, q = np.argwhere(hit)[0]
+            e = np.degrees(matrix_to_euler(Rs[list(opairs[q])]))
+            example = (f"at position {np.round(unit_pos[u], 3).tolist()} mm between "
+                       f"orientations {np.round(e[0], 3).tolist()} and "
+                       f"{np.round(e[1], 3).tolist()} deg (Z-Y-X Euler)")
+            example_poses = np.stack([_pose(unit_pos[u], Rs[opairs[q, 0]]),
+                                      _pose(unit_pos[u], Rs[opairs[q, 1]])])
+
+    singular = n_sing > 0 or changes > 0
+    reasons = []
+    if n_sing:
+        reasons.append(f"{n_sing:,} sample(s) singular (κ >= {KAPPA_SINGULAR:.0e} or J not "
+                       "finite)")
+    if changes:
+        reasons.append(f"det J changes sign between {changes:,} pair(s) of neighbouring "
+                       f"samples, first {example}: a singular pose lies between them")
+    if k_arg is None:                                 # no feasible sample (cannot happen)
+        kmax, kpose = math.nan, np.full(6, np.nan)
+    else:
+        kpose = _pose(unit_pos[k_arg[0]], Rs[k_arg[1]])
+    if f_arg is None:                                 # every sample has a non-finite J
+        f_exact, fpose = 0.0, np.full(6, np.nan)
+    else:
+        fu, fm = f_arg
+        fpose = _pose(unit_pos[fu], Rs[fm])
+        # report the library's own value at that pose (same rule, same L)
+        f_exact = float(max_force_all_directions(
+            mech.jacobian((unit_pos[fu][None], Rs[fm][None])), fmax, L)[0])
+        if not math.isfinite(f_exact):
+            f_exact = 0.0
+    method = (f"max over {where} = {U * M:,} poses, {n_feasible:,} of {V * M:,} (voxel, "
+              f"orientation) samples feasible; exact κ at {exact:,} poses (the others bounded "
+              f"below the maximum); singular: κ = inf at a sample, or det J changes sign "
+              f"across {n_pairs:,} neighbouring sample pairs")
+    res = WorstCase(
+        worst_kappa=math.inf if singular else kmax, min_force=0.0 if singular else f_exact,
+        singular=singular, reason="; ".join(reasons), grid_max_kappa=kmax,
+        grid_min_force=f_exact, worst_kappa_pose=kpose, min_force_pose=fpose,
+        singular_samples=n_sing, sign_changes=changes, pairs_checked=n_pairs, voxels=V,
+        orientations=M, poses=U * M, feasible=n_feasible, exact=exact, L=L, force_limit=fmax,
+        method=method, status="ok", seconds=time.perf_counter() - t0, length=length,
+        sign_change_poses=example_poses)
+    log.debug("worst_case: κ %.6g, force %.6g N, singular %s, %.3f s (%s)", res.worst_kappa,
+              res.min_force, singular, res.seconds, method)
+    return res
+
+
+def _exact_max(mech, unit_pos, Rs, cand, up, L):
+    """Largest exact κ over the candidate poses ``cand`` (flat ``unit · M + orientation``)
+    with bounds ``up``.
+
+    The candidates are the poses whose bound reaches the largest certified lower bound (any
+    other pose is certainly below the maximum) or :data:`_SINGULAR_BOUND`. They are evaluated
+    in decreasing order of the bound until the next bound is below the best exact κ — except
+    that every candidate that may be singular is evaluated, so singular samples are all counted.
+
+    Returns ``(kmax, (unit, orientation), exact evaluations, singular samples)``.
+    """
+    M = len(Rs)
+    order = np.argsort(-up, kind="stable")
+    cand, up = cand[order], up[order]
+    best, arg, exact, n_sing = -math.inf, None, 0, 0
+    for b0 in range(0, len(cand), _EXACT_BATCH):
+        if up[b0] < best and up[b0] < _SINGULAR_BOUND:
+            break
+        c = cand[b0:b0 + _EXACT_BATCH]
+        u, m = c // M, c % M
+        kap = condition_number(mech.jacobian((unit_pos[u], Rs[m])), L)
+        exact += len(c)
+        n_sing += int(np.sum(~np.isfinite(kap)))
+        j = int(np.argmax(kap))
+        if kap[j] > best:
+            best, arg = float(kap[j]), (int(u[j]), int(m[j]))
+    return best, arg, exact, n_sing
