@@ -343,3 +343,30 @@ def test_usage_errors_are_one_line_with_exit_2(args):
     r = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True)
     assert r.returncode == 2, r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and r.stderr.startswith("error: ")
+
+
+def test_study_worst_kappa_is_the_workspace_worst_not_a_random_samples(tmp_path):
+    """The 6-UPS layout that passed worst_kappa <= 50 with a 500-pose sample has a singularity
+    inside its ±10° dexterous workspace: the study metric now says so."""
+    ups = MECH_DIR / "gough-stewart-6ups.yaml"
+    over = {"base_points": None, "platform_points": None,
+            "generator": {"base_radii": ["240 mm", "400 mm"], "platform_radii": [90, 90],
+                          "base_pair_angle": "90 deg", "platform_rotation": "60 deg",
+                          "base_pair_separation": "10 deg",
+                          "platform_pair_separation": "10 deg"}}
+    data = study(tmp_path, mechanism={"file": str(ups), "overrides": over},
+                 design={"base_outer_radius": {"low": "380 mm", "high": "420 mm"}},
+                 evaluate={"workspace": {**WS, "box": ["10 deg"] * 3, "samples": 3,
+                                         "resolution": "20 mm"},
+                           "dexterity": {"gci_samples": 500}},
+                 constraints=[{"worst_kappa": {"max": 50}}, {"singularity_free": True}])
+    s = load_study(write(tmp_path, data))
+    rec = ev_mod.evaluate_design(s.space, None, s.evaluation, 4)
+    assert rec["status"] == "ok", rec["reason"]
+    m = rec["metrics"]
+    assert m["sampled_max_kappa"] < 1e6                       # what the old metric reported
+    assert m["worst_kappa"] is None and "singular" in rec["notes"]["worst_kappa"]
+    assert m["singularity_free"] == 0.0 and m["min_force"] == 0.0
+    from pkmlab.study.run import feasible
+
+    assert not feasible(s, [{"status": "ok", "metrics": m}])[0]

@@ -187,11 +187,6 @@ class GCIResult:
         m = self.sampled_min_lci
         return float("nan") if not math.isfinite(m) else (math.inf if m == 0 else 1.0 / m)
 
-    @property
-    def lci_min(self) -> float:
-        """Deprecated alias of :attr:`sampled_min_lci` (kept for existing callers)."""
-        return self.sampled_min_lci
-
 
 def _summarise(values: np.ndarray, rejected: int, method: str,
                length: CharacteristicLength) -> GCIResult:
@@ -281,7 +276,8 @@ def sample_poses(result, samples: int, rng: np.random.Generator):
 
 
 def gci_monte_carlo(mech, result, L: float | CharacteristicLength | None = None,
-                    samples: int = 2000, seed: int | None = 0) -> GCIResult:
+                    samples: int = 2000, seed: int | None = 0, *,
+                    poses: tuple[np.ndarray, np.ndarray] | None = None) -> GCIResult:
     """GCI by Monte Carlo over the workspace volume × orientation set.
 
     Positions: an occupied voxel chosen uniformly (all have volume h³), then a point uniform
@@ -297,11 +293,18 @@ def gci_monte_carlo(mech, result, L: float | CharacteristicLength | None = None,
         L: characteristic length in mm; default :func:`pkmlab.dexterity.resolve_length`.
         samples: number of poses drawn (≥ 1).
         seed: seed of ``numpy.random.default_rng``.
+        poses: the sample ``(p (n, 3), R (n, 3, 3))`` to use instead of drawing one (from
+            :func:`sample_poses`), so that several Monte-Carlo statistics share one sample.
 
     Returns:
         :class:`GCIResult` with ``method='monte-carlo'``.
     """
     length = resolve_length(mech, L)
+    if poses is not None:
+        p, R = poses
+        valid = _ik_valid(mech, p, R)
+        vals = lci(mech.jacobian((p[valid], R[valid])), length.length)
+        return _summarise(vals, len(p) - len(vals), "monte-carlo", length)
     samples = int(samples)
     if samples < 1:
         raise ParameterError("samples", "an integer >= 1", samples)

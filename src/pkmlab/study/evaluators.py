@@ -156,18 +156,14 @@ def _capability(mech, ctx: Context) -> dict:
 @_evaluator("dexterity")
 def _dexterity(mech, ctx: Context) -> dict:
     plan, res = ctx.evaluation.dexterity, ctx.result
-    if plan.characteristic_length is not None:
-        L = plan.characteristic_length
-    else:
-        cl = dx.characteristic_length(mech)
-        if not cl.ok:
-            raise NumericalError("characteristic length", "Angeles' length is undefined: the "
-                                 "Jacobian is singular or undefined at the nominal pose")
-        L = cl.length
+    length = dx.resolve_length(mech, plan.characteristic_length)
+    if length.status == "fallback":
+        raise NumericalError("characteristic length", length.reason)
+    L = length.length
     ctx.L = L
+    J0 = mech.jacobian(mech.nominal_pose)
     out = {"characteristic_length": float(L),
-           "nominal_kappa": _finite(dx.condition_number(mech.jacobian(mech.nominal_pose),
-                                                        L)[0])}
+           "nominal_kappa": _finite(dx.condition_number(J0, L)[0])}
     if out["nominal_kappa"] is None:
         ctx.notes["nominal_kappa"] = "singular at the nominal pose"
     names = ("worst_kappa", "min_force", "singularity_free", "gci", "gci_std_error",
@@ -177,24 +173,28 @@ def _dexterity(mech, ctx: Context) -> dict:
             ctx.notes[n] = "workspace empty"
         out.update(dict.fromkeys(names))
         return out
-    wc = dx.worst_case(mech, res, L, plan.force_limit)
+    wc = dx.worst_case(res.mechanism, res, length, plan.force_limit)
+    if wc.status != "ok":
+        raise NumericalError("worst case over the workspace", wc.reason)
     out["worst_kappa"] = _finite(wc.worst_kappa)
     out["min_force"] = float(wc.min_force)
     out["singularity_free"] = float(not wc.singular)
-    if out["worst_kappa"] is None:
-        ctx.notes["worst_kappa"] = f"singular pose inside the workspace ({wc.method})"
-    g = dx.gci_monte_carlo(mech, res, L, samples=plan.gci_samples, seed=ctx.seed)
+    if wc.singular:
+        ctx.notes["worst_kappa"] = f"singular pose inside the workspace: {wc.reason}"
+    # one Monte-Carlo sample serves every sampled statistic
+    p, R = dx.aggregate.sample_poses(res, plan.gci_samples, np.random.default_rng(ctx.seed))
+    g = dx.gci_monte_carlo(mech, res, length, poses=(p, R))
     out["gci"] = g.gci if g.ok else None
     out["gci_std_error"] = _finite(g.std_error) if g.ok else None
-    out["sampled_max_kappa"] = _finite(1.0 / g.lci_min) if g.ok and g.lci_min > 0 else None
-    rng = np.random.default_rng(ctx.seed)
-    p, R = dx.aggregate.sample_poses(res, plan.gci_samples, rng)
+    out["sampled_max_kappa"] = _finite(g.sampled_max_kappa) if g.ok else None
     valid = mech.inverse((p, R)).valid
-    F = dx.max_force_all_directions(mech.jacobian((p[valid], R[valid])), plan.force_limit)
-    out["sampled_min_force"] = float(np.nanmin(F)) if len(F) else None
+    F = dx.max_force_all_directions(mech.jacobian((p[valid], R[valid])), plan.force_limit,
+                                    L=L)
+    out["sampled_min_force"] = float(np.min(F)) if len(F) else None
     for n in ("gci", "gci_std_error", "sampled_max_kappa", "sampled_min_force"):
         if out[n] is None:
-            ctx.notes[n] = "no valid Monte-Carlo pose"
+            ctx.notes.setdefault(n, "a sampled pose is singular" if g.ok and
+                                 n == "sampled_max_kappa" else "no valid Monte-Carlo pose")
     return out
 
 

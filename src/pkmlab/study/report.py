@@ -11,7 +11,6 @@ import csv
 import io
 import json
 import logging
-import math
 import platform
 import time
 from pathlib import Path
@@ -272,10 +271,9 @@ def _export_one(d: Path, study: Study, r: dict, rank: int) -> None:
     if res.empty:
         return
     res.save_mesh(d / "workspace.stl")
-    L = r["metrics"].get("characteristic_length") or dx.characteristic_length(mech).length
-    if not (L and math.isfinite(L)):
-        return
-    mm = metric_map(mech, res, "kappa", L)
+    length = dx.resolve_length(mech, r["metrics"].get("characteristic_length"))
+    L = length.length
+    mm = metric_map(mech, res, "kappa", length)
     fig = slice_figure(res, window=ws.slice_window, spacing=ws.slice_spacing,
                        values=np.where(np.isfinite(mm.grid), mm.grid, np.nan),
                        label=f"{mm.label}, L = {L:.4g} mm")

@@ -12,7 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSchema
 
 from .. import limits
 from ..config import mechanism_spec, read_yaml, validate_model, workspace_spec
@@ -85,7 +85,10 @@ def _auto_length(v: Any) -> float | None:
 
 
 class DexteritySpec(_Model):
-    characteristic_length: Annotated[float | None, BeforeValidator(_auto_length)] = Field(
+    characteristic_length: Annotated[float | None, BeforeValidator(_auto_length),
+                                     WithJsonSchema({"anyOf": [{"const": "auto"},
+                                                               {"type": "number"},
+                                                               {"type": "string"}]})] = Field(
         None, description="'auto' (Angeles' length, the default) or a length > 0")
     gci_samples: int = Field(2000, ge=limits.GCI_SAMPLES[0], le=limits.GCI_SAMPLES[1])
     force_limit: float = Field(150.0, gt=0, allow_inf_nan=False,
