@@ -1,0 +1,84 @@
+"""Command-line interface (typer). Speaks mm and degrees; the library speaks mm and radians.
+
+JSON output (``--json``) uses these keys throughout:
+
+* a pose is ``{"x": mm, "y": mm, "z": mm, "theta_x": deg, "theta_y": deg, "theta_z": deg}``
+  (Z-Y-X Euler angles, R = Rz·Ry·Rx, of the tool frame in the base frame);
+* actuator values are ``{"<name>": mm, ...}`` keyed by the family's actuator names
+  (``q1``..``q6``, or ``l11``..``l32`` for ``luzi3``).
+
+Errors in the input print one line naming the field, the allowed values and the value given,
+and exit with status 2.
+"""
+
+from __future__ import annotations
+
+import sys
+from typing import Annotated
+
+import typer
+
+from . import analysis, kinematics, study, workspace  # noqa: F401 - registers the commands
+from .common import app
+
+__all__ = ["app", "main"]
+
+
+_DEBUG = {"on": False}
+
+
+def _version(value: bool) -> None:
+    if value:
+        from .. import __version__
+
+        sys.stdout.write(f"pkmlab {__version__}\n")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    debug: Annotated[bool, typer.Option(
+        "--debug", help="show the full traceback of an unexpected error")] = False,
+    version: Annotated[bool | None, typer.Option(
+        "--version", callback=_version, is_eager=True, help="print the version and exit")]
+    = None,
+) -> None:
+    """pkmlab: design-optimisation workbench for parallel manipulators."""
+    _DEBUG["on"] = debug
+
+
+def main() -> None:
+    """Console entry point: input errors exit 2 (one line); a file-system error exits 2 with
+    its path; a candidate's programming error exits 1 with its traceback and parameters; any
+    other unexpected error exits 1 with one line (``--debug``: the traceback)."""
+    from ..study.run import CandidateError
+
+    try:
+        code = app(standalone_mode=False)      # click returns an Exit's code in this mode
+        raise SystemExit(code if isinstance(code, int) else 0)
+    except typer.Exit as exc:
+        raise SystemExit(exc.exit_code) from None
+    except typer.TyperException as exc:           # a usage error: one line, exit 2
+        ctx = getattr(exc, "ctx", None)
+        sys.stderr.write(f"error: {exc.format_message()}"
+                         + (f" (see: {ctx.command_path} --help)" if ctx is not None
+                            else "") + "\n")
+        raise SystemExit(2) from None
+    except (typer.Abort, KeyboardInterrupt):
+        sys.stderr.write("interrupted\n")
+        raise SystemExit(130) from None
+    except CandidateError as exc:
+        sys.stderr.write(f"error: {exc}\n")
+        raise SystemExit(1) from None
+    except OSError as exc:
+        if _DEBUG["on"]:
+            raise
+        where = f" ({exc.filename})" if getattr(exc, "filename", None) else ""
+        sys.stderr.write(f"error: file system: {exc.strerror or exc}{where}\n")
+        raise SystemExit(2) from None
+    except Exception as exc:  # noqa: BLE001 - last resort: one line unless --debug
+        if _DEBUG["on"]:
+            raise
+        sys.stderr.write(f"error: {type(exc).__name__}: {exc} (this is a bug in pkmlab; run "
+                         "with --debug for the traceback)\n")
+        raise SystemExit(1) from None

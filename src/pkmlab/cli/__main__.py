@@ -1,0 +1,5 @@
+"""``python -m pkmlab.cli``."""
+
+from . import main
+
+main()

@@ -1,0 +1,350 @@
+"""Analysis commands: dexterity, trajectory, compare."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.markup import escape
+
+from ..errors import ParameterError
+from ..units import parse_length
+from .common import (
+    AllComponentsOpt,
+    BoxOpt,
+    JointLimitOpt,
+    JsonOpt,
+    KappaMaxOpt,
+    KindOpt,
+    LinkDiameterOpt,
+    MechArg,
+    OrientationOpt,
+    ResolutionOpt,
+    SamplesOpt,
+    SemanticsOpt,
+    StrokeOpt,
+    TiltOpt,
+    TorsionOpt,
+    _emit,
+    _fail,
+    _kappa_text,
+    _load,
+    _pose_str,
+    _request,
+    app,
+    out,
+)
+from .study import _open_results
+
+
+@app.command()
+def dexterity(
+    mech_file: MechArg,
+    kind: KindOpt = "dexterous",
+    orientation: OrientationOpt = None,
+    box: BoxOpt = "15,15,15",
+    semantics: SemanticsOpt = "simultaneous",
+    tilt: TiltOpt = None,
+    torsion: TorsionOpt = "0",
+    samples: SamplesOpt = 7,
+    resolution: ResolutionOpt = "2.5",
+    link_diameter: LinkDiameterOpt = None,
+    joint_limit: JointLimitOpt = None,
+    kappa_max: KappaMaxOpt = None,
+    all_components: AllComponentsOpt = False,
+    stroke: StrokeOpt = None,
+    metric: Annotated[str, typer.Option(help="map: kappa | lci | force | stiffness")]
+    = "kappa",
+    characteristic_length: Annotated[str, typer.Option(
+        help="L for κ: a length, or 'auto' (Angeles: the L minimising κ at nominal)")]
+    = "auto",
+    well_conditioned: Annotated[float, typer.Option(
+        help="κ bound of the well-conditioned sub-workspace")] = 10.0,
+    force_limit: Annotated[float, typer.Option(help="actuator force limit (N)")] = 150.0,
+    force_required: Annotated[float, typer.Option(
+        help="force (N) the platform must hold in every direction: its sub-workspace")]
+    = 100.0,
+    actuator_stiffness: Annotated[float, typer.Option(help="actuator stiffness (N/mm)")]
+    = 1.0e4,
+    gci_samples: Annotated[int, typer.Option(help="Monte-Carlo GCI samples")] = 2000,
+    seed: Annotated[int, typer.Option(help="Monte-Carlo seed")] = 0,
+    out_dir: Annotated[Path, typer.Option("--out", help="output folder")]
+    = Path("results/dexterity"),
+    as_json: JsonOpt = False,
+) -> None:
+    """Conditioning, force and stiffness at the nominal pose and over a workspace.
+
+    The analysis is pkmlab.dexterity.report.dexterity_report. Writes dexterity.json,
+    <metric>_slices.png and workspace_<metric>.ply/.glb (the workspace mesh coloured by the
+    metric's worst value over the orientation set) into --out.
+    """
+    import shutil
+    import tempfile
+
+    from ..dexterity.maps import METRICS, mesh_colours
+    from ..dexterity.report import dexterity_report
+    from ..workspaces.plots import slice_figure
+
+    mech = _load(mech_file)
+    spec, req = _request(kind, orientation, box, semantics, tilt, torsion, samples, resolution,
+                         link_diameter, joint_limit, kappa_max, all_components, stroke)
+    if metric not in METRICS:
+        _fail(ParameterError("--metric", f"one of {list(METRICS)}", metric))
+    L = None
+    if characteristic_length.strip().lower() != "auto":
+        try:
+            L = parse_length(characteristic_length, "--characteristic-length")
+        except ParameterError as exc:
+            _fail(exc)
+        if not L > 0:
+            _fail(ParameterError("--characteristic-length", "a length > 0 mm or 'auto'",
+                                 characteristic_length))
+    for name, v, lo in (("--force-limit", force_limit, 0), ("--actuator-stiffness",
+                                                              actuator_stiffness, 0),
+                        ("--well-conditioned", well_conditioned, 1),
+                        ("--force-required", force_required, 0)):
+        if not (math.isfinite(v) and v > lo):
+            _fail(ParameterError(name, f"a number > {lo}", v))
+    if not 10 <= gci_samples <= 10_000_000:
+        _fail(ParameterError("--gci-samples", "an integer in [10, 10000000]", gci_samples))
+
+    try:
+        rep = dexterity_report(mech, req, L=L, metric=metric,
+                               well_conditioned=well_conditioned, force_limit=force_limit,
+                               force_required=force_required,
+                               actuator_stiffness=actuator_stiffness, gci_samples=gci_samples,
+                               seed=seed)
+    except ParameterError as exc:
+        _fail(exc)
+    res, mmap, report = rep.result, rep.map, rep.data
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    with tempfile.TemporaryDirectory(dir=out_dir, prefix=".partial-") as tmp:
+        tmp = Path(tmp)
+        files = [tmp / "dexterity.json"]
+        files[0].write_text(json.dumps(report, indent=2, default=float) + "\n")
+        if mmap is not None:
+            vals = np.where(np.isfinite(mmap.grid), mmap.grid, np.nan)
+            fig = slice_figure(res, window=spec.slice_window, spacing=spec.slice_spacing,
+                               values=vals, label=mmap.label)
+            files.append(tmp / f"{metric}_slices.png")
+            fig.savefig(files[-1], dpi=120)
+            m = res.mesh()
+            m.visual.vertex_colors = mesh_colours(m, mmap)
+            for fmt in ("ply", "glb"):
+                files.append(tmp / f"workspace_{metric}.{fmt}")
+                m.export(files[-1])
+        for f in files:
+            shutil.move(str(f), out_dir / f.name)
+            written.append(out_dir / f.name)
+    if as_json:
+        report["files"] = [str(p) for p in written]
+        _emit(report)
+        return
+    _print_dexterity(rep, force_limit, well_conditioned, force_required, written)
+
+
+def _print_dexterity(rep, force_limit, well_conditioned, force_required, written) -> None:
+    """Text output of ``dexterity`` (everything printed is in ``rep.data``)."""
+    def g(v, fmt):
+        return "—" if v is None else format(v, fmt)
+
+    d, mech = rep.data, rep.mechanism
+    n, agg, cl = d["nominal"], d["aggregates"], d["characteristic_length"]
+    out.print(f"[bold]{escape(mech.name or mech.family)}[/] at the nominal pose "
+              f"{_pose_str(mech.nominal_pose)}:")
+    out.print(escape(f"  {_kappa_text(n)}, LCI = {n['lci']:.4f}, σ_min = "
+                     f"{g(n['sigma_min'], '.4g')}; singularity: {n['singularity']}"),
+              highlight=False)
+    if cl["status"] not in ("angeles", "given"):
+        out.print(escape(f"  note: {cl['reason']}"), highlight=False)
+    moment = n["moment_all_directions_Nmm"]
+    out.print(f"  force in every direction {g(n['force_all_directions_N'], '.1f')} N, moment "
+              f"{g(None if moment is None else moment / 1e3, '.2f')} "
+              f"N·m (actuators ±{force_limit:g} N); stiffness ≥ "
+              f"{g(n['stiffness_translational_min_N_per_mm'], '.0f')} N/mm")
+    if agg["empty"]:
+        out.print("  workspace: [bold]empty[/] — no aggregates")
+    else:
+        k, w = agg["kappa"], agg["worst_case"]
+        out.print(f"  over the {rep.result.kind} workspace ({agg['workspace_volume_cm3']:.2f} "
+                  f"cm³): GCI {g(agg['gci_grid'], '.4f')} (every voxel × orientation), "
+                  f"{g(agg['gci_monte_carlo'], '.4f')} ± "
+                  f"{g(agg['gci_monte_carlo_std_error'], '.4f')} (Monte-Carlo, "
+                  f"{agg['gci_samples']} samples)")
+        worst = "inf" if w["worst_kappa"] is None else f"{w['worst_kappa']:.4g}"
+        out.print(f"  worst case over every voxel × orientation: κ {worst}, force "
+                  f"{g(w['min_force_N'], '.1f')} N"
+                  + ("" if not w["singular"] else escape(f" — singular: {w['reason']}")),
+                  highlight=False)
+        out.print(f"  κ min {g(k['min'], '.3g')}, mean {g(k['mean'], '.3g')}, p95 "
+                  f"{g(k['p95'], '.3g')}; κ ≤ {well_conditioned:g} in "
+                  f"{agg['well_conditioned_volume_cm3']:.2f} cm³ "
+                  f"({100 * agg['well_conditioned_fraction']:.1f} %)")
+        f = agg["force_all_directions_N"]
+        out.print(f"  force held in every direction: min {f['min']:.1f} N, median "
+                  f"{f['p50']:.1f} N; ≥ {force_required:g} N in "
+                  f"{agg['force_capable_volume_cm3']:.2f} cm³")
+    for p in written:
+        out.print(f"  wrote {escape(str(p))}")
+
+
+@app.command()
+def trajectory(
+    mech_file: MechArg,
+    csv: Annotated[Path | None, typer.Option(
+        help="CSV with t,x,y,z,theta_x,theta_y,theta_z (s, mm, deg)")] = None,
+    paper_motion: Annotated[bool, typer.Option(
+        "--paper-motion", help="Hopkins & Williams' motion: ±2 in in x, y, z then ±30° in "
+        "θz, θy, θx, one after the other")] = False,
+    segment_time: Annotated[float, typer.Option(help="paper motion: s per cubic segment")]
+    = 1.0,
+    payload: Annotated[float, typer.Option(help="payload mass (kg) at the tool point")] = 0.0,
+    max_speed: Annotated[float | None, typer.Option(help="actuator speed limit (mm/s)")]
+    = None,
+    max_force: Annotated[float | None, typer.Option(help="actuator force limit (N)")] = 150.0,
+    out_dir: Annotated[Path, typer.Option("--out", help="output folder")]
+    = Path("results/trajectory"),
+    as_json: JsonOpt = False,
+) -> None:
+    """Actuator values, rates and forces along a trajectory, checked against the limits.
+
+    Writes trajectory.json, trajectory.csv and actuators.png into --out.
+    """
+    import shutil
+    import tempfile
+
+    from .. import trajectory as tr
+
+    mech = _load(mech_file)
+    if (csv is None) == (not paper_motion):
+        _fail(ParameterError("--csv / --paper-motion", "exactly one of them", "both"
+                             if paper_motion else "neither"))
+    try:
+        if csv is not None:
+            t, poses = tr.load_csv(csv)
+        else:
+            t, poses = tr.paper_motion(mech, segment_time=segment_time)
+        rep = tr.check_trajectory(mech, t, poses, payload_mass_kg=payload,
+                                  max_speed=max_speed, max_force=max_force)
+    except ParameterError as exc:
+        _fail(exc)
+    summary = rep.summary()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    with tempfile.TemporaryDirectory(dir=out_dir, prefix=".partial-") as tmp:
+        tmp = Path(tmp)
+        (tmp / "trajectory.json").write_text(json.dumps(summary, indent=2, default=float)
+                                             + "\n")
+        names = mech.actuator_names
+        header = ",".join(["t", *[f"{n}_mm" for n in names], *[f"{n}_rate_mm_s" for n in names],
+                           *[f"{n}_force_N" for n in names], "status"])
+        rows = [",".join([f"{t[i]:.6g}", *[f"{v:.6g}" for v in rep.q[i]],
+                          *[f"{v:.6g}" for v in rep.qdot[i]], *[f"{v:.6g}" for v in
+                                                               rep.force[i]], str(rep.status[i])])
+                for i in range(len(t))]
+        (tmp / "trajectory.csv").write_text(header + "\n" + "\n".join(rows) + "\n")
+        phases = tr.paper_motion_phases(segment_time) if paper_motion else None
+        tr.plot_actuators(rep, tmp / "actuators.png", title=f"{mech.name}: actuator values",
+                          phases=phases)
+        for name in ("trajectory.json", "trajectory.csv", "actuators.png"):
+            shutil.move(str(tmp / name), out_dir / name)
+            written.append(out_dir / name)
+    if as_json:
+        summary["files"] = [str(p) for p in written]
+        _emit(summary)
+        return
+    verdict = "[bold green]fits[/]" if rep.fits else "[bold red]does not fit[/]"
+    out.print(f"{escape(mech.name or mech.family)}: {len(t)} samples over {t[-1] - t[0]:.2f} s "
+              f"— {verdict} the limits")
+    for kind, v in rep.violations.items():
+        if v is not None:
+            what = "" if v.value is None else (
+                f", {escape(str(v.actuator))} = {v.value:.6g}"
+                + ("" if v.limit is None else f" vs limit {v.limit:.6g}"))
+            out.print(f"  first {kind} violation: sample {v.index} (t = {v.time:.3f} s){what}"
+                      + (f" — {escape(v.reason)}" if v.reason else ""))
+    lo_m, hi_m = rep.margin_low, rep.margin_high
+    out.print("  stroke margins (mm) below / above: " + ", ".join(
+        f"{n} {a:.2f}/{b:.2f}" for n, a, b in zip(mech.actuator_names, lo_m, hi_m)))
+    out.print(f"  peak speed {np.nanmax(np.abs(rep.qdot)):.1f} mm/s, peak force "
+              f"{np.nanmax(np.abs(rep.force)):.2f} N")
+    for p in written:
+        out.print(f"  wrote {escape(str(p))}")
+
+
+@app.command()
+def compare(
+    mech_files: Annotated[list[Path] | None, typer.Argument(help="Mechanism YAML files.")]
+    = None,
+    pareto: Annotated[Path | None, typer.Option(
+        help="a study's pareto.csv: compare its rows (with --rows)")] = None,
+    rows: Annotated[str | None, typer.Option(help='Pareto ranks, e.g. "1,3"')] = None,
+    box: Annotated[float, typer.Option(help="dexterous set: ±box° simultaneous")] = 15.0,
+    samples: SamplesOpt = 7,
+    resolution: ResolutionOpt = "2.5",
+    out_dir: Annotated[Path, typer.Option("--out", help="output folder")]
+    = Path("results/compare"),
+    as_json: JsonOpt = False,
+) -> None:
+    """Compare designs side by side: volumes, inscribed shapes, GCI, κ, force, footprint,
+    stroke use on the paper's motion; writes compare.md and overlaid slice plots.
+
+    Each figure is the library's, with the request of the other commands (``workspace
+    --inscribed``, ``dexterity``): see pkmlab.study.compare."""
+    import csv as csv_mod
+
+    from ..study.compare import compare_designs, comparison_markdown, plot_overlaid_slices
+
+    loaded = [_load(f) for f in (mech_files or [])]
+    designs = [(m.name or f.stem, m) for f, m in zip(mech_files or [], loaded)]
+    if pareto is not None:
+        if not pareto.is_file() or not (pareto.parent / "evaluations.sqlite").is_file():
+            _fail(ParameterError("--pareto", "a study's pareto.csv next to its "
+                                 "evaluations.sqlite", str(pareto)))
+        with open(pareto) as fh:
+            table = list(csv_mod.DictReader(fh))
+        wanted = [r.strip() for r in (rows or "1").split(",")]
+        study, all_records = _open_results(pareto.parent)
+        records = {str(r["seq"]): r for r in all_records}
+        by_rank = {row["rank"]: row for row in table}
+        for w in wanted:
+            if w not in by_rank:
+                _fail(ParameterError("--rows", f"ranks present in {pareto.name} "
+                                     f"(1..{len(table)})", w))
+            rec = records[by_rank[w]["seq"]]
+            try:
+                designs.append((f"{study.name} #{w}", study.space.decode(rec["params"])))
+            except ParameterError as exc:
+                _fail(exc)
+    if len(designs) < 1:
+        _fail(ParameterError("MECH_FILES / --pareto", "at least one design", "none"))
+    try:
+        h = parse_length(resolution, "--resolution")
+    except ParameterError as exc:
+        _fail(exc)
+    if not (0 <= box <= 90):
+        _fail(ParameterError("--box", "an angle in [0, 90] deg", box))
+    if not 1 <= samples <= 101:
+        _fail(ParameterError("--samples", "an integer in [1, 101]", samples))
+    table_rows = compare_designs(designs, box_deg=box, resolution=h, samples=samples)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    md = comparison_markdown(table_rows, box)
+    (out_dir / "compare.md").write_text(md)
+    plot_overlaid_slices(table_rows, out_dir / "compare_dexterous_slices.png", which=1)
+    plot_overlaid_slices(table_rows, out_dir / "compare_level_slices.png", which=0)
+    if as_json:
+        _emit({"designs": [{k: v for k, v in r.items() if k not in ("mechanism", "results")}
+                           for r in table_rows],
+               "files": [str(out_dir / n) for n in ("compare.md",
+                                                    "compare_dexterous_slices.png",
+                                                    "compare_level_slices.png")]})
+        return
+    out.print(md, markup=False, highlight=False)
+    out.print(f"wrote {escape(str(out_dir))}/compare.md and overlaid slice plots")
+
+

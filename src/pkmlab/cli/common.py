@@ -1,0 +1,150 @@
+"""What every command shares: the app, the consoles, one error form, argument parsing and
+the workspace request options."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.text import Text
+
+from ..config import load_mechanism
+from ..errors import ParameterError
+from ..mechanisms import Mechanism
+from ..units import parse_angle, parse_length
+from ..yamlio import locate_error
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
+                  help="pkmlab: design-optimisation workbench for parallel manipulators.")
+out = Console()
+err = Console(stderr=True, soft_wrap=True)  # one line per error, whatever the width
+
+POSE_KEYS = ("x", "y", "z", "theta_x", "theta_y", "theta_z")
+JSON_HELP = ("Print JSON. Pose keys: x, y, z (mm), theta_x, theta_y, theta_z (deg, Z-Y-X Euler); "
+             "actuators: {name: mm} with the family's actuator names.")
+
+
+def _fail(exc: Exception) -> None:
+    if isinstance(exc, ParameterError):
+        locate_error(exc)  # the line and column of its field, when it came from a file
+    err.print(Text("error", style="bold red") + Text(": " + " ".join(str(exc).split())))
+    raise typer.Exit(code=2)
+
+
+def _load(path: Path) -> Mechanism:
+    try:
+        return load_mechanism(path)
+    except ParameterError as exc:
+        _fail(exc)
+        raise  # unreachable
+
+
+def _parse_csv(text: str, field: str, n: int) -> list[str]:
+    parts = [p.strip() for p in text.split(",")]
+    if len(parts) != n or any(p == "" for p in parts):
+        _fail(ParameterError(field, f"{n} comma-separated values", text))
+    return parts
+
+
+def _parse_pose(text: str, field: str = "--pose") -> np.ndarray:
+    parts = _parse_csv(text, field, 6)
+    try:
+        lin = [parse_length(p, f"{field}[{i}]") for i, p in enumerate(parts[:3])]
+        ang = [parse_angle(p, f"{field}[{i + 3}]") for i, p in enumerate(parts[3:])]
+    except ParameterError as exc:
+        _fail(exc)
+    return np.array(lin + ang)
+
+
+def _pose_json(pose: np.ndarray) -> dict:
+    vals = list(pose[:3]) + [math.degrees(a) for a in pose[3:]]
+    return {k: (None if not np.isfinite(v) else float(v)) for k, v in zip(POSE_KEYS, vals)}
+
+
+def _act_json(mech: Mechanism, q: np.ndarray) -> dict:
+    return {n: (None if not np.isfinite(v) else float(v)) for n, v in zip(mech.actuator_names, q)}
+
+
+def _pose_str(pose: np.ndarray) -> str:
+    p = _pose_json(pose)
+    return (f"x={p['x']:.4f} y={p['y']:.4f} z={p['z']:.4f} mm, θx={p['theta_x']:.4f} "
+            f"θy={p['theta_y']:.4f} θz={p['theta_z']:.4f} deg") if None not in p.values() \
+        else "undefined"
+
+
+def _emit(data: dict) -> None:
+    sys.stdout.write(json.dumps(data, indent=2) + "\n")
+
+
+MechArg = Annotated[Path, typer.Argument(help="Mechanism YAML file.")]
+JsonOpt = Annotated[bool, typer.Option("--json", help=JSON_HELP)]
+
+
+def _kappa_text(rep: dict) -> str:
+    """One line: κ with its characteristic length and status (from a pose report)."""
+    cl = rep["characteristic_length"]
+    k = "inf (singular)" if rep["kappa"] is None else f"{rep['kappa']:.4g}"
+    return (f"κ = {k} (Jacobian homogenised with L = {cl['length_mm']:.2f} mm, "
+            f"{cl['status']})")
+
+
+def _csv_list(text: str | None, field: str, n: int) -> list[str] | None:
+    return None if text is None else _parse_csv(text, field, n)
+
+
+KindOpt = Annotated[str, typer.Option(help="constant | reachable | dexterous")]
+OrientationOpt = Annotated[str | None, typer.Option(
+    help='constant kind: "θx,θy,θz" relative to nominal (deg or with units)')]
+BoxOpt = Annotated[str | None, typer.Option(help='Euler half-ranges "a,b,c" (deg)')]
+SemanticsOpt = Annotated[str, typer.Option(help="simultaneous | single-axis")]
+TiltOpt = Annotated[str | None, typer.Option(help="tilt-and-torsion set: largest tilt")]
+TorsionOpt = Annotated[str, typer.Option(help="tilt-and-torsion set: torsion half-range")]
+SamplesOpt = Annotated[int, typer.Option(help="orientation samples per angle")]
+ResolutionOpt = Annotated[str, typer.Option(help="grid spacing (mm or with units)")]
+LinkDiameterOpt = Annotated[str | None, typer.Option(help="leg interference diameter")]
+JointLimitOpt = Annotated[str | None, typer.Option(
+    help='passive joint cone half-angles "base,platform" (deg)')]
+KappaMaxOpt = Annotated[float | None, typer.Option(help="largest condition number")]
+AllComponentsOpt = Annotated[bool, typer.Option(
+    "--all-components", help="keep regions not connected to the nominal pose")]
+StrokeOpt = Annotated[str | None, typer.Option(
+    help='evaluate with another actuator window "min,max" (mm or with units)')]
+
+
+def _request(kind, orientation, box, semantics, tilt, torsion, samples, resolution,
+             link_diameter, joint_limit, kappa_max, all_components, stroke=None):
+    """CLI workspace options → validated request (the config module does the validation)."""
+    from ..config import workspace_spec
+
+    data: dict = {"kind": kind, "semantics": semantics, "samples": samples,
+                  "resolution": resolution, "torsion": torsion,
+                  "constraints": {"connected": not all_components}}
+    for key, text in (("orientation", orientation), ("box", box)):
+        vals = _csv_list(text, f"--{key}", 3)
+        if vals is not None:
+            data[key] = vals
+    if tilt is not None:
+        data["tilt"] = tilt
+    if link_diameter is not None:
+        data["constraints"]["link_diameter"] = link_diameter
+    if kappa_max is not None:
+        data["constraints"]["kappa_max"] = kappa_max
+    jl = _csv_list(joint_limit, "--joint-limit", 2)
+    if jl is not None:
+        data["constraints"]["joint_limits"] = {"base": jl[0], "platform": jl[1]}
+    win = _csv_list(stroke, "--stroke", 2)
+    if win is not None:
+        data["constraints"]["stroke"] = win
+    try:
+        spec = workspace_spec(data, prefix="--")
+    except ParameterError as exc:
+        _fail(exc)
+    return spec, spec.build()
+
+
