@@ -303,6 +303,8 @@ _I1, _I2 = nt.int8[::1], nt.int8[:, ::1]
 def carray(a, dtype=np.float64) -> np.ndarray:
     """``a`` as a C-contiguous, aligned, writeable array of ``dtype`` (copied only if needed):
     the array types of the kernels' signatures."""
+    if isinstance(a, np.ndarray) and a.dtype == dtype and a.flags.carray:
+        return a
     return np.require(a, dtype, ("C", "A", "W"))
 
 
