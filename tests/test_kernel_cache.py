@@ -243,6 +243,19 @@ def test_uid_namespace_of_a_kernel():
     assert before < after < 1 << 32
 
 
+def test_identity_tells_functions_apart():
+    """Two per-pose functions of one module, or one reached through another function, give
+    different identities; the same function gives the same one every time."""
+    from pkmlab import _jit
+    from pkmlab.mechanisms import luzi3, psu6, ups6
+
+    ids = [_jit.identity(f) for f in (psu6._psu_one, psu6._psu_column_leg, ups6._ups_one,
+                                      luzi3._luzi_one, luzi3._luzi_chain)]
+    assert len(set(ids)) == len(ids)
+    assert _jit.identity(psu6._psu_one) == ids[0]
+    assert _jit.identity(psu6._psu_one, extra=(1,)) != ids[0]
+
+
 def test_kernels_compiled_by_different_processes_do_not_alias(tmp_path):
     """Two processes compile the families' kernels into one fresh cache at the same time, in
     different orders, from the same start (the drivers' shared helpers compiled by a first

@@ -19,9 +19,9 @@ time can leave it pointing to the other kernel's data file.
 1. *Identity*: a SHA-256 of the numba and Python versions, the kernel's name, signature and
    options, and the source of everything it can compile in. That is every Python function
    reachable from the kernel's function through globals, closure cells and module attributes,
-   transitively, except in numba, numpy, llvmlite and scipy. Whole source files are hashed, so
-   module constants count too; a function without a source file contributes its marshalled
-   code.
+   transitively, except in numba, numpy, llvmlite and scipy. The hash covers those functions'
+   qualified names and their whole source files, so module constants count too; a function
+   without a source file contributes its marshalled code.
 2. *Name*: the kernel is compiled from a copy of its function renamed ``<name>_<id16>``, where
    ``id16`` is the identity's first 16 hex digits. Family-specific helpers that are compiled as
    functions of their own are renamed the same way (:func:`jitable`). A name therefore implies
@@ -115,6 +115,7 @@ def identity(*roots, extra=()) -> str:
     """Hex SHA-256 of everything the functions ``roots`` compile in (see the module notes),
     with the numba and Python versions and ``extra`` (a tuple of reprs)."""
     parts: dict[str, bytes] = {}
+    reached: set[str] = set()
     seen: set = set()
     stack = list(roots)
     while stack:
@@ -126,6 +127,7 @@ def identity(*roots, extra=()) -> str:
             continue
         key, data = _source_part(fn)
         parts[key] = data
+        reached.add(f"{fn.__module__}.{fn.__qualname__}")
         names = _names(fn.__code__)
         for name in names:
             value = fn.__globals__.get(name)
@@ -137,7 +139,7 @@ def identity(*roots, extra=()) -> str:
         stack.extend(c.cell_contents for c in fn.__closure__ or ()
                      if c.cell_contents is not None)
     h = hashlib.sha256()
-    h.update(repr((numba.__version__, sys.version_info[:2], extra)).encode())
+    h.update(repr((numba.__version__, sys.version_info[:2], extra, sorted(reached))).encode())
     for key in sorted(parts):
         h.update(key.encode() + b"\0" + hashlib.sha256(parts[key]).digest())
     return h.hexdigest()
