@@ -405,6 +405,7 @@ def make_driver(one, ng: int, kind: str):
 # per-orientation intersections ("any").
 
 
+@cache
 def _inlined(leg):
     """``leg`` (an ``njit`` dispatcher or a plain function) as a plain function that numba
     inlines, named after its identity. A closure must not hold a dispatcher itself: a dispatcher
