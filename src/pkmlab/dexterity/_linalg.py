@@ -14,9 +14,13 @@ certified upper bound on κ, so that exact singular values are needed only near 
 from __future__ import annotations
 
 import math
+from functools import cache
 
 import numpy as np
 from numba import njit, prange
+from numba import types as nt
+
+from .._jit import cached_kernel
 
 __all__ = ["singular_values", "sweep_bounds", "KAPPA_BRACKET"]
 
@@ -98,13 +102,20 @@ def _serial6(J, out):
         _one(J, m, out, A, d, 6, 6)
 
 
-@njit(parallel=True, cache=True, error_model="numpy")
-def _parallel(J, out):
+def _parallel_loop(J, out):
     r, c = J.shape[1], J.shape[2]
     for m in prange(J.shape[0]):
         A = np.empty((c, r))
         d = np.empty(c)
         _one(J, m, out, A, d, r, c)
+
+
+@cache
+def _parallel():
+    """:func:`_parallel_loop` compiled on numba's thread pool; a parallel kernel is cached only
+    through :func:`pkmlab._jit.cached_kernel` (see there why)."""
+    return cached_kernel(_parallel_loop, nt.void(nt.float64[:, :, ::1], nt.float64[:, ::1]),
+                         parallel=True, error_model="numpy")
 
 
 def singular_values(J: np.ndarray) -> np.ndarray:
@@ -121,10 +132,10 @@ def singular_values(J: np.ndarray) -> np.ndarray:
     if J.ndim < 2 or J.shape[-2] < J.shape[-1]:
         raise ValueError(f"singular_values needs (..., r, c) with r >= c, got {J.shape}")
     lead = J.shape[:-2]
-    flat = np.ascontiguousarray(J.reshape((-1,) + J.shape[-2:]))
+    flat = np.require(J.reshape((-1,) + J.shape[-2:]), np.float64, ("C", "A", "W"))
     out = np.empty((flat.shape[0], J.shape[-1]))
     if flat.shape[0] >= _PARALLEL_FROM:
-        _parallel(flat, out)
+        _parallel()(flat, out)
     elif flat.shape[0] and J.shape[-2:] == (6, 6):
         _serial6(flat, out)
     elif flat.shape[0]:

@@ -3,7 +3,7 @@
 Each family supplies a per-pose function ``one(px, py, pz, r00, ..., r22, g, qmin, qmax, q, st,
 j)``, declared with ``numba.extending.register_jitable(inline="always")``, that writes the
 actuator value and status code of each leg ``i`` of block pose ``j`` to ``q[i * ROW + j]`` and
-``st[i * ROW + j]``. :func:`make_drivers` wraps it in parallel drivers over poses; the family
+``st[i * ROW + j]``. :func:`make_driver` wraps it in parallel drivers over poses; the family
 function is captured as a compile-time constant and inlined, so a new family needs no driver
 code of its own.
 
@@ -32,20 +32,60 @@ Poses with a non-finite coordinate (and, in the Euler driver, poses with an angl
 :data:`TRIG_MAX`, whose rotation is then taken from ``math.sin``/``math.cos``) take a scalar
 path after stage 1; non-finite poses get NaN actuator values and ``INVALID_INPUT`` for every
 leg.
+
+Caching and invalidation
+------------------------
+The drivers (:func:`make_driver`), the workspace column kernels (:func:`make_column_kernel`)
+and the vectorised leg interval of the refinement (:func:`make_leg_eval`) are made per family
+by closures over the family's function, and all are cached in numba's disk cache
+(``NUMBA_CACHE_DIR``): a process, a joblib or Dask worker included, loads them in well under a
+second instead of compiling them for seconds. They are built by
+:func:`pkmlab._jit.cached_kernel`, which is what makes that safe:
+
+- A kernel's *identity* is a SHA-256 of the numba and Python versions, its name, signature and
+  options, and the full text of every source file it compiles code from. That is this module,
+  the family's module (``psu6.py`` ...) and any module whose functions the family function calls,
+  found by following globals, closure cells and module attributes, and ``_intervals.py`` for the
+  column kernels.
+- The kernel is compiled from a copy of its function named ``<name>_<16 hex digits of the
+  identity>``. ``legs`` (stage 2, a function of its own) and the inlined per-leg interval are
+  renamed the same way. numba's symbols and cache file names start with that name, so two
+  kernels with different code never share a symbol or an index file.
+- It is compiled eagerly for its one signature with numba's per-process uid counter moved into
+  a range that belongs to its identity. So the symbols numba names only by address and counter,
+  the parfor gufuncs, are unique to the identity too, and no later call can compile it again
+  outside that range.
+
+Without this, the closures of all families shared one qualname, ``make_drivers.<locals>.
+drive_euler``, and the gufuncs shared ``__numba_parfor_gufunc_<address>``. Their symbols differed
+only by the per-process counter, so two processes could give two families' kernels the same
+symbol. A third process that loaded both then ran the first one's code for both: the ``legs``
+of psu6 behind the 6-UPS driver gave NaN, the frames driver of ups6 behind psu6 gave plausible
+wrong numbers (``tests/test_kernel_cache.py``).
+
+Invalidation: editing this module, a family module, or anything a kernel compiles in changes
+the kernel's identity and so its name. The next process finds no cache entry under the new
+name and compiles. Entries under old names stay on disk and are never loaded again; delete
+``NUMBA_CACHE_DIR`` to reclaim the space. The shared helpers below (``_load_euler`` ...) are
+ordinary module-level ``njit(cache=True)`` functions: numba drops their entries when this file
+changes. Every kernel has one signature, so arguments must be C-contiguous, aligned and
+writeable arrays of the declared dtype (:func:`carray`) and plain floats.
 """
 
 from __future__ import annotations
 
-import inspect
 import math
-import os
 from functools import cache
 
 import numpy as np
 from numba import njit, prange
-from numba.extending import register_jitable
+from numba import types as nt
 
-__all__ = ["BLOCK", "ROW", "make_drivers", "make_column_kernels", "make_leg_eval", "stroke_status"]
+from .._intervals import union_merge
+from .._jit import cached_kernel, identity, jitable
+
+__all__ = ["BLOCK", "ROW", "carray", "make_driver", "make_column_kernel", "make_leg_eval",
+           "stroke_status"]
 
 # Leg status codes, ordered by severity: a pose's reason is its legs' maximum.
 OK, BELOW_STROKE, ABOVE_STROKE, DEGENERATE, NO_SOLUTION, INVALID_INPUT = 0, 1, 2, 3, 4, 5
@@ -253,33 +293,29 @@ def _store_invalid(bad, m, q_out, st_out, reason_out):
             reason_out[j] = INVALID_INPUT
 
 
-def _fingerprint(fn) -> tuple:
-    """Identity of ``fn``'s source file (path, size, mtime), part of the drivers' cache key:
-    numba invalidates a cached function only when its own file changes."""
-    path = inspect.getsourcefile(fn)
-    if path is None or not os.path.exists(path):   # e.g. defined interactively
-        return "", 0, 0
-    stat = os.stat(path)
-    return path, stat.st_size, stat.st_mtime_ns
+# ---- signatures -------------------------------------------------------------------------------
+# Every kernel has exactly one signature (see :func:`.._jit.cached_kernel`); :func:`carray`
+# makes an argument match it.
+_F1, _F2, _F3 = nt.float64[::1], nt.float64[:, ::1], nt.float64[:, :, ::1]
+_I1, _I2 = nt.int8[::1], nt.int8[:, ::1]
+
+
+def carray(a, dtype=np.float64) -> np.ndarray:
+    """``a`` as a C-contiguous, aligned, writeable array of ``dtype`` (copied only if needed):
+    the array types of the kernels' signatures."""
+    if isinstance(a, np.ndarray) and a.dtype == dtype and a.flags.carray:
+        return a
+    return np.require(a, dtype, ("C", "A", "W"))
 
 
 @cache
-def make_drivers(one):
-    """Parallel drivers ``(euler, frames)`` for the per-pose function ``one``.
+def _legs(one, ng: int):
+    """Stage 2 for the per-pose function ``one``: compiled as a function of its own, which keeps
+    the drivers' parallel loop bodies small (numba's parfor passes are slow on large ones), and
+    named after ``one``'s identity (:func:`.._jit.jitable`), since its code is the family's."""
 
-    ``one`` must be a module-level function declared with ``register_jitable``. The drivers are
-    cached on disk under a key that includes what their closure holds, pickled: ``legs``, a plain
-    function (a numba dispatcher would pickle differently in every process) that holds ``one``
-    (by name) and the stamp of ``one``'s file (numba itself only watches this file). ``legs`` is
-    compiled as a function of its own, which keeps the parallel loop bodies small: numba's
-    parfor passes are slow on large ones.
-    """
-    source = _fingerprint(one)
-
-    @register_jitable(error_model="numpy")
     def legs(T, w, g, qmin, qmax, q, st):
         """Stage 2 over the first ``w`` poses of a block."""
-        source  # noqa: B018 - in the closure, so the cache key changes with ``one``'s file
         for j in range(w):
             one(T[j], T[ROW + j], T[2 * ROW + j],
                 T[3 * ROW + j], T[4 * ROW + j], T[5 * ROW + j],
@@ -287,7 +323,25 @@ def make_drivers(one):
                 T[9 * ROW + j], T[10 * ROW + j], T[11 * ROW + j],
                 g, qmin, qmax, q, st, j)
 
-    @njit(parallel=True, cache=True)
+    return jitable(legs, identity(legs, extra=("legs", ng)), error_model="numpy")
+
+
+@cache
+def make_driver(one, ng: int, kind: str):
+    """Parallel driver ``kind`` (``"euler"`` or ``"frames"``) for the per-pose function ``one``
+    and geometry tuples of ``ng`` floats, loaded from or compiled into numba's disk cache.
+
+    ``one`` must be a module-level function declared with ``register_jitable``. The driver is
+    built by :func:`.._jit.cached_kernel` (see the module notes): its name carries a hash of
+    all the source it compiles in, so no two families' drivers can alias and an edit
+    recompiles.
+
+    ``euler(poses (N, 6), g, qmin, qmax, q_out (N, 6), st_out (N, 6) int8, reason_out (N,)
+    int8)``; ``frames(p (N, 3), R (N, 3, 3), g, ...)`` likewise. All arrays C-contiguous,
+    writeable, float64 unless stated (:func:`carray`).
+    """
+    legs = _legs(one, ng)
+
     def drive_euler(poses, g, qmin, qmax, q_out, st_out, reason_out):
         """Inverse kinematics over Euler poses ``(N, 6)`` (R = Rz·Ry·Rx), C-contiguous."""
         n = poses.shape[0]
@@ -312,7 +366,6 @@ def make_drivers(one):
             if slow:
                 _store_invalid(bad, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
 
-    @njit(parallel=True, cache=True)
     def drive_frames(p, R, g, qmin, qmax, q_out, st_out, reason_out):
         """Inverse kinematics over positions ``(N, 3)`` and rotations ``(N, 3, 3)``."""
         n = p.shape[0]
@@ -335,7 +388,13 @@ def make_drivers(one):
                 _frames_bad(pb, Rb, m, bad)
                 _store_invalid(bad, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
 
-    return drive_euler, drive_frames
+    g, f8 = nt.UniTuple(nt.float64, ng), nt.float64
+    if kind == "euler":
+        return cached_kernel(drive_euler, nt.void(_F2, g, f8, f8, _F2, _I2, _I1), parallel=True)
+    if kind == "frames":
+        return cached_kernel(drive_frames, nt.void(_F2, _F3, g, f8, f8, _F2, _I2, _I1),
+                             parallel=True)
+    raise ValueError(f"kind must be 'euler' or 'frames', got {kind!r}")
 
 
 # ---- column kernels for the workspace engine --------------------------------------------------
@@ -347,11 +406,26 @@ def make_drivers(one):
 
 
 @cache
-def make_column_kernels(leg):
-    """Parallel drivers ``(columns_all, columns_any)`` for the per-leg interval ``leg``."""
-    from .._intervals import union_merge
+def _inlined(leg):
+    """``leg`` (an ``njit`` dispatcher or a plain function) as a plain function that numba
+    inlines, named after its identity. A closure must not hold a dispatcher itself: a dispatcher
+    pickles differently in every process, and the pickled closure is part of numba's cache key,
+    so the cache would never hit."""
+    fn = getattr(leg, "py_func", leg)
+    return jitable(fn, identity(fn, extra=("leg",)), inline="always")
 
-    @njit(parallel=True)
+
+@cache
+def make_column_kernel(leg, mode: str):
+    """Parallel driver ``columns_all`` (``mode="all"``) or ``columns_any`` (``"any"``) for the
+    per-leg interval ``leg``, cached like the IK drivers (:func:`make_driver`).
+
+    ``columns_all(xs (nx,), ys (ny,), W (M, 6, 3), P (6, 3), out_lo, out_hi (nx, ny, 1))``;
+    ``columns_any(xs, ys, W, P, allowed (nx, ny, M) bool, out_lo, out_hi (nx, ny, K), count
+    (nx, ny) int64)``. All arrays C-contiguous and writeable (:func:`carray`).
+    """
+    leg = _inlined(leg)
+
     def columns_all(xs, ys, W, P, out_lo, out_hi):
         """Intersection over orientations ``W (M, 6, 3)`` and legs; rows vectorised along y.
 
@@ -387,7 +461,6 @@ def make_column_kernels(leg):
                     out_lo[ix, j, 0] = np.inf
                     out_hi[ix, j, 0] = -np.inf
 
-    @njit(parallel=True)
     def columns_any(xs, ys, W, P, allowed, out_lo, out_hi, count):
         """Union over the orientations that ``allowed (nx, ny, M)`` permits."""
         nx, ny, M, K = xs.shape[0], ys.shape[0], W.shape[0], out_lo.shape[2]
@@ -417,25 +490,33 @@ def make_column_kernels(leg):
                     out_hi[ix, iy, k] = -np.inf
                 count[ix, iy] = union_merge(blo, bhi, n, out_lo[ix, iy], out_hi[ix, iy], K)
 
-    return columns_all, columns_any
+    if mode == "all":
+        return cached_kernel(columns_all, nt.void(_F1, _F1, _F3, _F2, _F3, _F3), parallel=True)
+    if mode == "any":
+        return cached_kernel(columns_any, nt.void(_F1, _F1, _F3, _F2, nt.boolean[:, :, ::1],
+                                                  _F3, _F3, nt.int64[:, ::1]), parallel=True)
+    raise ValueError(f"mode must be 'all' or 'any', got {mode!r}")
 
 
 @cache
 def make_leg_eval(leg):
-    """Vectorised ``leg`` over items: ``(x, y, W (n, 3), P (n, 3)) -> (a, b, ok)``, each (n,)."""
+    """Vectorised ``leg`` over items: ``(x, y, W (n, 3), P (n, 3)) -> (a, b, ok)``, each (n,);
+    cached like the IK drivers (:func:`make_driver`)."""
+    leg = _inlined(leg)
 
-    @njit(parallel=True)
     def leg_eval(x, y, W, P, a, b, ok):
         for k in prange(x.shape[0]):
             a[k], b[k], ok[k] = leg(x[k], y[k], W[k, 0], W[k, 1], W[k, 2],
                                     P[k, 0], P[k, 1], P[k, 2])
 
+    kernel = cached_kernel(leg_eval, nt.void(_F1, _F1, _F2, _F2, _F1, _F1, nt.boolean[::1]),
+                           parallel=True)
+
     def run(x, y, W, P):
         n = len(x)
         a, b, ok = np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
-        leg_eval(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float),
-                 np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(P, dtype=float),
-                 a, b, ok)
+        kernel(carray(x), carray(y), carray(W), carray(P), a, b, ok)
         return a, b, ok
 
+    run.kernel = kernel
     return run

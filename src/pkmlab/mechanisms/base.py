@@ -144,7 +144,7 @@ class Mechanism:
     column_invariant: ClassVar[bool] = False
 
     #: numba per-leg column interval ``leg(x, y, wx, wy, wz, p0, p1, p2) -> (a, b, ok)`` (see
-    #: :func:`._kernels.make_column_kernels`); families with it set ``column_method``.
+    #: :func:`._kernels.make_column_kernel`); families with it set ``column_method``.
     column_leg: ClassVar[Any] = None
 
     def column_params(self) -> np.ndarray:  # pragma: no cover - optional
@@ -164,9 +164,9 @@ class Mechanism:
         unites the orientations that ``allowed (nx, ny, M)`` permits. ``overflow`` counts
         columns whose union needed more than ``K`` pieces.
         """
-        columns_all, columns_any = _kernels.make_column_kernels(type(self).column_leg)
         W = self.leg_offsets(R)
-        P = np.ascontiguousarray(self.column_params(), dtype=float)
+        P = _kernels.carray(self.column_params())
+        xs, ys = _kernels.carray(xs), _kernels.carray(ys)
         nx, ny = len(xs), len(ys)
         if mode == "all":
             if allowed is not None:
@@ -174,13 +174,16 @@ class Mechanism:
             # Most tilted orientations first: dead columns then die after a few of them.
             W = W[np.argsort(-np.linalg.norm(R - np.eye(3), axis=(1, 2)), kind="stable")]
             lo, hi = np.empty((nx, ny, 1)), np.empty((nx, ny, 1))
-            columns_all(xs, ys, np.ascontiguousarray(W), P, lo, hi)
+            columns_all = _kernels.make_column_kernel(type(self).column_leg, "all")
+            columns_all(xs, ys, _kernels.carray(W), P, lo, hi)
             return lo, hi, 0
         if allowed is None:
             allowed = np.ones((nx, ny, len(R)), dtype=np.bool_)
         lo, hi = np.empty((nx, ny, K)), np.empty((nx, ny, K))
         count = np.empty((nx, ny), dtype=np.int64)
-        columns_any(xs, ys, W, P, allowed, lo, hi, count)
+        columns_any = _kernels.make_column_kernel(type(self).column_leg, "any")
+        columns_any(xs, ys, _kernels.carray(W), P, _kernels.carray(allowed, np.bool_), lo, hi,
+                    count)
         return lo, hi, int(np.sum(count > K))
 
     def position_bounds(self, R: np.ndarray) -> np.ndarray:
@@ -288,17 +291,19 @@ class Mechanism:
         return self._run_ik(p, R, lo, hi)
 
     def _run_ik(self, X_or_p, R, lo: float, hi: float) -> IKResult:
-        euler, frames = _kernels.make_drivers(type(self)._ik_one)
+        g = self._ik_geometry
         n = X_or_p.shape[0]
         q = np.empty((n, 6))
         st = np.empty((n, 6), dtype=np.int8)
         reason = np.empty(n, dtype=np.int8)
-        g = self._ik_geometry
+        lo, hi = float(lo), float(hi)
+        one, ng = type(self)._ik_one, len(g)
         if R is None:
-            euler(np.ascontiguousarray(X_or_p), g, lo, hi, q, st, reason)
+            euler = _kernels.make_driver(one, ng, "euler")
+            euler(_kernels.carray(X_or_p), g, lo, hi, q, st, reason)
         else:
-            frames(np.ascontiguousarray(X_or_p), np.ascontiguousarray(R), g, lo, hi, q, st,
-                   reason)
+            frames = _kernels.make_driver(one, ng, "frames")
+            frames(_kernels.carray(X_or_p), _kernels.carray(R), g, lo, hi, q, st, reason)
         return IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st)
 
     @cached_property

@@ -1,0 +1,193 @@
+"""Numba kernels cached on disk whose machine code cannot be mistaken for another kernel's.
+
+**The hazard.** numba caches a compiled function as an object file. Each function in it has a
+symbol made of ``module.qualname``, a uid and the argument types, and the uid is a per-process
+counter (``numba.core.bytecode.FunctionIdentity``). A process that loads cached objects links
+all of them into one MCJIT engine, and there a symbol defined twice resolves to its first
+definition. The functions a kernel links in (its helpers, the ``__numba_parfor_gufunc_<address>``
+that holds a ``prange`` loop body) are even emitted as weak ``linkonce_odr`` symbols, so a later
+object calls the first object's copy. Two kernels that share a qualname and argument types
+(closures made by one factory for several families) or a gufunc name (an address and the
+counter), compiled by two processes whose counters happened to agree, are therefore aliased:
+whichever is loaded second runs the first one's code. The result can be NaN or plausible wrong
+numbers, depending on which processes filled the cache. The same name also means the same
+cache index file. Two processes that save different kernels under one index file at the same
+time can leave it pointing to the other kernel's data file.
+
+**The construction.** :func:`cached_kernel` builds every parallel or family-specific kernel:
+
+1. *Identity*: a SHA-256 of the numba and Python versions, the kernel's name, signature and
+   options, and the source of everything it can compile in. That is every Python function
+   reachable from the kernel's function through globals, closure cells and module attributes,
+   transitively, except in numba, numpy, llvmlite and scipy. The hash covers those functions'
+   qualified names and their whole source files, so module constants count too; a function
+   without a source file contributes its marshalled code.
+2. *Name*: the kernel is compiled from a copy of its function renamed ``<name>_<id16>``, where
+   ``id16`` is the identity's first 16 hex digits. Family-specific helpers that are compiled as
+   functions of their own are renamed the same way (:func:`jitable`). A name therefore implies
+   its source. The cache index file is named after it, so one index file only ever holds one
+   kernel, and editing anything the kernel compiles in gives a new name: a fresh compile, never
+   a stale hit.
+3. *Uid namespace*: the kernel is compiled, eagerly, with numba's uid counter set to a range
+   owned by its identity, ``[(2^63 | h)·2^32, (2^63 | h + 1)·2^32)``, where ``h`` is the
+   identity's first 64 bits. Every function numba creates during that compile (the kernel, its
+   gufuncs, helpers compiled for the first time) takes its uid from that range. No other
+   identity's compile uses the range, and ordinary compiles count from 1 and stay below it.
+   Compiling is then disabled (explicit signature), so the kernel never compiles again outside
+   its namespace.
+
+So two symbols with the same name, from any two processes, come from the same identity and hold
+the same code: loading both is harmless. Ordinary module-level ``njit(cache=True)`` functions
+without ``parallel=True`` need none of this. Their symbol is ``module.qualname`` + uid + types,
+numba discards their cache entries when their file changes, and the only other objects that
+contain a linked copy of one are kernels whose identity covers that file. Every ``parallel=True``
+function in pkmlab goes through :func:`cached_kernel` (``tests/test_kernel_cache.py`` checks
+this).
+
+If this numba has no ``FunctionIdentity._unique_ids`` counter, kernels are compiled uncached. Each
+process then compiles them itself, which is slow but safe, and a warning says so.
+
+Stale entries (from earlier sources) stay in ``NUMBA_CACHE_DIR`` until it is cleared. They are
+never loaded.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import inspect
+import itertools
+import marshal
+import sys
+import types as pytypes
+import warnings
+
+import numba
+from numba import njit
+from numba.core.bytecode import FunctionIdentity
+from numba.core.compiler_lock import global_compiler_lock
+from numba.extending import register_jitable
+
+__all__ = ["cached_kernel", "identity", "jitable", "CACHE_SAFE"]
+
+#: True when kernels can be cached safely (numba's uid counter is where it is expected).
+CACHE_SAFE = isinstance(getattr(FunctionIdentity, "_unique_ids", None), itertools.count)
+if not CACHE_SAFE:  # pragma: no cover - depends on the numba version
+    warnings.warn("pkmlab: this numba has no FunctionIdentity._unique_ids counter; numba "
+                  "kernels are compiled in every process instead of being cached", stacklevel=1)
+
+#: Packages whose functions are never part of a kernel's identity (the numba version is).
+_SKIP = frozenset({"numba", "numpy", "llvmlite", "scipy", "builtins"})
+_counters: dict[str, itertools.count] = {}
+
+
+def _unwrap(obj):
+    """The Python function behind ``obj`` (itself, a dispatcher's ``py_func``), or None."""
+    obj = getattr(obj, "py_func", obj)
+    return obj if isinstance(obj, pytypes.FunctionType) else None
+
+
+def _names(code) -> set[str]:
+    """Global and attribute names used by ``code`` and the code objects nested in it."""
+    names = set(code.co_names)
+    for c in code.co_consts:
+        if isinstance(c, pytypes.CodeType):
+            names |= _names(c)
+    return names
+
+
+def _source_part(fn) -> tuple[str, bytes]:
+    """``(key, bytes)`` of ``fn``'s source: its whole file, or its code when it has none."""
+    path = inspect.getsourcefile(fn)
+    if path:
+        try:
+            with open(path, "rb") as f:
+                return "file:" + (fn.__module__ or path), f.read()
+        except OSError:
+            pass
+    consts = tuple(sorted((n, repr(fn.__globals__[n])) for n in _names(fn.__code__)
+                          if isinstance(fn.__globals__.get(n), int | float | str | tuple)))
+    return f"code:{fn.__module__}.{fn.__qualname__}", marshal.dumps(fn.__code__) + \
+        repr(consts).encode()
+
+
+def identity(*roots, extra=()) -> str:
+    """Hex SHA-256 of everything the functions ``roots`` compile in (see the module notes),
+    with the numba and Python versions and ``extra`` (a tuple of reprs)."""
+    parts: dict[str, bytes] = {}
+    reached: set[str] = set()
+    seen: set = set()
+    stack = list(roots)
+    while stack:
+        fn = _unwrap(stack.pop())
+        if fn is None or fn in seen:
+            continue
+        seen.add(fn)
+        if (fn.__module__ or "").split(".")[0] in _SKIP:
+            continue
+        key, data = _source_part(fn)
+        parts[key] = data
+        reached.add(f"{fn.__module__}.{fn.__qualname__}")
+        names = _names(fn.__code__)
+        for name in names:
+            value = fn.__globals__.get(name)
+            if isinstance(value, pytypes.ModuleType):
+                if value.__name__.split(".")[0] not in _SKIP:
+                    stack.extend(getattr(value, n, None) for n in names)
+            else:
+                stack.append(value)
+        stack.extend(c.cell_contents for c in fn.__closure__ or ()
+                     if c.cell_contents is not None)
+    h = hashlib.sha256()
+    h.update(repr((numba.__version__, sys.version_info[:2], extra, sorted(reached))).encode())
+    for key in sorted(parts):
+        h.update(key.encode() + b"\0" + hashlib.sha256(parts[key]).digest())
+    return h.hexdigest()
+
+
+def _renamed(fn, name: str):
+    """A copy of the function ``fn`` named ``name`` (same code, globals and closure cells)."""
+    new = pytypes.FunctionType(fn.__code__, fn.__globals__, name, fn.__defaults__,
+                               fn.__closure__)
+    new.__qualname__ = name
+    new.__kwdefaults__ = fn.__kwdefaults__
+    new.__doc__ = fn.__doc__
+    return new
+
+
+@contextlib.contextmanager
+def _uid_namespace(ident: str):
+    """Functions numba creates inside take uids from ``ident``'s own range (see module notes)."""
+    with global_compiler_lock:
+        saved = FunctionIdentity._unique_ids
+        base = ((1 << 63) | int(ident[:16], 16)) << 32
+        FunctionIdentity._unique_ids = _counters.setdefault(ident, itertools.count(base))
+        try:
+            yield
+        finally:
+            FunctionIdentity._unique_ids = saved
+
+
+def jitable(fn, ident: str, **options):
+    """``register_jitable(**options)`` of a copy of ``fn`` named after ``ident``: for a helper
+    that a kernel calls as a function of its own (not inlined) and whose code depends on a
+    family, so that its symbol is as unique as the kernels' (``ident`` must cover it)."""
+    return register_jitable(**options)(_renamed(fn, f"{fn.__name__}_{ident[:16]}"))
+
+
+def cached_kernel(fn, sig, *, roots=(), extra=(), **options):
+    """``njit(sig, cache=True, **options)`` of ``fn``, compiled now, named and compiled in a
+    uid namespace after its identity (see the module notes).
+
+    Args:
+        fn: the kernel's Python function (module-level or a closure).
+        sig: its one signature; calls must match it exactly (C-contiguous, writeable arrays).
+        roots: more functions whose source the kernel compiles in but that ``fn`` does not
+            reach by itself.
+        extra: more values (reprs) that the identity must cover.
+    """
+    ident = identity(fn, *roots, extra=(fn.__name__, str(sig), sorted(options.items()),
+                                        tuple(extra)))
+    kernel = _renamed(fn, f"{fn.__name__}_{ident[:16]}")
+    with _uid_namespace(ident) if CACHE_SAFE else contextlib.nullcontext():
+        return njit(sig, cache=CACHE_SAFE, **options)(kernel)
