@@ -129,3 +129,18 @@ def test_ply_carries_metric_values_as_vertex_properties(small, tmp_path):
     np.testing.assert_allclose(back.vertices, mesh.vertices, atol=1e-4)
     with pytest.raises(ValueError, match="vertex values"):
         small.save_mesh(tmp_path / "bad.ply", values={"kappa": kappa[:-1]})
+
+
+def test_metric_slices_are_not_washed_out_by_a_few_near_singular_voxels(small):
+    from pkmlab.workspaces.plots import _colour_range
+
+    values = np.full(small.occupancy.shape, np.nan)
+    values[small.occupancy] = np.linspace(5.0, 9.0, int(small.occupancy.sum()))
+    lo, hi, extend = _colour_range(values)
+    assert extend == "neither" and (lo, hi) == (5.0, 9.0)
+    few = tuple(np.argwhere(small.occupancy)[:3].T)
+    values[few] = 600.0                                  # three near-singular voxels
+    lo, hi, extend = _colour_range(values)
+    assert lo < 5.1 and hi < 10 and extend == "max"
+    fig = slice_figure(small, values=values, label="κ")
+    assert "percentile" in fig.axes[-1].get_ylabel()

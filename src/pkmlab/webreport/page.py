@@ -100,13 +100,13 @@ def hull_of_ply(path: Path) -> dict:
 
 def colour_option(label: str, values: np.ndarray, digits: int = 4) -> dict:
     """A hull colouring: values (non-finite ones at the top of the scale) and a colour range
-    from the 2nd to the 98th percentile, so that a few near-singular poses do not wash the
+    from the 1st to the 99th percentile, so that a few near-singular poses do not wash the
     scale out."""
     v = np.asarray(values, dtype=float)
     finite = np.isfinite(v)
     if not finite.any():
         return {"label": label, "values": [0.0] * len(v), "cmin": 0.0, "cmax": 1.0}
-    lo, hi = np.percentile(v[finite], [2, 98])
+    lo, hi = np.percentile(v[finite], [1, 99])
     hi = hi if hi > lo else lo + 1e-9
     v = np.where(finite, v, np.max(v[finite]))
     return {"label": label, "values": [float(f"{x:.{digits}g}") for x in v],

@@ -131,8 +131,8 @@ def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
             hull = {"vertices": h["vertices"], "faces": h["faces"],
                     "intensity": np.asarray(first["values"]), "label": first["label"]}
             card["scene_note"] = (f"{len(h['faces'])} triangles; the hull is the set of tool "
-                                  "points of the study's workspace request. Colour range: 2nd "
-                                  "to 98th percentile. Drag to rotate, scroll to zoom; click "
+                                  "points of the study's workspace request. Colour range: 1st "
+                                  "to 99th percentile. Drag to rotate, scroll to zoom; click "
                                   "legend entries to hide parts.")
         else:
             card["scene_note"] = ("No workspace hull: " + ("the workspace is empty."

@@ -48,7 +48,7 @@ def slice_figure(result, window: float | None = None, spacing: float | None = No
     if values is not None and not np.any(np.isfinite(values)):
         values = None                     # nothing to colour: plain sections
     if values is not None:
-        vmin, vmax = np.nanmin(values), np.nanmax(values)
+        vmin, vmax, extend = _colour_range(values)
     for a, ax in enumerate(axes.ravel()):
         ax.set_xlim(cx - half, cx + half)
         ax.set_ylim(cy - half, cy + half)
@@ -70,7 +70,10 @@ def slice_figure(result, window: float | None = None, spacing: float | None = No
                            interpolation="nearest")
         ax.set_title(f"z = {z:.1f} mm", fontsize=7)
     if im is not None:
-        fig.colorbar(im, ax=axes, shrink=0.6, label=label)
+        note = {"neither": "", "max": "\n(colours capped at the 99th percentile)",
+                "min": "\n(colours floored at the 1st percentile)",
+                "both": "\n(colours: 1st to 99th percentile)"}[extend]
+        fig.colorbar(im, ax=axes, shrink=0.6, extend=extend, label=label + note)
     name = getattr(result.mechanism, "name", "") or result.mechanism.family
     if result.empty:
         axes.ravel()[0].text(0.5, 0.5, "empty: no position satisfies\nthe constraints",
@@ -79,6 +82,26 @@ def slice_figure(result, window: float | None = None, spacing: float | None = No
     empty = " (empty)" if result.empty else ""
     fig.suptitle(f"{name}: {result.kind} workspace{empty}\n{lay.describe()}", fontsize=9)
     return fig
+
+
+def _colour_range(values: np.ndarray) -> tuple[float, float, str]:
+    """Colour limits: the full range, unless a few extreme voxels (near-singular κ in the
+    hundreds) stretch it to more than 1.5 times the 1st-99th percentile range; then those
+    percentiles, with ``extend`` marking the ends that were cut."""
+    v = values[np.isfinite(values)]
+    lo, hi = float(v.min()), float(v.max())
+    plo, phi = (float(x) for x in np.percentile(v, [1, 99]))
+    if not (phi > plo and hi - lo > 1.5 * (phi - plo)):
+        return lo, hi if hi > lo else lo + 1e-12, "neither"
+    span = phi - plo
+    cut_lo, cut_hi = plo - lo > 0.25 * span, hi - phi > 0.25 * span
+    if not cut_lo:
+        plo = lo
+    if not cut_hi:
+        phi = hi
+    extend = {(False, False): "neither", (True, False): "min", (False, True): "max",
+              (True, True): "both"}[(cut_lo, cut_hi)]
+    return plo, phi, extend
 
 
 def plot_slices(result, path, **kw) -> Path:
