@@ -60,6 +60,8 @@ def pareto_matrix(axes: list[dict], points: list[dict]):
                         horizontal_spacing=0.06 if n > 1 else 0.0,
                         vertical_spacing=0.06 if n > 1 else 0.0)
     shown = set()
+    # many points: WebGL markers (the same clicks and hover), SVG otherwise (crisp in print)
+    Scatter = go.Scattergl if len(points) > 1500 else go.Scatter
     for r in range(n):
         for c in range(r + 1):
             ax, ay = axes[c], axes[r + 1]
@@ -70,7 +72,7 @@ def pareto_matrix(axes: list[dict], points: list[dict]):
                 if not pts:
                     continue
                 label, marker = _STYLE[group]
-                fig.add_trace(go.Scatter(
+                fig.add_trace(Scatter(
                     x=[p["values"][ax["key"]] for p in pts],
                     y=[p["values"][ay["key"]] for p in pts],
                     mode="markers+text" if group == "exported" else "markers",

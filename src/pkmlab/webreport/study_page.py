@@ -242,7 +242,9 @@ def write_study_page(out: Path, study: Study, records: list[dict], *, progress=N
         export_problems=index["problems"], variables=_variables(study),
         optimizer=_optimizer_text(study),
         seed=study.seed, resolved_yaml=resolved_text, runs=_runs(out),
-        length_step=D.LENGTH_STEP_MM, angle_step=D.ANGLE_STEP_DEG)
+        length_step=D.LENGTH_STEP_MM, angle_step=D.ANGLE_STEP_DEG,
+        stale_designs=not index["designs"] and any(
+            p.is_dir() for p in (out / "designs").glob("[0-9][0-9]-*")))
     log.info("report.html written in %.1f s (%d design cards)", time.perf_counter() - t0,
              len(cards))
     return path
