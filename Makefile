@@ -3,6 +3,8 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
+# The browser tests open report.html in a headless Chromium from the OS packages.
+BROWSER := $(VENV)/.chromium
 
 .PHONY: demo test bench clean
 
@@ -14,10 +16,22 @@ $(STAMP): pyproject.toml | $(PY)
 	$(PY) -m pip install --quiet -e '.[dev]'
 	touch $(STAMP)
 
+# Chromium for the browser tests: installed with apt-get when root and absent; otherwise the
+# browser tests skip, saying why.
+$(BROWSER): | $(PY)
+	@if command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1; then \
+		touch $(BROWSER); \
+	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium \
+			&& touch $(BROWSER); \
+	else \
+		echo "note: no Chromium (apt-get install chromium as root): the browser tests will skip"; \
+	fi
+
 demo: $(STAMP)
 	$(VENV)/bin/pkmlab run studies/hopkins-6psu-redesign.yaml --jobs 2
 
-test: $(STAMP)
+test: $(STAMP) $(BROWSER)
 	$(PY) -m pytest
 
 bench: $(STAMP)

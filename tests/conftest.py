@@ -44,3 +44,40 @@ def random_valid_poses(mech, n: int, seed: int, lin: float = 25.0, ang_deg: floa
              np.radians(rng.uniform(-ang_deg, ang_deg, (4 * n, 3)))], axis=1)
         out.append(X[mech.inverse(X).valid])
     return np.concatenate(out)[:n]
+
+
+# ---- one tiny study run through the CLI, shared by the report tests ---------------------------
+
+TINY_STUDY = {
+    "study": "tiny-report",
+    "description": "A tiny study for the report tests.",
+    "mechanism": {"file": str(MECH_DIR / "hopkins-williams-6psu.yaml")},
+    "design": {"base_outer_radius": {"low": "120 mm", "high": "165 mm"},
+               "platform_outer_radius": {"low": "55 mm", "high": "90 mm"},
+               "link_length": {"low": "200 mm", "high": "260 mm"}},
+    "evaluate": {"workspace": {"kind": "dexterous", "box": ["8 deg"] * 3, "samples": 2,
+                               "resolution": "8 mm"}},
+    "objectives": [{"maximize": "dexterous_volume"}, {"minimize": "base_outer_radius"},
+                   {"maximize": "z_span"}],
+    "constraints": [{"base_outer_radius": {"max": 160}}],
+    "optimizer": {"method": "sobol", "samples": 8},
+    "seed": 5,          # 5 Pareto designs, 3 exported, 2 infeasible candidates
+    "top": 3,
+}
+
+
+@pytest.fixture(scope="session")
+def tiny_report(tmp_path_factory):
+    """``(out, run)``: the tiny study's results folder after ``pkmlab run`` (no terminal), and
+    the CLI result (its stderr holds the progress lines)."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from pkmlab.cli import app
+
+    d = tmp_path_factory.mktemp("tiny-report")
+    path = d / "study.yaml"
+    path.write_text(yaml.safe_dump({**TINY_STUDY, "output": str(d / "out")}))
+    r = CliRunner().invoke(app, ["run", str(path), "--json"])
+    assert r.exit_code == 0, r.output
+    return d / "out", r

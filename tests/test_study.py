@@ -255,7 +255,7 @@ def test_cli_run_end_to_end_and_report(tmp_path):
     assert info["evaluations"] == 9
     lines = (out / "evaluations.csv").read_text().splitlines()
     assert len(lines) == 10
-    designs = list((out / "designs").iterdir())
+    designs = [d for d in (out / "designs").iterdir() if d.is_dir()]
     assert len(designs) == 1 and (designs[0] / "mechanism.yaml").exists()
     assert "baseline" in (out / "summary.md").read_text()
     (out / "pareto.png").unlink()

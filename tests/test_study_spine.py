@@ -131,7 +131,8 @@ def test_resolved_study_reloads_to_the_same_study_in_its_stated_units(tmp_path):
     # angles labelled deg are degrees; the workspace block is resolved with its defaults
     assert r["design"]["platform_rotation"]["low"] == "10 deg"
     ws = r["evaluate"]["workspace"]
-    assert ws["box"] == ["8 deg"] * 3 and ws["slice_window"] == "152.4 mm"
+    assert ws["box"] == ["8 deg"] * 3 and ws["slice_window"] == "auto"
+    assert ws["slice_layout"] == "auto" and ws["slice_spacing"] == "auto"
     assert ws["constraints"]["connected"] is True and ws["semantics"] == "simultaneous"
     assert r["mechanism"]["inline"]["generator"]["platform_rotation"] == "33.7 deg"
     back = study_from_mapping(yaml.safe_load(yaml.safe_dump(r)))

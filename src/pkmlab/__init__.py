@@ -9,15 +9,18 @@ __version__ = "0.1.0"
 
 __all__ = ["load_mechanism", "load_study", "ParameterError", "NumericalError", "REGISTRY",
            "Mechanism", "PSU6", "UPS6", "Luzi3", "workspace", "OrientationSet", "Constraints",
-           "JointLimits", "WorkspaceResult", "__version__"]
+           "JointLimits", "WorkspaceResult", "open_results", "__version__"]
 
 
 def __getattr__(name: str):
-    """Heavy subpackages load on first use (``pkmlab.study``, ``pkmlab.load_study``)."""
+    """Heavy subpackages load on first use (``pkmlab.study``, ``pkmlab.load_study``,
+    ``pkmlab.open_results``)."""
     import importlib
 
-    if name in ("study", "dexterity", "trajectory"):
+    if name in ("study", "dexterity", "trajectory", "results", "webreport"):
         return importlib.import_module(f".{name}", __name__)
     if name == "load_study":
         return importlib.import_module(".study", __name__).load_study
+    if name == "open_results":
+        return importlib.import_module(".results", __name__).open_results
     raise AttributeError(f"module 'pkmlab' has no attribute {name!r}")

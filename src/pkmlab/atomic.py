@@ -17,11 +17,21 @@ from pathlib import Path
 __all__ = ["write_text", "write_bytes", "staged"]
 
 
+def _file_mode() -> int:
+    """The mode ``open()`` would give a new file (0o666 less the umask): a temporary file is
+    created 0o600, which would make every result readable by its owner only."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def write_bytes(path: str | Path, data: bytes) -> Path:
-    """Write ``data`` to ``path`` atomically (temporary sibling, fsync, rename)."""
+    """Write ``data`` to ``path`` atomically (temporary sibling, fsync, rename), with the
+    permissions a plain write would give."""
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".part")
     try:
+        os.fchmod(fd, _file_mode())
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
             fh.flush()

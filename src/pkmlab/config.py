@@ -115,6 +115,10 @@ def _auto_angle(v: Any) -> float | None:
     return None if v == "auto" else _angle(v)
 
 
+def _auto_positive_length(v: Any) -> float | None:
+    return None if v in ("auto", None) else _positive_length(v)
+
+
 # JSON Schema of the quantity types: a bare number (in the documented unit) or a string with
 # its unit, so that editors accept what the loader accepts.
 _NUMBER_OR_UNIT = {"anyOf": [{"type": "number"}, {"type": "string"}]}
@@ -136,6 +140,9 @@ Length = Annotated[float, BeforeValidator(_length), _LENGTH_JSON]
 PositiveLength = Annotated[float, BeforeValidator(_positive_length), _LENGTH_JSON]
 Angle = Annotated[float, BeforeValidator(_angle), _ANGLE_JSON]
 AutoAngle = Annotated[float | None, BeforeValidator(_auto_angle), _ANGLE_JSON]
+AutoLength = Annotated[float | None, BeforeValidator(_auto_positive_length),
+                       WithJsonSchema({**_NUMBER_OR_UNIT,
+                                       "description": "'auto', mm, or a string with units"})]
 Radii = Annotated[list[float], BeforeValidator(_length_list(2)), _json_list(2)]
 Stroke = Annotated[list[float], BeforeValidator(_stroke), _json_list(2)]
 Points = Annotated[list[list[float]], BeforeValidator(_points),
@@ -310,8 +317,19 @@ class WorkspaceSpec(_Model):
                          description="orientation samples per angle")
     resolution: PositiveLength = Field(2.5, description="grid spacing (mm)")
     constraints: ConstraintsSpec = ConstraintsSpec()
-    slice_window: PositiveLength = Field(152.4, description="slice plot window edge (mm)")
-    slice_spacing: PositiveLength = Field(12.7, description="slice plot spacing (mm)")
+    slice_layout: Literal["auto", "paper"] = Field(
+        "auto", description="slice plots: 'auto' (window and spacing from the workspace's "
+        "bounding box, at most 16 sections) or 'paper' (Hopkins & Williams: 152.4 mm every "
+        "12.7 mm)")
+    slice_window: AutoLength = Field(None, description="slice plot window edge (mm; 'auto': "
+                                     "the layout's)")
+    slice_spacing: AutoLength = Field(None, description="slice plot spacing (mm; 'auto': the "
+                                      "layout's)")
+
+    def slice_options(self) -> dict:
+        """Keyword arguments of :func:`pkmlab.workspaces.plots.slice_figure`."""
+        return {"layout": self.slice_layout, "window": self.slice_window,
+                "spacing": self.slice_spacing}
 
     def build(self):
         """→ ``dict(kind, orientations, resolution, constraints)`` for :func:`pkmlab.workspace`."""
@@ -473,6 +491,7 @@ def _display_of(validator):
              _points: lambda v: [[_fmt_length(x) for x in row] for row in v],
              _pose: lambda v: [_fmt_length(x) for x in v[:3]] + [_fmt_angle(x) for x in v[3:]],
              _auto_angle: lambda v: "auto" if v is None else _fmt_angle(v),
+             _auto_positive_length: lambda v: "auto" if v is None else _fmt_length(v),
              _link_lengths: lambda v: ([_fmt_length(x) for x in v] if isinstance(v, list)
                                        else _fmt_length(v)),
              _stroke_choice: lambda v: v if v is True else [_fmt_length(x) for x in v]}
@@ -495,7 +514,7 @@ def to_display(model: BaseModel) -> dict:
         validator = next((m.func for m in metadata if isinstance(m, BeforeValidator)), None)
         fmt = _display_of(validator)
         if value is None:
-            out[name] = "auto" if validator is _auto_angle else None
+            out[name] = "auto" if validator in (_auto_angle, _auto_positive_length) else None
         elif isinstance(value, BaseModel):
             out[name] = to_display(value)
         elif isinstance(value, dict):

@@ -118,12 +118,16 @@ StrokeOpt = Annotated[str | None, typer.Option(
 
 
 def _request(kind, orientation, box, semantics, tilt, torsion, samples, resolution,
-             link_diameter, joint_limit, kappa_max, all_components, stroke=None):
+             link_diameter, joint_limit, kappa_max, all_components, stroke=None,
+             slice_layout="auto"):
     """CLI workspace options → validated request (the config module does the validation)."""
     from ..config import workspace_spec
+    from ..workspaces.slicing import LAYOUTS
 
+    if slice_layout not in LAYOUTS:
+        _fail(ParameterError("--slice-layout", f"one of {list(LAYOUTS)}", slice_layout))
     data: dict = {"kind": kind, "semantics": semantics, "samples": samples,
-                  "resolution": resolution, "torsion": torsion,
+                  "resolution": resolution, "torsion": torsion, "slice_layout": slice_layout,
                   "constraints": {"connected": not all_components}}
     for key, text in (("orientation", orientation), ("box", box)):
         vals = _csv_list(text, f"--{key}", 3)

@@ -92,7 +92,8 @@ def metrics(as_json: JsonOpt = False) -> None:
 
 
 def _progress_bar(total: int):
-    """A rich progress bar with rate and ETA on a terminal, nothing otherwise."""
+    """A rich progress bar with rate and ETA on a terminal; without one (a log, CI, a batch
+    job), a line on stderr every 5 s or every tenth of the candidates."""
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
@@ -108,7 +109,9 @@ def _progress_bar(total: int):
             return Text(f"{task.speed:.1f} candidates/s" if task.speed else "… candidates/s")
 
     if not err.is_terminal:
-        return None, (lambda n: None)
+        from ..progress import ProgressLines
+
+        return None, ProgressLines(total, sys.stderr)
     prog = Progress(TextColumn("evaluating"), BarColumn(), MofNCompleteColumn(), Rate(),
                     TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(),
                     console=err, transient=True)
@@ -134,10 +137,12 @@ def run(
     """Run a design study: evaluate candidates, keep every result, report the Pareto set."""
     import time
 
+    from ..progress import log_lines
     from ..study.optimisers import expected_evaluations
     from ..study.report import export_designs, pareto_records, write_report
     from ..study.run import run_study
     from ..study.runners import make_runner
+    from ..webreport import write_study_page
 
     study = _load_study(study_file)
     if out_dir is not None:
@@ -164,9 +169,11 @@ def run(
     records = store.all()
     store.close()
     outp = Path(study.output)
-    info = write_report(outp, study, records)
-    _, problems = export_designs(outp, study, pareto_records(study, records))
-    info.update(seconds=elapsed, output=str(outp), export_problems=problems)
+    with log_lines():
+        info = write_report(outp, study, records)
+        _, problems = export_designs(outp, study, pareto_records(study, records))
+        page = write_study_page(outp, study, records)
+    info.update(seconds=elapsed, output=str(outp), export_problems=problems, report=str(page))
     if as_json:
         _emit(info)
         return
@@ -176,8 +183,9 @@ def run(
     out.print(escape((outp / "summary.md").read_text()), highlight=False)
     for p in problems:
         err.print(escape(f"warning: export skipped: {p}"), highlight=False)
-    out.print(escape(f"results in {outp}/ (summary.md, pareto.csv, pareto.png, "
+    out.print(escape(f"results in {outp}/ (report.html, summary.md, pareto.csv, pareto.png, "
                      "evaluations.csv, designs/)"), highlight=False)
+    out.print(escape(f"open {page.resolve().as_uri()} in a browser"), highlight=False)
 
 
 def _open_results(results_dir: Path):
@@ -202,11 +210,16 @@ def _open_results(results_dir: Path):
 @app.command()
 def report(results_dir: Annotated[Path, typer.Argument(help="a study's results folder")],
            as_json: JsonOpt = False) -> None:
-    """Rebuild the tables, Pareto plot and summary from the store (no re-evaluation)."""
+    """Rebuild the tables, Pareto plot, summary and report.html from the store and the
+    exported designs (no re-evaluation)."""
+    from ..progress import log_lines
     from ..study.report import write_report
+    from ..webreport import write_study_page
 
     study, records = _open_results(results_dir)
-    info = write_report(results_dir, study, records)
+    with log_lines():
+        info = write_report(results_dir, study, records)
+        info["report"] = str(write_study_page(results_dir, study, records))
     info["output"] = str(results_dir)
     if as_json:
         _emit(info)

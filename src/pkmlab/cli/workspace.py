@@ -36,16 +36,16 @@ from .common import (
 )
 
 
-def _write_workspace(res, out_dir: Path, mesh_formats: list[str], window: float,
-                     spacing: float) -> list[Path]:
-    """Write every output into a scratch folder first, then move it into ``out_dir``."""
+def _write_workspace(res, out_dir: Path, mesh_formats: list[str], slices: dict) -> list[Path]:
+    """Write every output into a scratch folder first, then move it into ``out_dir``;
+    ``slices``: the slice layout (``WorkspaceSpec.slice_options()``)."""
     from ..atomic import staged
 
     for stale in ("workspace.stl", "workspace.ply", "workspace.glb"):
         (out_dir / stale).unlink(missing_ok=True)
     with staged(out_dir) as tmp:
         files = [res.save_npz(tmp / "workspace.npz"), res.save_json(tmp / "workspace.json"),
-                 res.plot_slices(tmp / "slices.png", window=window, spacing=spacing)]
+                 res.plot_slices(tmp / "slices.png", **slices)]
         if not res.empty:
             files += [res.save_mesh(tmp / f"workspace.{fmt}") for fmt in mesh_formats]
     return [out_dir / f.name for f in files]
@@ -123,8 +123,11 @@ def workspace(
     convergence: Annotated[bool, typer.Option(
         "--convergence", help="also report the volume for 3, 5, 7, 9, 13, 17 samples")]
     = False,
-    mesh: Annotated[str, typer.Option(help="mesh formats, comma-separated: stl,ply,glb")]
-    = "stl",
+    mesh: Annotated[str, typer.Option(
+        help="mesh formats, comma-separated: stl (mm), ply (mm), glb (m, y up)")] = "stl",
+    slice_layout: Annotated[str, typer.Option(
+        help="slices.png: auto (window and spacing scaled to the workspace) | paper "
+             "(Hopkins & Williams: 152.4 mm every 12.7 mm)")] = "auto",
     out_dir: Annotated[Path, typer.Option("--out", help="output folder")]
     = Path("results/workspace"),
     as_json: JsonOpt = False,
@@ -137,7 +140,8 @@ def workspace(
 
     mech = _load(mech_file)
     spec, req = _request(kind, orientation, box, semantics, tilt, torsion, samples, resolution,
-                         link_diameter, joint_limit, kappa_max, all_components, stroke)
+                         link_diameter, joint_limit, kappa_max, all_components, stroke,
+                         slice_layout)
     formats = [f.strip().lower() for f in mesh.split(",") if f.strip()]
     bad = [f for f in formats if f not in ("stl", "ply", "glb")]
     if bad or not formats:
@@ -155,7 +159,7 @@ def workspace(
             extra["orientation_convergence"] = orientation_convergence(mech, **req)
     except ParameterError as exc:
         _fail(exc)
-    written = _write_workspace(res, out_dir, formats, spec.slice_window, spec.slice_spacing)
+    written = _write_workspace(res, out_dir, formats, spec.slice_options())
     if extra:
         (out_dir / "workspace.json").write_text(
             json.dumps({**res.metrics(), **extra}, indent=2) + "\n")
@@ -184,8 +188,8 @@ def workspaces(
     for name, req in requests.items():
         res = compute(mech, **req, refine=refine and req["kind"] == "dexterous")
         ws = spec.workspaces[name]
-        written = _write_workspace(res, out_dir / spec.study / name, ["stl"], ws.slice_window,
-                                   ws.slice_spacing)
+        written = _write_workspace(res, out_dir / spec.study / name, ["stl"],
+                                   ws.slice_options())
         m = res.metrics()
         m["files"] = [str(p) for p in written]
         rows[name] = m

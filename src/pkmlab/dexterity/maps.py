@@ -21,7 +21,7 @@ from .force import max_force_all_directions
 from .metrics import CharacteristicLength, condition_number, resolve_length
 from .stiffness import stiffness
 
-__all__ = ["METRICS", "MetricMap", "metric_map", "mesh_colours"]
+__all__ = ["METRICS", "MetricMap", "metric_map", "mesh_colours", "vertex_values"]
 
 #: metric → (label, unit, worse is larger)
 METRICS = {
@@ -61,7 +61,7 @@ class MetricMap:
 
 def metric_map(mech, result, metric: str = "kappa",
                L: float | CharacteristicLength | None = None, f_max=150.0,
-               k=1.0e4) -> MetricMap:
+               k=1.0e4, progress=None) -> MetricMap:
     """Worst-case ``metric`` over ``result``'s orientation set at every occupied voxel.
 
     Args:
@@ -71,6 +71,8 @@ def metric_map(mech, result, metric: str = "kappa",
             :func:`pkmlab.dexterity.resolve_length` (Angeles').
         f_max: actuator force limit(s) in N for ``"force"``.
         k: actuator stiffness(es) in N/mm for ``"stiffness"``.
+        progress: optional ``progress(fraction_done)``, called after each batch of
+            orientations (a map over a large workspace takes tens of seconds).
     """
     if metric not in METRICS:
         raise ParameterError("metric", f"one of {list(METRICS)}", metric)
@@ -81,7 +83,7 @@ def metric_map(mech, result, metric: str = "kappa",
     V = len(pos)
     worse_is_larger = METRICS[metric][2]
     worst = np.full(V, -np.inf if worse_is_larger else np.inf)
-    for _, n, p, Rr in orientation_batches(pos, R):
+    for m0, n, p, Rr in orientation_batches(pos, R):
         J = mech.jacobian((p, Rr))
         valid = _ik_valid(mech, p, Rr)
         if metric in ("kappa", "lci"):
@@ -100,15 +102,26 @@ def metric_map(mech, result, metric: str = "kappa",
         val = val.reshape(n, V)
         worst = np.maximum(worst, val.max(axis=0)) if worse_is_larger else \
             np.minimum(worst, val.min(axis=0))
+        if progress is not None:
+            progress((m0 + n) / len(R))
     grid = np.full(result.occupancy.shape, np.nan)
     grid[idx[:, 0], idx[:, 1], idx[:, 2]] = worst
     return MetricMap(metric, worst, idx, pos, grid, length)
 
 
+def vertex_values(mesh, mmap: MetricMap) -> np.ndarray:
+    """``(n_vertices,)`` the map's value at each vertex of ``mesh``: its nearest voxel's."""
+    from scipy.spatial import cKDTree
+
+    if len(mmap.positions) == 0:
+        return np.full(len(mesh.vertices), np.nan)
+    _, near = cKDTree(mmap.positions).query(mesh.vertices)
+    return mmap.values.astype(float)[near]
+
+
 def mesh_colours(mesh, mmap: MetricMap, vmin=None, vmax=None, cmap: str = "viridis"):
     """``(n_vertices, 4)`` uint8 RGBA colours: each vertex takes its nearest voxel's value."""
     import matplotlib
-    from scipy.spatial import cKDTree
 
     vals = mmap.values.astype(float)
     finite = np.isfinite(vals)
@@ -116,8 +129,7 @@ def mesh_colours(mesh, mmap: MetricMap, vmin=None, vmax=None, cmap: str = "virid
         return np.tile([128, 128, 128, 255], (len(mesh.vertices), 1)).astype(np.uint8)
     lo = np.min(vals[finite]) if vmin is None else vmin
     hi = np.max(vals[finite]) if vmax is None else vmax
-    _, near = cKDTree(mmap.positions).query(mesh.vertices)
-    v = vals[near]
+    v = vertex_values(mesh, mmap)
     t = np.clip((np.where(np.isfinite(v), v, hi) - lo) / max(hi - lo, 1e-300), 0, 1)
     rgba = matplotlib.colormaps[cmap](t)
     return (rgba * 255).round().astype(np.uint8)

@@ -1,7 +1,7 @@
 """Study results from the store: tables, Pareto set, plots, exported designs, summary.
 
-Everything here reads the store; only :func:`export_designs` computes (the full workspace,
-mesh and κ map of the few Pareto designs it exports). Plots are built on
+Everything here reads the store; only :func:`.export.export_designs` computes (the full
+workspace, mesh and κ map of the few Pareto designs it exports). Plots are built on
 :class:`matplotlib.figure.Figure` objects (no pyplot state, no global backend).
 """
 
@@ -11,19 +11,17 @@ import csv
 import io
 import json
 import logging
-import platform
-import time
 from pathlib import Path
 
 import numpy as np
 import yaml
 
-from .. import __version__, atomic
-from ..config import to_display
-from ..errors import NumericalError, ParameterError
+from .. import atomic
 from .definition import Study
+from .export import export_designs
 from .metrics import METRICS
-from .run import BASELINE, feasible, objective_matrix
+from .run import BASELINE, feasible, objective_matrix, provenance
+from .selection import non_dominated
 
 log = logging.getLogger(__name__)
 
@@ -34,17 +32,9 @@ def pareto_mask(F: np.ndarray) -> np.ndarray:
     """``(n,)`` True for the rows of ``F (n, m)`` (minimised) that no other row dominates.
 
     Row a dominates b when a <= b everywhere and a < b somewhere. Duplicated rows are all kept.
+    (pymoo's non-dominated sorting: :func:`.selection.non_dominated`.)
     """
-    F = np.asarray(F, dtype=float)
-    n = len(F)
-    keep = np.ones(n, dtype=bool)
-    for i in range(n):
-        if not keep[i]:
-            continue
-        dominated = np.all(F <= F[i], axis=1) & np.any(F < F[i], axis=1)
-        if dominated.any():
-            keep[i] = False
-    return keep
+    return non_dominated(F)
 
 
 def _params(study: Study, record: dict) -> dict:
@@ -93,17 +83,12 @@ def pareto_records(study: Study, records: list[dict]) -> list[dict]:
     return [cand[i] for i in front]
 
 
-def provenance() -> dict:
-    """Where and when results were made."""
-    return {"pkmlab_version": __version__, "time": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-            "machine": platform.node(), "python": platform.python_version(),
-            "platform": platform.platform()}
-
-
 def write_report(out: Path, study: Study, records: list[dict]) -> dict:
     """evaluations.csv, pareto.csv, pareto.png, study.resolved.yaml, summary.md."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    log.info("writing evaluations.csv, pareto.csv, pareto.png, summary.md (%d evaluations)",
+             len(records))
     resolved = {**study.resolved(), "provenance": provenance()}
     atomic.write_text(out / "study.resolved.yaml",
                       "# The study as run: every default filled in, every quantity with its "
@@ -229,52 +214,3 @@ def _summary(study: Study, records, front, baseline) -> str:
               "definitions: `pkmlab metrics`. Full tables: evaluations.csv, pareto.csv; "
               "exported designs (mechanism YAML, workspace STL, slices, κ map) under designs/."]
     return "\n".join(lines) + "\n"
-
-
-def export_designs(out: Path, study: Study, front: list[dict]) -> tuple[list[Path], list[str]]:
-    """For the top designs: mechanism.yaml, workspace.stl, slices.png, kappa_slices.png.
-
-    Returns ``(folders, problems)``: a design whose export fails is skipped with its reason
-    in ``problems`` (logged), so an export error never stops the report.
-    """
-    folders, problems = [], []
-    for i, r in enumerate(front[:study.top]):
-        d = Path(out) / "designs" / f"{i + 1:02d}-{r['key'][:8]}"
-        try:
-            _export_one(d, study, r, i + 1)
-            folders.append(d)
-        except (ParameterError, NumericalError, ValueError, OSError) as exc:
-            log.warning("export of Pareto design %d failed: %s", i + 1, exc)
-            problems.append(f"Pareto design {i + 1}: {type(exc).__name__}: {exc}")
-    return folders, problems
-
-
-def _export_one(d: Path, study: Study, r: dict, rank: int) -> None:
-    from .. import dexterity as dx
-    from ..dexterity.maps import metric_map
-    from ..workspaces import workspace
-    from ..workspaces.plots import slice_figure
-
-    d.mkdir(parents=True, exist_ok=True)
-    spec = study.space.spec_of(r["params"])
-    spec = spec.model_copy(update={"name": f"{study.name}-pareto-{rank}"})
-    (d / "mechanism.yaml").write_text(
-        f"# Pareto design {rank} of study {study.name} (candidate {r['key']})\n"
-        + yaml.safe_dump(_plain(to_display(spec)), sort_keys=False, allow_unicode=True))
-    ev = study.evaluation
-    if ev.workspace is None:
-        return
-    mech = spec.build()
-    res = workspace(mech, **ev.request)
-    ws = ev.workspace
-    res.plot_slices(d / "slices.png", window=ws.slice_window, spacing=ws.slice_spacing)
-    if res.empty:
-        return
-    res.save_mesh(d / "workspace.stl")
-    length = dx.resolve_length(mech, r["metrics"].get("characteristic_length"))
-    L = length.length
-    mm = metric_map(mech, res, "kappa", length)
-    fig = slice_figure(res, window=ws.slice_window, spacing=ws.slice_spacing,
-                       values=np.where(np.isfinite(mm.grid), mm.grid, np.nan),
-                       label=f"{mm.label}, L = {L:.4g} mm")
-    fig.savefig(d / "kappa_slices.png", dpi=110)

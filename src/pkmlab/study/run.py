@@ -10,7 +10,9 @@ from __future__ import annotations
 import logging
 import math
 import os
+import platform
 import shutil
+import time
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +27,7 @@ from .store import Store, candidate_key
 log = logging.getLogger(__name__)
 
 __all__ = ["run_study", "objective_matrix", "feasible", "CandidateError", "BASELINE",
-           "OutputLock"]
+           "OutputLock", "provenance"]
 
 BASELINE = {"__baseline__": True}
 
@@ -39,6 +41,13 @@ class CandidateError(RuntimeError):
         self.details = details
         super().__init__(f"evaluation of candidate {params} raised an error (recorded in the "
                          f"store); the run stops:\n{details}")
+
+
+def provenance() -> dict:
+    """Where and when results were made."""
+    return {"pkmlab_version": __version__, "time": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+            "machine": platform.node(), "python": platform.python_version(),
+            "platform": platform.platform()}
 
 
 def _value(record: dict, metric: str):
@@ -166,6 +175,9 @@ def _run(study: Study, runner, store: Store, fp: str, progress) -> None:
     store.set_meta("fingerprint", fp)
     store.set_meta("resolved", study.resolved())
     store.set_meta("version", __version__)
+    runs = store.get_meta("runs") or []
+    store.set_meta("runs", [*runs, {**provenance(), "seed": study.seed,
+                                    "resumed": bool(runs)}])
     space, ev, seed = study.space, study.evaluation, study.seed
 
     def commit(key, role, params, result):

@@ -1,10 +1,15 @@
-"""Boundary meshes of workspaces by marching cubes on the stored signed field."""
+"""Boundary meshes of workspaces by marching cubes on the stored signed field, and their
+files in each format's unit convention."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
-__all__ = ["boundary_mesh"]
+from ..atomic import write_bytes
+
+__all__ = ["boundary_mesh", "write_mesh", "STL_HEADER"]
 
 
 def boundary_mesh(result):
@@ -28,3 +33,41 @@ def boundary_mesh(result):
     if mesh.volume < 0:
         mesh.invert()
     return mesh
+
+
+#: The 80-byte header of the binary STL files pkmlab writes (never starting with "solid").
+STL_HEADER = b"pkmlab workspace boundary; units: mm"
+
+
+def write_mesh(mesh, path, colors=None, values: dict | None = None) -> Path:
+    """Write ``mesh`` (mm) to ``path`` (.stl, .ply, .glb) atomically, in each format's unit.
+
+    STL: binary, mm, the unit stated in the 80-byte header. PLY: binary, mm (a ``comment
+    units mm`` header line), vertex colours and ``values`` (``{name: (n_vertices,)}``) as
+    float32 vertex properties. GLB: glTF's convention, metres and +y up (x, y, z → x, z, -y).
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    mesh = mesh.copy()
+    if colors is not None:
+        mesh.visual.vertex_colors = colors
+    if suffix == ".stl":
+        data = mesh.export(file_type="stl")
+        data = STL_HEADER.ljust(80, b" ") + data[80:]
+    elif suffix == ".ply":
+        for name, v in (values or {}).items():
+            v = np.asarray(v, dtype=np.float32)
+            if v.shape != (len(mesh.vertices),):
+                raise ValueError(f"vertex values {name!r}: shape {v.shape}, expected "
+                                 f"({len(mesh.vertices)},)")
+            mesh.vertex_attributes[name] = v
+        data = mesh.export(file_type="ply", encoding="binary")
+        head, sep, rest = data.partition(b"\n")            # "ply"
+        fmt, sep2, rest = rest.partition(b"\n")            # "format ..."
+        data = head + sep + fmt + sep2 + b"comment units mm\n" + rest
+    elif suffix == ".glb":
+        mesh.apply_transform([[1e-3, 0, 0, 0], [0, 0, 1e-3, 0], [0, -1e-3, 0, 0], [0, 0, 0, 1]])
+        data = mesh.export(file_type="glb")
+    else:
+        raise ValueError(f"mesh format {suffix!r}: use .stl, .ply or .glb")
+    return write_bytes(path, data)

@@ -1,31 +1,43 @@
 """Slice plots in the format of Hopkins & Williams (2002), Figs. 7-8.
 
 A grid of horizontal top-view sections through a square window, lowest slice top-left,
-advancing left-to-right then top-to-bottom, each labelled with its height.
+advancing left-to-right then top-to-bottom, each labelled with its height. The window and the
+spacing come from :func:`.slicing.slice_layout`: scaled to the workspace by default, or the
+paper's 152.4 mm every 12.7 mm (``layout="paper"``).
 """
 
 from __future__ import annotations
 
+import io
 import math
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["plot_slices", "slice_figure"]
+from ..atomic import write_bytes
+from .slicing import MAX_PANELS, slice_layout
+
+__all__ = ["plot_slices", "slice_figure", "overlay_figure"]
 
 
-def slice_figure(result, window: float = 152.4, spacing: float = 12.7, centre=None,
-                 columns: int | None = None, values: np.ndarray | None = None,
-                 cmap: str = "viridis", label: str = ""):
+def slice_figure(result, window: float | None = None, spacing: float | None = None,
+                 centre=None, columns: int | None = None, values: np.ndarray | None = None,
+                 cmap: str = "viridis", label: str = "", layout: str = "auto",
+                 max_panels: int = MAX_PANELS):
     """Build the figure (a :class:`matplotlib.figure.Figure`, no pyplot state, no global
-    backend); ``values (nx, ny, nz)`` colours the sections (nearest voxel layer)."""
+    backend); ``values (nx, ny, nz)`` colours the sections (nearest voxel layer).
+
+    ``layout`` (``"auto"`` or ``"paper"``), ``window``, ``spacing``, ``centre`` and
+    ``max_panels`` choose the sections (:func:`.slicing.slice_layout`; ``None``: the
+    layout's)."""
     from matplotlib.figure import Figure
 
-    levels = result.slice_levels(spacing)
+    lay = slice_layout(result, layout, window, spacing, centre, max_panels)
+    levels, window, spacing = lay.levels, lay.window, lay.spacing
     n = max(len(levels), 1)
     cols = columns or int(math.ceil(math.sqrt(n)))
     rows = int(math.ceil(n / cols))
-    cx, cy = centre if centre is not None else result.mechanism.nominal_pose[:2]
+    cx, cy = lay.centre
     half = window / 2
     h = result.resolution
     fig = Figure(figsize=(2.2 * cols, 2.2 * rows + 0.6), layout="constrained")
@@ -36,7 +48,7 @@ def slice_figure(result, window: float = 152.4, spacing: float = 12.7, centre=No
     if values is not None and not np.any(np.isfinite(values)):
         values = None                     # nothing to colour: plain sections
     if values is not None:
-        vmin, vmax = np.nanmin(values), np.nanmax(values)
+        vmin, vmax, extend = _colour_range(values)
     for a, ax in enumerate(axes.ravel()):
         ax.set_xlim(cx - half, cx + half)
         ax.set_ylim(cy - half, cy + half)
@@ -58,20 +70,86 @@ def slice_figure(result, window: float = 152.4, spacing: float = 12.7, centre=No
                            interpolation="nearest")
         ax.set_title(f"z = {z:.1f} mm", fontsize=7)
     if im is not None:
-        fig.colorbar(im, ax=axes, shrink=0.6, label=label)
+        note = {"neither": "", "max": "\n(colours capped at the 99th percentile)",
+                "min": "\n(colours floored at the 1st percentile)",
+                "both": "\n(colours: 1st to 99th percentile)"}[extend]
+        fig.colorbar(im, ax=axes, shrink=0.6, extend=extend, label=label + note)
     name = getattr(result.mechanism, "name", "") or result.mechanism.family
     if result.empty:
         axes.ravel()[0].text(0.5, 0.5, "empty: no position satisfies\nthe constraints",
                              ha="center", va="center", transform=axes.ravel()[0].transAxes,
                              fontsize=8)
     empty = " (empty)" if result.empty else ""
-    fig.suptitle(f"{name}: {result.kind} workspace{empty}\n{window:g} × {window:g} mm top views "
-                 f"every {spacing:g} mm, lowest top-left", fontsize=9)
+    fig.suptitle(f"{name}: {result.kind} workspace{empty}\n{lay.describe()}", fontsize=9)
     return fig
+
+
+def _colour_range(values: np.ndarray) -> tuple[float, float, str]:
+    """Colour limits: the full range, unless a few extreme voxels (near-singular κ in the
+    hundreds) stretch it to more than 1.5 times the 1st-99th percentile range; then those
+    percentiles, with ``extend`` marking the ends that were cut."""
+    v = values[np.isfinite(values)]
+    lo, hi = float(v.min()), float(v.max())
+    plo, phi = (float(x) for x in np.percentile(v, [1, 99]))
+    if not (phi > plo and hi - lo > 1.5 * (phi - plo)):
+        return lo, hi if hi > lo else lo + 1e-12, "neither"
+    span = phi - plo
+    cut_lo, cut_hi = plo - lo > 0.25 * span, hi - phi > 0.25 * span
+    if not cut_lo:
+        plo = lo
+    if not cut_hi:
+        phi = hi
+    extend = {(False, False): "neither", (True, False): "min", (False, True): "max",
+              (True, True): "both"}[(cut_lo, cut_hi)]
+    return plo, phi, extend
 
 
 def plot_slices(result, path, **kw) -> Path:
     """Write the slice grid to ``path`` (PNG). An empty workspace gets a labelled blank."""
     path = Path(path)
-    slice_figure(result, **kw).savefig(path, dpi=120)
-    return path
+    buf = io.BytesIO()
+    slice_figure(result, **kw).savefig(buf, format="png", dpi=120)
+    return write_bytes(path, buf.getvalue())
+
+
+def overlay_figure(results: list, labels: list[str], layout: str = "auto",
+                   window: float | None = None, spacing: float | None = None,
+                   max_panels: int = MAX_PANELS, title: str = ""):
+    """Outlines of several workspaces' sections, one colour each, on one common layout
+    (:func:`.slicing.slice_layout` over all of them: nothing is clipped by default)."""
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+
+    lay = slice_layout(list(results), layout, window, spacing, None, max_panels)
+    n = max(len(lay.levels), 1)
+    cols = int(math.ceil(math.sqrt(n)))
+    rows = int(math.ceil(n / cols))
+    colours = ["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#D55E00", "#56B4E9", "#F0E442",
+               "#000000"]
+    fig = Figure(figsize=(2.4 * cols, 2.4 * rows + 1.0), layout="constrained")
+    axes = fig.subplots(rows, cols, squeeze=False)
+    cx, cy = lay.centre
+    half = lay.window / 2
+    for a, ax in enumerate(axes.ravel()):
+        ax.set_xlim(cx - half, cx + half)
+        ax.set_ylim(cy - half, cy + half)
+        ax.set_aspect("equal")
+        ax.tick_params(labelsize=6)
+        if a >= len(lay.levels):
+            ax.axis("off")
+            continue
+        z = lay.levels[a]
+        for k, w in enumerate(results):
+            if w.empty or len(w.xs) < 2 or len(w.ys) < 2:
+                continue
+            sec = w.slice(z)
+            if sec.any():
+                ax.contour(w.xs, w.ys, sec.T.astype(float), levels=[0.5],
+                           colors=[colours[k % len(colours)]], linewidths=1.2)
+        ax.set_title(f"z = {z:.1f} mm", fontsize=7)
+    handles = [Line2D([], [], color=colours[k % len(colours)], label=lab)
+               for k, lab in enumerate(labels)]
+    fig.legend(handles=handles, loc="outside lower center", ncol=min(len(labels), 4),
+               fontsize=8)
+    fig.suptitle((title + "\n" if title else "") + lay.describe(), fontsize=9)
+    return fig

@@ -238,29 +238,42 @@ class WorkspaceResult:
         path.write_text(json.dumps(self.metrics(), indent=2) + "\n")
         return path
 
-    def mesh(self):
-        """Watertight boundary mesh (``trimesh.Trimesh``) by marching cubes on ``field``."""
+    @cached_property
+    def _boundary(self):
         from .mesh import boundary_mesh
 
         return boundary_mesh(self)
 
-    def save_mesh(self, path, colors=None) -> Path:
-        """Write the boundary mesh; the format follows the suffix (.stl, .ply, .glb)."""
+    def mesh(self):
+        """Watertight boundary mesh (``trimesh.Trimesh``, mm) by marching cubes on ``field``
+        (computed once; each call returns a copy the caller may colour or move)."""
+        return self._boundary.copy()
+
+    def save_mesh(self, path, colors=None, values: dict | None = None) -> Path:
+        """Write the boundary mesh; the format follows the suffix (.stl, .ply, .glb).
+
+        Each format's unit convention: STL in mm (stated in its header), PLY in mm (stated
+        in a header comment) with ``values`` — ``{name: (n_vertices,) array}`` for the
+        vertices of :meth:`mesh` — as float vertex properties, glTF binary in metres and
+        y up. ``colors``: ``(n_vertices, 4)`` uint8 vertex colours (PLY, GLB).
+        """
+        from .mesh import write_mesh
+
         path = Path(path)
         if path.suffix.lower() not in (".stl", ".ply", ".glb"):
             raise ParameterError("mesh file", "a .stl, .ply or .glb path", str(path))
-        m = self.mesh()
-        if colors is not None:
-            m.visual.vertex_colors = colors
-        m.export(path)
-        return path
+        return write_mesh(self.mesh(), path, colors=colors, values=values)
 
-    def plot_slices(self, path, window: float = 152.4, spacing: float = 12.7,
-                    centre: tuple[float, float] | None = None, columns: int | None = None):
+    def plot_slices(self, path, window: float | None = None, spacing: float | None = None,
+                    centre: tuple[float, float] | None = None, columns: int | None = None,
+                    layout: str = "auto", **kw):
+        """Slice grid PNG: scaled to the workspace (``layout="auto"``) or the paper's 152.4 mm
+        every 12.7 mm (``"paper"``); ``window`` / ``spacing`` override (see
+        :func:`.slicing.slice_layout`)."""
         from .plots import plot_slices
 
         return plot_slices(self, path, window=window, spacing=spacing, centre=centre,
-                           columns=columns)
+                           columns=columns, layout=layout, **kw)
 
     # ---- regular workspace -------------------------------------------------------------------
     def inscribed_box(self, **kw):

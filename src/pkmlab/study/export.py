@@ -1,0 +1,200 @@
+"""Export the chosen Pareto designs in full: mechanism file, workspace meshes, slices, κ map.
+
+The only part of reporting that computes: each exported design's workspace is evaluated again
+(with the study's request) to write its hull, slices and per-voxel κ. Everything the HTML
+report and :func:`pkmlab.open_results` need later is written here, so they only read files.
+
+``designs/NN-key/`` (``NN``: 1 = the knee, then the extremes, then the spread designs; see
+:mod:`.selection`) holds ``mechanism.yaml``, ``design.json`` (why it was chosen, its Pareto
+rank, values, slice layout, files), ``workspace.stl`` (mm), ``workspace.ply`` (mm, κ per
+vertex as a property), ``workspace.glb`` (m, coloured by κ), ``slices.png`` and
+``kappa_slices.png``; ``designs/index.json`` lists them and the exports that failed.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import logging
+import re
+import shutil
+import time
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from .. import atomic
+from ..config import to_display
+from ..errors import NumericalError, ParameterError
+from .definition import Study
+from .run import BASELINE, objective_matrix
+from .selection import select_designs
+
+log = logging.getLogger(__name__)
+
+__all__ = ["export_designs", "chosen_designs", "read_index", "DESIGN_FOLDER"]
+
+#: Exported design folders: ``NN-<first 8 characters of the candidate key>``.
+DESIGN_FOLDER = re.compile(r"^\d{2}-[0-9a-f]{8}$")
+
+
+def _plain(obj):
+    return json.loads(json.dumps(obj, default=float))
+
+
+def chosen_designs(study: Study, front: list[dict]) -> list[tuple[dict, int, str]]:
+    """The ``study.top`` designs of ``front`` to export: ``(record, pareto rank, why)``."""
+    if not front:
+        return []
+    F, _ = objective_matrix(study, front)
+    names = [o.metric for o in study.objectives]
+    return [(front[s.index], s.index + 1, s.why)
+            for s in select_designs(F, study.top, names)]
+
+
+def export_designs(out: Path, study: Study, front: list[dict], *, maps=("kappa",),
+                   progress=None) -> tuple[list[Path], list[str]]:
+    """Write the chosen designs of ``front`` (the Pareto records, in pareto.csv order).
+
+    Args:
+        out: the study's results folder.
+        study: the study.
+        front: :func:`.report.pareto_records`.
+        maps: per-voxel metrics of :mod:`pkmlab.dexterity.maps` written as PLY vertex
+            properties (the first also colours the GLB and the slices).
+        progress: optional ``progress(done, total, message)``, called as each step starts.
+
+    Returns ``(folders, problems)``: a design whose export fails is skipped with its reason
+    in ``problems`` (logged), so an export error never stops the report.
+    """
+    out = Path(out)
+    chosen = chosen_designs(study, front)
+    root = out / "designs"
+    root.mkdir(parents=True, exist_ok=True)
+    folders, problems, entries = [], [], []
+    t0 = time.perf_counter()
+    for i, (r, rank, why) in enumerate(chosen):
+        d = root / f"{i + 1:02d}-{r['key'][:8]}"
+
+        def step(message: str, i=i) -> None:
+            log.info("design %d/%d: %s", i + 1, len(chosen), message)
+            if progress:
+                progress(i, len(chosen), message)
+
+        step(f"Pareto rank {rank} ({why})")
+        try:
+            info = _export_one(d, study, r, i + 1, rank, why, maps, step)
+            folders.append(d)
+            entries.append({"folder": d.name, "number": i + 1, "pareto_rank": rank,
+                            "why": why, "seq": r["seq"], "key": r["key"],
+                            "files": info["files"]})
+        except (ParameterError, NumericalError, ValueError, OSError) as exc:
+            log.warning("export of design %d (Pareto rank %d) failed: %s", i + 1, rank, exc)
+            problems.append(f"design {i + 1} (Pareto rank {rank}): {type(exc).__name__}: "
+                            f"{exc}")
+    keep = {d.name for d in folders}
+    for stale in root.iterdir():
+        if stale.is_dir() and DESIGN_FOLDER.match(stale.name) and stale.name not in keep:
+            shutil.rmtree(stale)
+    atomic.write_text(root / "index.json", json.dumps(
+        {"designs": entries, "problems": problems}, indent=2) + "\n")
+    if progress:
+        progress(len(chosen), len(chosen), "done")
+    log.info("exported %d design(s) in %.1f s", len(folders), time.perf_counter() - t0)
+    return folders, problems
+
+
+def _every(seconds: float, report):
+    """``report(x)`` at most once per ``seconds`` (for progress callbacks)."""
+    last = [time.perf_counter()]
+
+    def tick(x) -> None:
+        now = time.perf_counter()
+        if now - last[0] >= seconds:
+            last[0] = now
+            report(x)
+    return tick
+
+
+def read_index(out: Path) -> dict:
+    """``designs/index.json`` of a results folder (empty when nothing was exported)."""
+    p = Path(out) / "designs" / "index.json"
+    if not p.is_file():
+        return {"designs": [], "problems": []}
+    return json.loads(p.read_text())
+
+
+def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str, maps,
+                step) -> dict:
+    from .. import dexterity as dx
+    from ..dexterity.maps import METRICS as MAPS
+    from ..dexterity.maps import mesh_colours, metric_map, vertex_values
+    from ..workspaces import workspace
+    from ..workspaces.plots import slice_figure
+    from ..workspaces.slicing import slice_layout
+
+    d.mkdir(parents=True, exist_ok=True)
+    params = study.space.baseline_values() if r["params"] == BASELINE else r["params"]
+    spec = study.space.spec_of(r["params"] if r["params"] != BASELINE else None)
+    spec = spec.model_copy(update={"name": f"{study.name}-design-{number}"})
+    atomic.write_text(d / "mechanism.yaml",
+                      f"# Design {number} of study {study.name}: Pareto rank {rank}, {why} "
+                      f"(candidate {r['key']}). Lengths in mm, angles in degrees.\n"
+                      + yaml.safe_dump(_plain(to_display(spec)), sort_keys=False,
+                                       allow_unicode=True))
+    files = ["mechanism.yaml"]
+    info: dict = {"number": number, "pareto_rank": rank, "why": why, "seq": r["seq"],
+                  "key": r["key"], "params": params, "metrics": r["metrics"],
+                  "notes": r.get("notes", {}), "files": files}
+    ev = study.evaluation
+    if ev.workspace is not None:
+        mech = spec.build()
+        force_limit = ev.dexterity.force_limit if ev.dexterity is not None else 150.0
+        step("workspace")
+        res = workspace(mech, **ev.request)
+        opts = ev.workspace.slice_options()
+        lay = slice_layout(res, **opts)
+        info["workspace"] = {k: v for k, v in res.metrics().items()
+                             if k in ("kind", "volume_cm3", "volume_error_cm3", "bbox_mm",
+                                      "z_range_mm", "centroid_mm", "resolution_mm", "empty",
+                                      "method")}
+        info["slice_layout"] = lay.as_dict()
+        step("slices")
+        res.plot_slices(d / "slices.png", **opts)
+        files.append("slices.png")
+        if not res.empty:
+            length = dx.resolve_length(mech, r["metrics"].get("characteristic_length"))
+            L = length.length if length.status != "fallback" else None
+            mesh = res.mesh()
+            values, first = {}, None
+            for name in maps if L else ():
+                step(f"{name} map over {int(res.occupancy.sum())} voxels × "
+                     f"{len(res.orientations.rotations())} orientations")
+                mm = metric_map(mech, res, name, L, f_max=force_limit,
+                                progress=_every(2.0, lambda f, name=name: step(
+                                    f"{name} map {100 * f:.0f} %")))
+                values[name] = vertex_values(mesh, mm)
+                if first is None:
+                    first = mm
+            colours = mesh_colours(mesh, first) if first is not None else None
+            step("meshes (STL, PLY, GLB)")
+            for fmt in ("stl", "ply", "glb"):
+                res.save_mesh(d / f"workspace.{fmt}", colors=None if fmt == "stl" else colours,
+                              values=values if fmt == "ply" else None)
+                files.append(f"workspace.{fmt}")
+            info["characteristic_length"] = L
+            info["vertex_values"] = {n: {"label": MAPS[n][0], "unit": MAPS[n][1]}
+                                     for n in values}
+            if first is not None:
+                step(f"{first.metric} slices")
+                fig = slice_figure(res, values=np.where(np.isfinite(first.grid), first.grid,
+                                                        np.nan),
+                                   label=f"{first.label}, L = {L:.4g} mm", **opts)
+                name = f"{first.metric}_slices.png"
+                buf = io.BytesIO()
+                fig.savefig(buf, format="png", dpi=110)
+                atomic.write_bytes(d / name, buf.getvalue())
+                files.append(name)
+    atomic.write_text(d / "design.json", json.dumps(_plain(info), indent=2) + "\n")
+    return info

@@ -1,0 +1,266 @@
+"""The report's interactive charts, built with plotly (rendered offline by the embedded
+plotly.js): the Pareto scatter matrix and parallel coordinates, and 3-D scenes of workspace
+hulls with the mechanism drawn at its nominal pose.
+
+Every point of the Pareto charts carries its candidate's ``seq`` as ``customdata``: the page
+opens that candidate's card when it is clicked.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["pareto_matrix", "pareto_parcoords", "mechanism_traces", "hull_trace",
+           "design_scene", "overlay_scene", "PALETTE"]
+
+#: Colours of overlaid designs (colour-blind safe, Okabe-Ito).
+PALETTE = ("#0072B2", "#E69F00", "#009E73", "#CC79A7", "#D55E00", "#56B4E9", "#F0E442",
+           "#000000")
+
+_STYLE = {  # group → (label, marker)
+    "infeasible": ("infeasible", dict(color="#b8b8b8", size=5, symbol="x-thin",
+                                      line=dict(width=1, color="#9a9a9a"))),
+    "feasible": ("feasible", dict(color="#6baed6", size=6, line=dict(width=0))),
+    "pareto": ("Pareto front", dict(color="#d62728", size=8, line=dict(width=0.5,
+                                                                      color="#7f0000"))),
+    "exported": ("exported design (card)", dict(color="rgba(0,0,0,0)", size=17,
+                                                 line=dict(width=2.5, color="#111111"))),
+    "baseline": ("baseline", dict(color="#111111", size=15, symbol="star",
+                                  line=dict(width=1, color="#ffffff"))),
+}
+
+
+def _layout(**kw) -> dict:
+    base = dict(template="none", font=dict(family="system-ui, sans-serif", size=12),
+                paper_bgcolor="#ffffff", plot_bgcolor="#ffffff",
+                margin=dict(l=60, r=20, t=40, b=50), hoverlabel=dict(align="left"))
+    base.update(kw)
+    return base
+
+
+def pareto_matrix(axes: list[dict], points: list[dict]):
+    """Scatter matrix of the objectives (lower triangle; one panel for two objectives).
+
+    Args:
+        axes: one ``{"key", "label"}`` per objective (label with unit and sense).
+        points: ``{"seq", "group", "values": {key: float | None}, "hover": str,
+            "text": str}``; ``group`` is one of infeasible, feasible, pareto, exported,
+            baseline (an exported design is drawn twice: as a Pareto point and ringed).
+    """
+    import plotly.graph_objects as go
+    from plotly.subplots import make_subplots
+
+    m = len(axes)
+    if m == 1:          # one objective: its value against the evaluation order
+        axes = [{"key": "__seq__", "label": "candidate (evaluation order)"}, axes[0]]
+        points = [{**p, "values": {**p["values"], "__seq__": p["seq"]}} for p in points]
+        m = 2
+    n = m - 1
+    fig = make_subplots(rows=n, cols=n, shared_xaxes="columns", shared_yaxes="rows",
+                        horizontal_spacing=0.06 if n > 1 else 0.0,
+                        vertical_spacing=0.06 if n > 1 else 0.0)
+    shown = set()
+    # many points: WebGL markers (the same clicks and hover), SVG otherwise (crisp in print)
+    Scatter = go.Scattergl if len(points) > 1500 else go.Scatter
+    for r in range(n):
+        for c in range(r + 1):
+            ax, ay = axes[c], axes[r + 1]
+            for group in ("infeasible", "feasible", "pareto", "exported", "baseline"):
+                pts = [p for p in points if p["group"] == group
+                       and p["values"].get(ax["key"]) is not None
+                       and p["values"].get(ay["key"]) is not None]
+                if not pts:
+                    continue
+                label, marker = _STYLE[group]
+                fig.add_trace(Scatter(
+                    x=[p["values"][ax["key"]] for p in pts],
+                    y=[p["values"][ay["key"]] for p in pts],
+                    mode="markers+text" if group == "exported" else "markers",
+                    text=[p.get("text", "") for p in pts], textposition="top right",
+                    textfont=dict(size=11, color="#111111"),
+                    customdata=[p["seq"] for p in pts], hovertext=[p["hover"] for p in pts],
+                    hovertemplate="%{hovertext}<extra></extra>", name=label, marker=marker,
+                    legendgroup=group, showlegend=group not in shown), row=r + 1, col=c + 1)
+                shown.add(group)
+            if r == n - 1:
+                fig.update_xaxes(title_text=ax["label"], row=r + 1, col=c + 1)
+            if c == 0:
+                fig.update_yaxes(title_text=ay["label"], row=r + 1, col=c + 1)
+    side = 330 if n > 1 else 470
+    fig.update_xaxes(showgrid=True, gridcolor="#eeeeee", zeroline=False, ticks="outside",
+                     showline=True, linecolor="#888888")
+    fig.update_yaxes(showgrid=True, gridcolor="#eeeeee", zeroline=False, ticks="outside",
+                     showline=True, linecolor="#888888")
+    fig.update_layout(**_layout(height=side * n + 90, clickmode="event", hovermode="closest",
+                                legend=dict(orientation="h", y=1.0, yanchor="bottom", x=0),
+                                margin=dict(l=80, r=20, t=50, b=60)))
+    return fig
+
+
+def pareto_parcoords(axes: list[dict], rows: list[dict]):
+    """Parallel coordinates of the objectives over the feasible candidates, the Pareto set in
+    red. ``rows``: ``{"values": {key: float}, "pareto": bool}``."""
+    import plotly.graph_objects as go
+
+    dims = []
+    for a in axes:
+        vals = [r["values"][a["key"]] for r in rows]
+        dims.append(dict(label=a["label"], values=vals))
+    colour = [1.0 if r["pareto"] else 0.0 for r in rows]
+    fig = go.Figure(go.Parcoords(
+        dimensions=dims, labelangle=0, labelside="top",
+        line=dict(color=colour, colorscale=[[0, "#9ecae1"], [1, "#d62728"]], cmin=0, cmax=1)))
+    fig.update_layout(**_layout(height=380, margin=dict(l=150, r=150, t=80, b=30)))
+    return fig
+
+
+def _loop(P: np.ndarray) -> np.ndarray:
+    """Points in angular order about their centroid, closed."""
+    c = P.mean(axis=0)
+    order = np.argsort(np.arctan2(P[:, 1] - c[1], P[:, 0] - c[0]))
+    P = P[order]
+    return np.vstack([P, P[:1]])
+
+
+def _segments(starts: np.ndarray, ends: np.ndarray):
+    """Line segments as one polyline broken by ``None``."""
+    xs, ys, zs = [], [], []
+    for a, b in zip(starts, ends):
+        xs += [float(a[0]), float(b[0]), None]
+        ys += [float(a[1]), float(b[1]), None]
+        zs += [float(a[2]), float(b[2]), None]
+    return xs, ys, zs
+
+
+def mechanism_traces(mech, name: str = "", colour: str = "#333333", visible=True,
+                     grouped: bool = False) -> list:
+    """The mechanism at its nominal pose: base, platform, legs, actuators (plotly traces).
+
+    ``grouped``: one legend entry for the whole mechanism (``name: mechanism``), which shows
+    or hides it at once; otherwise one entry per part."""
+    import plotly.graph_objects as go
+
+    from ..poses import as_frames
+
+    pose = mech.nominal_pose
+    p, R = as_frames(pose[None, :])
+    q = mech.inverse((p, R)).q[0]
+    starts, ends = (a[0] for a in mech.leg_segments(p, R))
+    label = f"{name}: " if name else ""
+    kw: dict = dict(visible=visible)
+    if grouped:
+        kw["legendgroup"] = f"mech-{name}"
+    traces = []
+    base = _loop(np.asarray(mech.base_points))
+    traces.append(go.Scatter3d(x=base[:, 0], y=base[:, 1], z=base[:, 2], mode="lines",
+                               line=dict(color="#7f7f7f", width=6), name=f"{label}base",
+                               hoverinfo="name", **kw))
+    W = p[0] + np.asarray(mech.tool_points) @ R[0].T
+    plat = _loop(W)
+    traces.append(go.Scatter3d(x=plat[:, 0], y=plat[:, 1], z=plat[:, 2], mode="lines",
+                               line=dict(color=colour, width=8),
+                               name=f"{label}platform (nominal pose)", hoverinfo="name",
+                               **kw))
+    if mech.family == "psu6":       # vertical rails: the sliders' travel
+        lo, hi = mech.stroke
+        b = np.asarray(mech.base_points)
+        x, y, z = _segments(b + [0, 0, lo], b + [0, 0, hi])
+        traces.append(go.Scatter3d(x=x, y=y, z=z, mode="lines",
+                                   line=dict(color="#bbbbbb", width=4),
+                                   name=f"{label}actuator rails", hoverinfo="name", **kw))
+    if mech.family == "luzi3":      # the upper links joining each chain's two legs
+        x, y, z = _segments(ends[0::2], ends[1::2])
+        traces.append(go.Scatter3d(x=x, y=y, z=z, mode="lines",
+                                   line=dict(color=colour, width=6),
+                                   name=f"{label}upper links", hoverinfo="name", **kw))
+    x, y, z = _segments(starts, ends)
+    traces.append(go.Scatter3d(x=x, y=y, z=z, mode="lines", line=dict(color="#E69F00", width=5),
+                               name=f"{label}legs", hoverinfo="name", **kw))
+    names = mech.actuator_names
+    hover = [f"{n} = {v:.2f} mm (stroke {mech.stroke[0]:g} … {mech.stroke[1]:g})"
+             for n, v in zip(names, q)]
+    traces.append(go.Scatter3d(x=starts[:, 0], y=starts[:, 1], z=starts[:, 2],
+                               mode="markers", marker=dict(size=4, color="#D55E00"),
+                               name=f"{label}actuators", hovertext=hover,
+                               hovertemplate="%{hovertext}<extra></extra>", **kw))
+    traces.append(go.Scatter3d(x=[float(p[0, 0])], y=[float(p[0, 1])], z=[float(p[0, 2])],
+                               mode="markers", marker=dict(size=5, color="#000000",
+                                                           symbol="diamond"),
+                               name=f"{label}tool point", hovertemplate=(
+                                   "tool point (%{x:.1f}, %{y:.1f}, %{z:.1f}) mm"
+                                   "<extra></extra>"), **kw))
+    if grouped:
+        for i, t in enumerate(traces):
+            t.update(showlegend=i == 0, name=f"{label}mechanism (nominal pose)" if i == 0
+                     else t.name)
+    return traces
+
+
+def hull_trace(vertices: np.ndarray, faces: np.ndarray, intensity=None, *, label: str = "",
+               colour: str | None = None, opacity: float = 0.55, name: str = "workspace",
+               showscale: bool = True, ambient: float = 0.55):
+    """A workspace hull (mm) as a mesh3d trace, coloured by ``intensity`` per vertex."""
+    import plotly.graph_objects as go
+
+    V = np.asarray(vertices, dtype=np.float32)
+    Fc = np.asarray(faces, dtype=np.int32)
+    kw: dict = {}
+    if intensity is not None:
+        kw = dict(intensity=np.asarray(intensity, dtype=np.float32), colorscale="Viridis",
+                  showscale=showscale, colorbar=dict(title=dict(text=label, side="right"),
+                                                     len=0.75, thickness=14))
+    else:
+        kw = dict(color=colour or PALETTE[0])
+    return go.Mesh3d(x=V[:, 0], y=V[:, 1], z=V[:, 2], i=Fc[:, 0], j=Fc[:, 1], k=Fc[:, 2],
+                     opacity=opacity, flatshading=False, name=name, showlegend=True,
+                     lighting=dict(ambient=ambient, diffuse=0.6, specular=0.1),
+                     hovertemplate="(%{x:.1f}, %{y:.1f}, %{z:.1f}) mm"
+                     + ("<br>%{intensity:.3g}" if intensity is not None else "")
+                     + f"<extra>{name}</extra>", **kw)
+
+
+def _scene() -> dict:
+    ax = dict(showbackground=True, backgroundcolor="#f7f7f7", gridcolor="#dddddd",
+              zerolinecolor="#bbbbbb")
+    return dict(aspectmode="data", xaxis=dict(title=dict(text="x (mm)"), **ax),
+                yaxis=dict(title=dict(text="y (mm)"), **ax),
+                zaxis=dict(title=dict(text="z (mm)"), **ax),
+                camera=dict(eye=dict(x=1.6, y=-1.6, z=0.9)))
+
+
+def design_scene(mech, hull: dict | None):
+    """One design: its hull (``{"vertices", "faces", "intensity", "label"}`` or None) and the
+    mechanism at its nominal pose."""
+    import plotly.graph_objects as go
+
+    traces = []
+    if hull is not None:
+        traces.append(hull_trace(hull["vertices"], hull["faces"], hull.get("intensity"),
+                                 label=hull.get("label", "")))
+    traces += mechanism_traces(mech)
+    fig = go.Figure(traces)
+    fig.update_layout(**_layout(height=560, scene=_scene(), margin=dict(l=0, r=0, t=10, b=0),
+                                legend=dict(orientation="h", x=0, y=0, yanchor="top",
+                                            bgcolor="rgba(255,255,255,0.7)")))
+    return fig
+
+
+def overlay_scene(items: list[dict], title: str = ""):
+    """Several designs' hulls overlaid (``{"label", "vertices", "faces", "mechanism"}``), each
+    in its colour; mechanisms drawn but hidden until chosen in the legend."""
+    import plotly.graph_objects as go
+
+    traces = []
+    for n, it in enumerate(items):
+        colour = PALETTE[n % len(PALETTE)]
+        if it.get("vertices") is not None:
+            traces.append(hull_trace(it["vertices"], it["faces"], colour=colour, opacity=0.35,
+                                     name=it["label"], ambient=0.85))
+        if it.get("mechanism") is not None:
+            traces += mechanism_traces(it["mechanism"], it["label"], colour,
+                                       visible="legendonly", grouped=True)
+    fig = go.Figure(traces)
+    fig.update_layout(**_layout(height=560, scene=_scene(), margin=dict(l=0, r=0, t=30, b=0),
+                                title=dict(text=title, x=0.01, font=dict(size=13)),
+                                legend=dict(x=0, y=1, bgcolor="rgba(255,255,255,0.7)")))
+    return fig

@@ -1,0 +1,251 @@
+"""``results/<study>/report.html``: the study's interactive report, from the store and the
+exported design files (nothing is evaluated again)."""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from ..study.definition import Study
+from ..study.export import read_index
+from ..study.metrics import METRICS
+from . import data as D
+from .figures import design_scene, pareto_matrix, pareto_parcoords
+from .page import colour_option, figure_json, hull_of_ply, png_uri, render_page
+
+log = logging.getLogger(__name__)
+
+__all__ = ["write_study_page", "REPORT_NAME"]
+
+REPORT_NAME = "report.html"
+
+_FILES = {
+    "mechanism.yaml": "mechanism file (pkmlab inspect / workspace / compare read it)",
+    "design.json": "why it was chosen, values, slice layout",
+    "workspace.stl": "workspace hull, binary STL in mm",
+    "workspace.ply": "workspace hull in mm, per-vertex metric values as properties",
+    "workspace.glb": "workspace hull, glTF binary in metres (y up), coloured by the metric",
+    "slices.png": "horizontal sections",
+}
+
+
+def _runs(out: Path) -> list[dict]:
+    from ..study.store import Store
+
+    path = out / "evaluations.sqlite"
+    if not path.is_file():
+        return []
+    store = Store(path, read_only=True)
+    try:
+        return store.get_meta("runs") or []
+    finally:
+        store.close()
+
+
+def _points(study: Study, rows: list[dict]) -> list[dict]:
+    pts = []
+    for r in rows:
+        if r["status"] != "ok":
+            continue
+        values = {o.metric: r["metrics"].get(o.metric) for o in study.objectives}
+        pts.append({"seq": r["seq"], "group": r["group"], "values": values,
+                    "hover": r["hover"]})
+        if r["design"]:
+            pts.append({"seq": r["seq"], "group": "exported", "values": values,
+                        "hover": r["hover"], "text": str(r["design"])})
+    return pts
+
+
+def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
+          n: int) -> tuple[dict, object | None, list]:
+    folder = out / "designs" / entry["folder"]
+    info = json.loads((folder / "design.json").read_text())
+    params = info["params"]
+    base_p = baseline["params"] if baseline else {}
+    base_m = baseline["metrics"] if baseline else {}
+    rounded, problem = D.build_values(study, params)
+    prow = []
+    for v in study.variables:
+        x = params.get(v.name)
+        xd = None if x is None else v.display(x)
+        xr = rounded.get(v.name)
+        d, pct = D.difference(xd, base_p.get(v.name))
+        prow.append({"name": v.name, "unit": v.unit, "value": D.fmt(xd),
+                     "build": D.fmt(None if xr is None else v.display(xr), 6),
+                     "baseline": D.fmt(base_p.get(v.name)), "delta": d, "pct": pct})
+    objectives = {o.metric: o.sense[:3] + "." for o in study.objectives}
+    metrics = info["metrics"]
+    mrows = D.compare_rows([(m, METRICS[m].unit, metrics.get(m), base_m.get(m))
+                            for m in METRICS if m in metrics or m in base_m])
+    for r in mrows:
+        r["objective"] = objectives.get(r["name"], "")
+        r["title"] = METRICS[r["name"]].description
+    mrows.sort(key=lambda r: (not r["objective"],))
+    card = {"number": entry["number"], "seq": entry["seq"], "key": entry["key"][:12],
+            "pareto_rank": entry["pareto_rank"], "why": info["why"],
+            "short": info["why"].split(":")[0], "params": prow,
+            "derived": D.derived_rows(study, params, rounded), "metrics": mrows,
+            "constraints": D.constraint_rows(study, metrics), "notes": info.get("notes", {}),
+            "build_problem": problem, "slices": [], "files": [], "has_scene": False,
+            "colour_options": [], "scene_note": ""}
+    for name in info["files"]:
+        what = _FILES.get(name, "slices coloured by the metric" if name.endswith("_slices.png")
+                          else "")
+        card["files"].append({"name": name, "href": f"designs/{entry['folder']}/{name}",
+                              "what": what})
+    card["files"].append({"name": "design.json", "href": f"designs/{entry['folder']}/"
+                          "design.json", "what": _FILES["design.json"]})
+    lay = info.get("slice_layout")
+    for name in sorted(info["files"], key=lambda s: (s == "slices.png", s)):
+        if name.endswith(".png") and (folder / name).is_file():
+            caption = ("sections" if name == "slices.png" else
+                       f"sections coloured by {name.replace('_slices.png', '')}")
+            if lay:
+                caption += (f", {lay['window_mm']:g} mm window every {lay['spacing_mm']:g} mm "
+                            f"({lay['layout']} layout)")
+            card["slices"].append({"uri": png_uri(folder / name), "caption": caption})
+    fig, colours = None, []
+    mech = None
+    try:
+        mech = study.space.decode(params)
+    except Exception as exc:  # noqa: BLE001 - a drawing problem never stops the report
+        log.warning("design %d: mechanism not drawn: %s", n, exc)
+    ply = folder / "workspace.ply"
+    if mech is not None:
+        hull = None
+        if ply.is_file():
+            h = hull_of_ply(ply)
+            labels = info.get("vertex_values", {})
+            for name, vals in h["values"].items():
+                meta = labels.get(name, {"label": name, "unit": ""})
+                text = meta["label"] + (f" ({meta['unit']})" if meta.get("unit") else "")
+                colours.append(colour_option(text, vals))
+            colours.append(colour_option("height z (mm)", h["vertices"][:, 2]))
+            first = colours[0]
+            hull = {"vertices": h["vertices"], "faces": h["faces"],
+                    "intensity": np.asarray(first["values"]), "label": first["label"]}
+            card["scene_note"] = (f"{len(h['faces'])} triangles; the hull is the set of tool "
+                                  "points of the study's workspace request. Colour range: 1st "
+                                  "to 99th percentile. Drag to rotate, scroll to zoom; click "
+                                  "legend entries to hide parts.")
+        else:
+            card["scene_note"] = ("No workspace hull: " + ("the workspace is empty."
+                                  if info.get("workspace", {}).get("empty")
+                                  else "the study evaluates no workspace."))
+        fig = design_scene(mech, hull)
+        if hull is not None:
+            fig.data[0].update(cmin=colours[0]["cmin"], cmax=colours[0]["cmax"])
+        card["has_scene"] = True
+        card["colour_options"] = [c["label"] for c in colours] or ["—"]
+    else:
+        card["scene_note"] = "The mechanism could not be drawn (see the log)."
+    return card, fig, colours
+
+
+def _variables(study: Study) -> list[dict]:
+    base = study.space.baseline_values()
+    out = []
+    for v in study.variables:
+        if v.kind == "choice":
+            rng = ", ".join(str(c) for c in v.choices)
+        else:
+            rng = f"{D.fmt(v.display(v.low))} … {D.fmt(v.display(v.high))}"
+            if v.kind == "integer":
+                rng += " (integer)"
+        b = base.get(v.name)
+        out.append({"name": v.name, "unit": v.unit, "range": rng,
+                    "baseline": "— (free parameter)" if b is None else D.fmt(v.display(b))})
+    return out
+
+
+def _optimizer_text(study: Study) -> str:
+    opt = study.optimizer.model_dump()
+    method = opt.get("method", "")
+    keys = {"sobol": ("samples",), "lhs": ("samples",), "grid": (),
+            "nsga2": ("population", "generations"), "de": ("population", "generations")}
+    return ", ".join([str(method)] + [f"{k} {opt[k]}" for k in keys.get(method, ())
+                                      if opt.get(k) is not None])
+
+
+def write_study_page(out: Path, study: Study, records: list[dict], *, progress=None) -> Path:
+    """Write ``out/report.html`` for ``study`` from its ``records`` (``Store.all()``) and the
+    designs exported into ``out/designs`` (:func:`pkmlab.study.export.export_designs`).
+
+    ``progress``: optional ``progress(message)`` per step (also logged at INFO).
+    """
+    from ..study.report import pareto_records
+
+    t0 = time.perf_counter()
+    out = Path(out)
+
+    def step(message: str) -> None:
+        log.info("report.html: %s", message)
+        if progress:
+            progress(message)
+
+    step("tables")
+    front = pareto_records(study, records)
+    index = read_index(out)
+    by_seq = {e["seq"]: e["number"] for e in index["designs"]}
+    rows = D.candidate_rows(study, records, front, by_seq)
+    baseline = next((r for r in rows if r["role"] == "baseline"), None)
+    axes = D.objective_axes(study)
+    step("Pareto charts")
+    figures = {"fig-pareto-matrix": figure_json(pareto_matrix(axes, _points(study, rows)))}
+    has_parcoords = len(axes) > 2
+    if has_parcoords:
+        pc = [{"values": {a["key"]: r["metrics"][a["key"]] for a in axes},
+               "pareto": bool(r["pareto_rank"])} for r in rows
+              if r["role"] == "candidate" and r["feasible"]
+              and all(isinstance(r["metrics"].get(a["key"]), int | float) and
+                      math.isfinite(r["metrics"][a["key"]]) for a in axes)]
+        figures["fig-pareto-parcoords"] = figure_json(pareto_parcoords(axes, pc))
+    cards, colours = [], {}
+    for entry in index["designs"]:
+        if not (out / "designs" / entry["folder"] / "design.json").is_file():
+            continue
+        step(f"design card {entry['number']}")
+        card, fig, opts = _card(out, study, entry, baseline, entry["number"])
+        cards.append(card)
+        if fig is not None:
+            figures[f"fig-design-{card['number']}"] = figure_json(fig)
+        if opts:
+            colours[card["number"]] = opts
+    metrics = [m for m in METRICS if any(m in r["metrics"] for r in rows)]
+    counts, reasons = D.failure_counts(records)
+    resolved = out / "study.resolved.yaml"
+    resolved_text = (resolved.read_text() if resolved.is_file() else
+                     yaml.safe_dump(json.loads(json.dumps(study.resolved(), default=float)),
+                                    sort_keys=False, allow_unicode=True))
+    data = {"study": study.name, "objectives": axes,
+            "variables": [{"name": v.name, "unit": v.unit} for v in study.variables],
+            "metrics": [{"name": m, "unit": METRICS[m].unit} for m in metrics],
+            "candidates": [{k: v for k, v in r.items() if k != "hover"} for r in rows],
+            "pareto": [r["seq"] for r in front],
+            "designs": [{k: c[k] for k in ("number", "seq", "pareto_rank", "why")}
+                        for c in cards],
+            "colours": colours}
+    step("writing")
+    path = render_page(
+        out / REPORT_NAME, "study.html.j2", title=study.name, kind="design study report",
+        data=data, figures=figures, description=study.description, axes=axes, cards=cards,
+        n_evaluations=len(records), counts=counts, reasons=reasons,
+        n_feasible=sum(r["feasible"] for r in rows if r["role"] == "candidate"),
+        n_pareto=len(front), has_parcoords=has_parcoords,
+        constraints_text=", ".join(c.describe() for c in study.constraints) or "none",
+        export_problems=index["problems"], variables=_variables(study),
+        optimizer=_optimizer_text(study),
+        seed=study.seed, resolved_yaml=resolved_text, runs=_runs(out),
+        length_step=D.LENGTH_STEP_MM, angle_step=D.ANGLE_STEP_DEG,
+        stale_designs=not index["designs"] and any(
+            p.is_dir() for p in (out / "designs").glob("[0-9][0-9]-*")))
+    log.info("report.html written in %.1f s (%d design cards)", time.perf_counter() - t0,
+             len(cards))
+    return path
+

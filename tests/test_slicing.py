@@ -1,0 +1,146 @@
+"""Slice layouts scaled to each workspace (the paper's as an option) and mesh files in each
+format's unit (issue "A report a designer opens in the browser", item 3)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+from conftest import MECH_DIR
+from typer.testing import CliRunner
+
+import pkmlab
+from pkmlab.cli import app
+from pkmlab.config import workspace_spec
+from pkmlab.errors import ParameterError
+from pkmlab.workspaces.mesh import STL_HEADER
+from pkmlab.workspaces.plots import overlay_figure, slice_figure
+from pkmlab.workspaces.slicing import MAX_PANELS, nice_ceil, slice_layout
+
+HOPKINS = MECH_DIR / "hopkins-williams-6psu.yaml"
+
+
+@pytest.fixture(scope="module")
+def small():
+    mech = pkmlab.load_mechanism(HOPKINS)
+    return pkmlab.workspace(mech, "dexterous",
+                            pkmlab.OrientationSet.box(np.radians([8.0] * 3), samples=2), 6.0)
+
+
+@pytest.fixture(scope="module")
+def large():
+    """A large 6-UPS: the paper's 152.4 mm window gave it 70 mostly solid panels."""
+    mech = pkmlab.load_mechanism(MECH_DIR / "gough-stewart-6ups.yaml")
+    return pkmlab.workspace(mech, "constant", None, 30.0)
+
+
+def _covers(lay, res) -> bool:
+    (x0, y0, z0), (x1, y1, z1) = res.metrics()["bbox_mm"]
+    cx, cy = lay.centre
+    h = lay.window / 2
+    return (cx - h <= x0 and x1 <= cx + h and cy - h <= y0 and y1 <= cy + h
+            and np.all((z0 < lay.levels) & (lay.levels < z1)))
+
+
+@pytest.mark.parametrize("which", ["small", "large"])
+def test_auto_layout_is_scaled_to_the_workspace_and_never_clips(which, request):
+    res = request.getfixturevalue(which)
+    lay = slice_layout(res)
+    assert _covers(lay, res)
+    (x0, y0, _), (x1, y1, _) = res.metrics()["bbox_mm"]
+    assert lay.window <= 1.5 * max(x1 - x0, y1 - y0)          # scaled, not a huge window
+    assert 4 <= len(lay.levels) <= MAX_PANELS
+    assert lay.spacing >= res.resolution
+    assert lay.spacing in (nice_ceil(lay.spacing), res.resolution)     # a round step
+    fig = slice_figure(res)
+    titled = [ax for ax in fig.axes if ax.get_title().startswith("z = ")]
+    assert len(titled) == len(lay.levels)
+
+
+def test_the_paper_layout_stays_available(large, small):
+    lay = slice_layout(large, "paper")
+    assert (lay.window, lay.spacing) == (152.4, 12.7)
+    assert len(lay.levels) > 60 and not _covers(lay, large)     # what the issue complained of
+    assert tuple(slice_layout(small, "paper").centre) == tuple(
+        small.mechanism.nominal_pose[:2])
+    fig = slice_figure(small, layout="paper")
+    assert "152.4 × 152.4 mm" in fig.get_suptitle()
+    # explicit values override either layout
+    lay = slice_layout(small, window=300.0, spacing=5.0)
+    assert (lay.window, lay.spacing) == (300.0, 5.0)
+    with pytest.raises(ParameterError, match="slice layout"):
+        slice_layout(small, "huge")
+
+
+def test_common_layout_of_several_workspaces_covers_each(small, large):
+    lay = slice_layout([small, large])
+    assert _covers(lay, large)
+    fig = overlay_figure([small, large], ["small", "large"])
+    assert sum(ax.get_title().startswith("z = ") for ax in fig.axes) == len(lay.levels)
+
+
+def test_nice_ceil():
+    assert [nice_ceil(x) for x in (0.3, 1.0, 1.1, 2.2, 3, 7, 55, 120)] == \
+        [0.5, 1.0, 2.0, 2.5, 5.0, 10.0, 100.0, 200.0]
+
+
+def test_workspace_spec_slice_options():
+    spec = workspace_spec({"kind": "constant"})
+    assert spec.slice_options() == {"layout": "auto", "window": None, "spacing": None}
+    spec = workspace_spec({"kind": "constant", "slice_layout": "paper", "slice_window": "8 in",
+                           "slice_spacing": "auto"})
+    assert spec.slice_options() == {"layout": "paper", "window": pytest.approx(203.2),
+                                    "spacing": None}
+    with pytest.raises(ParameterError, match="slice_layout"):
+        workspace_spec({"kind": "constant", "slice_layout": "big"})
+
+
+def test_cli_workspace_slice_layout_and_mesh_units(tmp_path):
+    out = tmp_path / "w"
+    r = CliRunner().invoke(app, ["workspace", str(HOPKINS), "--resolution", "8",
+                                 "--mesh", "stl,ply,glb", "--slice-layout", "paper",
+                                 "--out", str(out), "--json"])
+    assert r.exit_code == 0, r.output
+    stl = (out / "workspace.stl").read_bytes()
+    assert stl[:80].rstrip(b" \0") == STL_HEADER and b"units: mm" in stl[:80]
+    assert not stl.startswith(b"solid")
+    mm = trimesh.load(out / "workspace.stl")
+    m = trimesh.load(out / "workspace.glb", force="mesh")
+    # glTF: metres, y up (x, y, z) -> (x, z, -y)
+    np.testing.assert_allclose(m.bounds[:, 0], mm.bounds[:, 0] / 1000, atol=1e-6)
+    np.testing.assert_allclose(m.bounds[:, 1], mm.bounds[:, 2] / 1000, atol=1e-6)
+    np.testing.assert_allclose(np.sort(-m.bounds[:, 2]), mm.bounds[:, 1] / 1000, atol=1e-6)
+    assert b"comment units mm" in (out / "workspace.ply").read_bytes()[:200]
+    r = CliRunner().invoke(app, ["workspace", str(HOPKINS), "--slice-layout", "big"])
+    assert r.exit_code == 2 and "--slice-layout" in r.stderr
+
+
+def test_ply_carries_metric_values_as_vertex_properties(small, tmp_path):
+    from pkmlab.dexterity.maps import metric_map, vertex_values
+
+    mesh = small.mesh()
+    mmap = metric_map(small.mechanism, small, "kappa", 40.0)
+    kappa = vertex_values(mesh, mmap)
+    assert kappa.shape == (len(mesh.vertices),) and np.all(np.isfinite(kappa))
+    small.save_mesh(tmp_path / "w.ply", values={"kappa": kappa})
+    back = trimesh.load(tmp_path / "w.ply", process=False)
+    raw = back.metadata["_ply_raw"]["vertex"]["data"]
+    np.testing.assert_allclose(raw["kappa"], kappa.astype(np.float32))
+    np.testing.assert_allclose(back.vertices, mesh.vertices, atol=1e-4)
+    with pytest.raises(ValueError, match="vertex values"):
+        small.save_mesh(tmp_path / "bad.ply", values={"kappa": kappa[:-1]})
+
+
+def test_metric_slices_are_not_washed_out_by_a_few_near_singular_voxels(small):
+    from pkmlab.workspaces.plots import _colour_range
+
+    values = np.full(small.occupancy.shape, np.nan)
+    values[small.occupancy] = np.linspace(5.0, 9.0, int(small.occupancy.sum()))
+    lo, hi, extend = _colour_range(values)
+    assert extend == "neither" and (lo, hi) == (5.0, 9.0)
+    few = tuple(np.argwhere(small.occupancy)[:3].T)
+    values[few] = 600.0                                  # three near-singular voxels
+    lo, hi, extend = _colour_range(values)
+    assert lo < 5.1 and hi < 10 and extend == "max"
+    fig = slice_figure(small, values=values, label="κ")
+    assert "percentile" in fig.axes[-1].get_ylabel()
