@@ -29,7 +29,7 @@ $(BROWSER): | $(PY)
 	fi
 
 demo: $(STAMP)
-	$(VENV)/bin/pkmlab run studies/hopkins-6psu-redesign.yaml --jobs 2
+	$(VENV)/bin/pkmlab run studies/hopkins-6psu-redesign.yaml --jobs 2 --overwrite
 
 test: $(STAMP) $(BROWSER)
 	$(PY) -m pytest
