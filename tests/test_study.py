@@ -288,6 +288,7 @@ def test_compare_files_and_pareto_rows(tmp_path, serial_run):
                     5.0)
     assert d[1]["dexterous_volume_cm3"] == pytest.approx(ref.volume / 1e3)
     assert (tmp_path / "cmp" / "compare.md").read_text().count("|") > 20
+    assert "plotly" in (tmp_path / "cmp" / "compare.html").read_text()
     r = CliRunner().invoke(app, ["compare", "--pareto", str(out / "pareto.csv"), "--rows", "99"])
     assert r.exit_code == 2 and "--rows" in r.stderr
 

@@ -298,7 +298,9 @@ def compare(
     --inscribed``, ``dexterity``): see pkmlab.study.compare."""
     import csv as csv_mod
 
+    from ..progress import log_lines
     from ..study.compare import compare_designs, comparison_markdown, plot_overlaid_slices
+    from ..webreport import compare_html
 
     loaded = [_load(f) for f in (mech_files or [])]
     designs = [(m.name or f.stem, m) for f, m in zip(mech_files or [], loaded)]
@@ -337,14 +339,17 @@ def compare(
     (out_dir / "compare.md").write_text(md)
     plot_overlaid_slices(table_rows, out_dir / "compare_dexterous_slices.png", which=1)
     plot_overlaid_slices(table_rows, out_dir / "compare_level_slices.png", which=0)
+    with log_lines():
+        page = compare_html(table_rows, out_dir / "compare.html", box_deg=box)
+    names = ("compare.md", "compare.html", "compare_dexterous_slices.png",
+             "compare_level_slices.png")
     if as_json:
         _emit({"designs": [{k: v for k, v in r.items() if k not in ("mechanism", "results")}
                            for r in table_rows],
-               "files": [str(out_dir / n) for n in ("compare.md",
-                                                    "compare_dexterous_slices.png",
-                                                    "compare_level_slices.png")]})
+               "files": [str(out_dir / n) for n in names]})
         return
     out.print(md, markup=False, highlight=False)
-    out.print(f"wrote {escape(str(out_dir))}/compare.md and overlaid slice plots")
+    out.print(f"wrote {escape(str(out_dir))}/compare.md, compare.html and overlaid slice plots; "
+              f"open {escape(page.resolve().as_uri())} in a browser")
 
 

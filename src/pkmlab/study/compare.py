@@ -151,51 +151,18 @@ def comparison_markdown(rows: list[dict], box_deg: float | None = None) -> str:
     return "\n".join(lines) + "\n"
 
 
-def plot_overlaid_slices(rows: list[dict], path: Path, which: int = 1, window: float = 152.4,
-                         spacing: float = 12.7) -> Path:
-    """Outlines of every design's workspace (``which``: 0 level, 1 dexterous) per slice, as a
-    PNG at ``path`` (Agg canvas: pyplot and the global backend are not touched)."""
-    import matplotlib as mpl
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-    from matplotlib.lines import Line2D
+def plot_overlaid_slices(rows: list[dict], path: Path, which: int = 1,
+                         layout: str = "auto") -> Path:
+    """Outlines of every design's workspace (``which``: 0 level, 1 dexterous; the level ones
+    when every dexterous workspace is empty) per section, on one layout scaled to all of them
+    (``layout="paper"``: Hopkins & Williams' 152.4 mm every 12.7 mm), as a PNG at ``path``."""
+    from ..workspaces.plots import overlay_figure
 
     res = [r["results"][which] for r in rows]
-    spans = [x.metrics()["z_range_mm"] for x in res if not x.empty]
-    if not spans:
-        res = [r["results"][0] for r in rows]
-        spans = [x.metrics()["z_range_mm"] for x in res if not x.empty]
-    lo = min(s[0] for s in spans)
-    hi = max(s[1] for s in spans)
-    n = int(math.floor((hi - lo) / spacing)) + 1
-    levels = lo + 0.5 * ((hi - lo) - (n - 1) * spacing) + spacing * np.arange(n)
-    cols = int(math.ceil(math.sqrt(n)))
-    nrows = int(math.ceil(n / cols))
-    fig = Figure(figsize=(2.4 * cols, 2.4 * nrows + 0.8), layout="constrained")
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(nrows, cols, squeeze=False)
-    colours = mpl.rcParams["axes.prop_cycle"].by_key()["color"]
-    for a, ax in enumerate(axes.ravel()):
-        ax.set_xlim(-window / 2, window / 2)
-        ax.set_ylim(-window / 2, window / 2)
-        ax.set_aspect("equal")
-        ax.tick_params(labelsize=6)
-        if a >= n:
-            ax.axis("off")
-            continue
-        z = levels[a]
-        for k, w in enumerate(res):
-            if w.empty or len(w.xs) < 2 or len(w.ys) < 2:
-                continue
-            sec = w.slice(z).astype(float)
-            if sec.any():
-                ax.contour(w.xs, w.ys, sec.T, levels=[0.5], colors=[colours[k % len(colours)]],
-                           linewidths=1.2)
-        ax.set_title(f"z = {z:.1f} mm", fontsize=7)
-    handles = [Line2D([], [], color=colours[k % len(colours)], label=r["label"])
-               for k, r in enumerate(rows)]
-    fig.legend(handles=handles, loc="lower center", ncol=min(len(rows), 4), fontsize=8)
-    fig.suptitle(f"{'dexterous' if which else 'level'} workspaces, {window:g} mm windows every "
-                 f"{spacing:g} mm (lowest top-left)", fontsize=9)
-    fig.savefig(path, dpi=110)
+    if all(x.empty for x in res):
+        res, which = [r["results"][0] for r in rows], 0
+    kind = "dexterous" if which == 1 else "level"
+    fig = overlay_figure(res, [r["label"] for r in rows], layout=layout,
+                         title=f"{kind} workspaces, overlaid")
+    fig.savefig(Path(path), dpi=110)
     return Path(path)
