@@ -85,7 +85,7 @@ def dexterity(
     import shutil
     import tempfile
 
-    from ..dexterity.maps import METRICS, mesh_colours
+    from ..dexterity.maps import METRICS, mesh_colours, vertex_values
     from ..dexterity.report import dexterity_report
     from ..workspaces.plots import slice_figure
 
@@ -129,15 +129,16 @@ def dexterity(
         files[0].write_text(json.dumps(report, indent=2, default=float) + "\n")
         if mmap is not None:
             vals = np.where(np.isfinite(mmap.grid), mmap.grid, np.nan)
-            fig = slice_figure(res, window=spec.slice_window, spacing=spec.slice_spacing,
-                               values=vals, label=mmap.label)
+            fig = slice_figure(res, **spec.slice_options(), values=vals, label=mmap.label)
             files.append(tmp / f"{metric}_slices.png")
             fig.savefig(files[-1], dpi=120)
             m = res.mesh()
-            m.visual.vertex_colors = mesh_colours(m, mmap)
-            for fmt in ("ply", "glb"):
+            colours = mesh_colours(m, mmap)
+            for fmt in ("ply", "glb"):       # PLY in mm with the metric per vertex; GLB in m
                 files.append(tmp / f"workspace_{metric}.{fmt}")
-                m.export(files[-1])
+                res.save_mesh(files[-1], colors=colours,
+                              values={metric: vertex_values(m, mmap)} if fmt == "ply"
+                              else None)
         for f in files:
             shutil.move(str(f), out_dir / f.name)
             written.append(out_dir / f.name)
