@@ -57,8 +57,11 @@ import contextlib
 import hashlib
 import inspect
 import itertools
+import logging
 import marshal
 import sys
+import threading
+import time
 import types as pytypes
 import warnings
 
@@ -67,6 +70,10 @@ from numba import njit
 from numba.core.bytecode import FunctionIdentity
 from numba.core.compiler_lock import global_compiler_lock
 from numba.extending import register_jitable
+
+log = logging.getLogger(__name__)
+#: seconds after which a kernel compile is announced (the progress rule: no silent step > 2 s)
+COMPILE_NOTICE_S = 1.5
 
 __all__ = ["cached_kernel", "identity", "jitable", "CACHE_SAFE"]
 
@@ -189,5 +196,18 @@ def cached_kernel(fn, sig, *, roots=(), extra=(), **options):
     ident = identity(fn, *roots, extra=(fn.__name__, str(sig), sorted(options.items()),
                                         tuple(extra)))
     kernel = _renamed(fn, f"{fn.__name__}_{ident[:16]}")
-    with _uid_namespace(ident) if CACHE_SAFE else contextlib.nullcontext():
-        return njit(sig, cache=CACHE_SAFE, **options)(kernel)
+    # a compile (not a cache load) takes seconds: say so after COMPILE_NOTICE_S, once per kernel
+    notice = threading.Timer(COMPILE_NOTICE_S, log.info, ("compiling the numba kernel %s (first "
+                             "use after an install or an edit; cached for later runs)",
+                                                        fn.__name__))
+    notice.daemon = True
+    notice.start()
+    t0 = time.perf_counter()
+    try:
+        with _uid_namespace(ident) if CACHE_SAFE else contextlib.nullcontext():
+            compiled = njit(sig, cache=CACHE_SAFE, **options)(kernel)
+    finally:
+        notice.cancel()
+    if time.perf_counter() - t0 > COMPILE_NOTICE_S:
+        log.info("compiled %s in %.1f s", fn.__name__, time.perf_counter() - t0)
+    return compiled

@@ -12,6 +12,7 @@ import typer
 from rich.markup import escape
 
 from ..errors import ParameterError
+from ..progress import log_lines
 from ..units import parse_length
 from .common import (
     AllComponentsOpt,
@@ -113,11 +114,12 @@ def dexterity(
         _fail(ParameterError("--gci-samples", "an integer in [10, 10000000]", gci_samples))
 
     try:
-        rep = dexterity_report(mech, req, L=L, metric=metric,
-                               well_conditioned=well_conditioned, force_limit=force_limit,
-                               force_required=force_required,
-                               actuator_stiffness=actuator_stiffness, gci_samples=gci_samples,
-                               seed=seed)
+        with log_lines():
+            rep = dexterity_report(mech, req, L=L, metric=metric,
+                                   well_conditioned=well_conditioned, force_limit=force_limit,
+                                   force_required=force_required,
+                                   actuator_stiffness=actuator_stiffness,
+                                   gci_samples=gci_samples, seed=seed)
     except ParameterError as exc:
         _fail(exc)
     res, mmap, report = rep.result, rep.map, rep.data
@@ -299,7 +301,6 @@ def compare(
     --inscribed``, ``dexterity``): see pkmlab.study.compare."""
     import csv as csv_mod
 
-    from ..progress import log_lines
     from ..study.compare import compare_designs, comparison_markdown, plot_overlaid_slices
     from ..webreport import compare_html
 
@@ -334,7 +335,8 @@ def compare(
         _fail(ParameterError("--box", "an angle in [0, 90] deg", box))
     if not 1 <= samples <= 101:
         _fail(ParameterError("--samples", "an integer in [1, 101]", samples))
-    table_rows = compare_designs(designs, box_deg=box, resolution=h, samples=samples)
+    with log_lines():
+        table_rows = compare_designs(designs, box_deg=box, resolution=h, samples=samples)
     out_dir.mkdir(parents=True, exist_ok=True)
     md = comparison_markdown(table_rows, box)
     (out_dir / "compare.md").write_text(md)

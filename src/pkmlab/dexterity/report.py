@@ -168,6 +168,7 @@ def dexterity_report(mech, request: dict, *, L: float | CharacteristicLength | N
         raise ParameterError("well_conditioned", "a κ bound >= 1", well_conditioned)
     if not (math.isfinite(force_required) and force_required > 0):
         raise ParameterError("force_required", "a force > 0 N", force_required)
+    log.info("dexterity: workspace")
     res = workspace(mech, **request)
     mech = res.mechanism                      # carries a stroke window override, if any
     length = resolve_length(mech, L)
@@ -176,11 +177,14 @@ def dexterity_report(mech, request: dict, *, L: float | CharacteristicLength | N
     agg: dict = {"workspace_volume_cm3": res.volume / 1e3, "empty": res.empty}
     mmap = None
     if not res.empty:
+        log.info("dexterity: κ over %d voxels × %d orientations", int(res.occupancy.sum()),
+                 len(res.orientations.rotations()))
         g = kappa_grid(mech, res, length)
         ks = kappa_statistics(g.kappa[g.valid])
         grid_gci = gci_grid(mech, res, grid=g)
         mc = gci_monte_carlo(mech, res, length, samples=gci_samples, seed=seed)
         wc_vol = well_conditioned_volume(mech, res, well_conditioned, grid=g)
+        log.info("dexterity: worst case, then the %s map", metric)
         wc = worst_case(mech, res, length, force_limit)
         mmap = metric_map(mech, res, metric, length, force_limit, actuator_stiffness)
         fmap = mmap if metric == "force" else metric_map(mech, res, "force", length,

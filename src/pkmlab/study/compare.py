@@ -80,7 +80,8 @@ def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
                "resolution_mm": float(resolution), "force_limit_N": float(force_limit),
                "inscribed": f"inscribed_box() / inscribed_cylinder() defaults (seed {seed})"}
     rows = []
-    for label, mech in designs:
+    for i, (label, mech) in enumerate(designs):
+        log.info("compare: design %d of %d (%s)", i + 1, len(designs), label)
         const = workspace(mech, "constant", None, resolution)
         dex = workspace(mech, "dexterous", oset, resolution)
         ref = dex if not dex.empty else const
