@@ -47,9 +47,9 @@ def main() -> None:
     task = TaskRegion("box", size=(50.0, 50.0, 50.0))
     for name in ("hopkins-williams-6psu", "gough-stewart-6ups"):
         mech = load_mechanism(MECH / f"{name}.yaml")
-        t_ws, res = timed(lambda: workspace(mech, "dexterous", BOX, 2.5))
-        t_task, chk = timed(lambda: task_contained(mech, task, BOX), 21)
-        t_marg, m = timed(lambda: task_margins(mech, task, BOX), 3)
+        t_ws, res = timed(lambda mech=mech: workspace(mech, "dexterous", BOX, 2.5))
+        t_task, chk = timed(lambda mech=mech: task_contained(mech, task, BOX), 21)
+        t_marg, m = timed(lambda mech=mech: task_margins(mech, task, BOX), 3)
         print(f"{name}: task_contained {t_task * 1e3:.2f} ms ({chk.method}, "
               f"contained={chk.contained}) vs dexterous workspace {t_ws * 1e3:.1f} ms "
               f"(volume {res.volume / 1e3:.1f} cm³): ratio {t_task / t_ws:.3f} (target ≤ 2); "
@@ -62,7 +62,7 @@ def main() -> None:
         mech = load_mechanism(MECH / f"{name}.yaml")
         motion = sinusoid_motion(mech, amp, [1, 1.3, 0.7, 0.5, 0.9, 1.1], duration=10.0,
                                  rate=100_000)
-        t, r = timed(lambda: inverse_dynamics(mech, motion, body), 3)
+        t, r = timed(lambda mech=mech, motion=motion: inverse_dynamics(mech, motion, body), 3)
         print(f"{name}: inverse dynamics {len(motion.t) / t / 1e6:.2f} M samples/s "
               f"({len(motion.t)} samples in {t:.3f} s, {int(np.sum(r.ok))} feasible; "
               "target ≥ 1 M/s)")
