@@ -12,7 +12,9 @@ from typing import Any
 
 from .errors import ParameterError
 
-__all__ = ["LENGTH_UNITS", "ANGLE_UNITS", "parse_length", "parse_angle", "parse_quantity"]
+__all__ = ["LENGTH_UNITS", "ANGLE_UNITS", "parse_length", "parse_angle", "parse_quantity",
+           "parse_physical", "MASS_UNITS", "FORCE_UNITS", "TORQUE_UNITS", "SPEED_UNITS",
+           "ANGULAR_SPEED_UNITS", "INERTIA_UNITS", "TIME_UNITS", "FREQUENCY_UNITS", "LEAD_UNITS"]
 
 LENGTH_UNITS = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "inch": 25.4, "ft": 304.8}
 ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180.0, "°": math.pi / 180.0}
@@ -53,3 +55,49 @@ def parse_length(value: Any, field: str, default_unit: str = "mm") -> float:
 def parse_angle(value: Any, field: str, default_unit: str = "deg") -> float:
     """Angle in rad from a bare number (``default_unit``) or a string such as ``"30 deg"``."""
     return parse_quantity(value, field, ANGLE_UNITS, default_unit)
+
+
+# ---- other physical quantities (requirements: payloads, motions, actuators) --------------------
+# Internal units: kg, mm, s, N, N·mm, rad. Unit spellings are normalised before lookup: "·" and
+# " " → "*", "²" → "^2", so "kg·m²", "kg*m^2" and "N m" are the same unit.
+
+MASS_UNITS = {"kg": 1.0, "g": 1e-3, "lb": 0.45359237}
+FORCE_UNITS = {"N": 1.0, "kN": 1e3, "lbf": 4.4482216152605}
+TORQUE_UNITS = {"N*mm": 1.0, "N*m": 1e3, "Nm": 1e3, "Nmm": 1.0, "mN*m": 1.0}
+SPEED_UNITS = {"mm/s": 1.0, "m/s": 1e3, "in/s": 25.4}
+ANGULAR_SPEED_UNITS = {"rad/s": 1.0, "deg/s": math.pi / 180.0, "rpm": 2.0 * math.pi / 60.0}
+INERTIA_UNITS = {"kg*mm^2": 1.0, "kg*m^2": 1e6, "kg*cm^2": 1e2, "g*mm^2": 1e-3}
+TIME_UNITS = {"s": 1.0, "ms": 1e-3}
+FREQUENCY_UNITS = {"Hz": 1.0}
+LEAD_UNITS = {"mm/rev": 1.0, "mm": 1.0}
+
+_ANY_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
+
+
+def _normalise_unit(unit: str) -> str:
+    unit = unit.replace("·", "*").replace("²", "^2").replace("×", "*")
+    return re.sub(r"\s+", "*", unit.strip())
+
+
+def parse_physical(value: Any, field: str, units: dict[str, float], default_unit: str) -> float:
+    """Convert ``value`` (a bare number in ``default_unit`` or a string with a unit from
+    ``units``, compound units allowed: ``"500 mm/s"``, ``"1.2 kg·m²"``, ``"3 N m"``) to the
+    internal unit (factor 1.0). Raises :class:`ParameterError` naming ``field``."""
+    allowed = f"a number (in {default_unit}) or a string with a unit from {sorted(units)}"
+    if isinstance(value, bool):
+        raise ParameterError(field, allowed, value)
+    if isinstance(value, int | float):
+        number, unit = float(value), default_unit
+    elif isinstance(value, str):
+        match = _ANY_QUANTITY.match(value)
+        if match is None:
+            raise ParameterError(field, allowed, value)
+        number = float(match.group(1))
+        unit = _normalise_unit(match.group(2)) or default_unit
+        if unit not in units:
+            raise ParameterError(field, allowed, value)
+    else:
+        raise ParameterError(field, allowed, value)
+    if not math.isfinite(number):
+        raise ParameterError(field, "a finite " + allowed, value)
+    return number * units[unit]

@@ -14,7 +14,8 @@ method whose name starts with ``_``):
 * ``leg_segments(p, R)`` — each leg's moving link, for interference and drawing;
 * workspace hooks: ``position_bounds(R)``, and for families with exact column intervals
   ``column_method``, ``column_leg``, ``column_params()``, ``leg_offsets(R)`` and
-  ``column_intervals(xs, ys, R, mode)``;
+  ``column_intervals(xs, ys, R, mode)`` (and ``column_radial`` when the leg intervals are
+  monotone functions of the distance from the leg's column axis);
 * equality and hashing by geometry (two mechanisms with the same family, joints, stroke, tool
   offset and nominal pose are equal, whatever their names).
 
@@ -142,6 +143,13 @@ class Mechanism:
     #: True when, at fixed (x, y, orientation), the leg geometry (link vectors, joint angles,
     #: Jacobian) does not depend on z, so non-stroke constraints act on whole columns.
     column_invariant: ClassVar[bool] = False
+
+    #: True when ``column_leg``'s interval depends on (x, y) only through the horizontal
+    #: distance ``d = |(x, y) + w_xy|`` from the leg's column axis, with both ends and the
+    #: ``ok`` flag monotone in ``d`` (``ok`` true on ``d <= d_max``): a task region's
+    #: containment is then decided exactly from the nearest and farthest ``d`` of its
+    #: footprint (:mod:`pkmlab.requirements.task`). ``psu6`` and ``ups6`` declare it.
+    column_radial: ClassVar[bool] = False
 
     #: numba per-leg column interval ``leg(x, y, wx, wy, wz, p0, p1, p2) -> (a, b, ok)`` (see
     #: :func:`._kernels.make_column_kernel`); families with it set ``column_method``.

@@ -161,6 +161,7 @@ class PSU6(Mechanism):
     column_method = "linear"
     column_invariant = True   # link vectors, joint angles and J do not depend on z
 
+    column_radial = True
     column_leg = _psu_column_leg
 
     def column_params(self) -> np.ndarray:

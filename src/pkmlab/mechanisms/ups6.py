@@ -155,6 +155,7 @@ class UPS6(Mechanism):
     # ---- workspace hooks -------------------------------------------------------------------
     column_method = "quadratic"
 
+    column_radial = True
     column_leg = _ups_column_leg
 
     def column_params(self) -> np.ndarray:

@@ -46,6 +46,10 @@ class Evaluation:
     orientation_capability: bool
     dexterity: DexterityPlan | None
     trajectory: TrajectoryPlan | None
+    task: object | None = None              # requirements.spec.TaskPlan
+    motions: object | None = None           # requirements.spec.MotionsPlan
+    payload: object | None = None           # requirements.spec.PayloadPlan
+    actuators: object | None = None         # requirements.spec.ActuatorsPlan
 
     @property
     def evaluators(self) -> tuple[str, ...]:
@@ -59,6 +63,7 @@ class Evaluation:
                 names.append("dexterity")
         if self.trajectory is not None:
             names.append("trajectory")
+        names += [n for n in ("task", "motions", "actuators") if getattr(self, n) is not None]
         return tuple(names)
 
     @property
@@ -126,6 +131,8 @@ class Study:
             d: dict = {"type": v.kind, "quantity": v.quantity}
             if v.target is not None:
                 d["path"] = _path_text(v.target)
+            if v.role != "mechanism":
+                d = {"target": v.role, "type": "choice"}
             if v.kind == "choice":
                 d["choices"] = [_quantity(v, c) for c in v.choices]
             else:
@@ -144,6 +151,10 @@ class Study:
                 "paper_motion": True, "segment_time": ev.trajectory.segment_time,
                 "payload": ev.trajectory.payload},
         }
+        for block in ("task", "motions", "payload", "actuators"):
+            plan = getattr(ev, block)
+            if plan is not None:
+                evaluate[block] = plan.source
         return {
             "study": self.name, "description": self.description,
             "mechanism": {"inline": to_display(self.space.base_spec)},

@@ -31,6 +31,9 @@ import numpy as np
 from .. import dexterity as dx
 from ..errors import NumericalError, ParameterError
 from ..limits import CAPABILITY_MAX_DEG
+from ..requirements.actuators import fit as actuator_fit
+from ..requirements.dynamics import inverse_dynamics
+from ..requirements.task import task_margins
 from ..trajectory import check_trajectory, paper_motion
 from ..workspaces import OrientationSet, workspace
 from .metrics import metrics_of
@@ -49,6 +52,8 @@ class Context:
     result: object = None       # the WorkspaceResult, once computed
     L: float | None = None      # characteristic length used (mm)
     notes: dict = field(default_factory=dict)
+    choices: dict = field(default_factory=dict)   # evaluation choices: {"actuator": name}
+    dynamics: list = field(default_factory=list)  # DynamicsResult per required motion
 
 
 #: name → evaluator; the order is the evaluation order (dependencies first)
@@ -212,13 +217,59 @@ def _trajectory(mech, ctx: Context) -> dict:
     return out
 
 
-def evaluate_mechanism(mech, evaluation, seed: int) -> tuple[dict, dict]:
+@_evaluator("task")
+def _task(mech, ctx: Context) -> dict:
+    plan = ctx.evaluation.task
+    m = task_margins(mech, plan.region, plan.orientations, plan.resolution)
+    chk = m["check"]
+    if chk.note:
+        ctx.notes["task_contained"] = chk.note
+    ctx.notes.update(m["notes"])
+    return {"task_contained": float(chk.contained), "task_margin": m["margin_mm"],
+            "task_orientation_margin": m["orientation_margin_deg"]}
+
+
+@_evaluator("motions")
+def _motions(mech, ctx: Context) -> dict:
+    ev = ctx.evaluation
+    body = ev.payload.for_mechanism(mech)
+    ctx.dynamics = [inverse_dynamics(mech, m, body) for m in ev.motions.motions(mech)]
+    bad = [r.first_problem() for r in ctx.dynamics if not np.all(r.ok)]
+    out = {"motions_feasible": float(not bad)}
+    if bad:
+        ctx.notes["motions_feasible"] = bad[0]
+    sums = [r.summary() for r in ctx.dynamics if np.any(r.ok)]
+    for name, key in (("peak_actuator_force", "peak_force"), ("rms_actuator_force",
+                      "rms_force"), ("peak_actuator_speed", "peak_speed"),
+                      ("peak_actuator_power", "peak_power")):
+        out[name] = float(max(np.max(s[key]) for s in sums)) if sums else None
+        if not sums:
+            ctx.notes[name] = "no feasible sample in any motion"
+    return out
+
+
+@_evaluator("actuators")
+def _actuators(mech, ctx: Context) -> dict:
+    plan = ctx.evaluation.actuators
+    name = ctx.choices.get("actuator", plan.default)
+    spec = plan.catalogue[name]
+    f = actuator_fit(spec, ctx.dynamics)
+    ctx.notes.update(f.notes)
+    return {"actuators_fit": float(f.fits), "actuator_force_margin": f.force_margin,
+            "actuator_speed_margin": f.speed_margin,
+            "actuator_torque_speed_margin": f.torque_speed_margin,
+            "actuator_stroke_margin": f.stroke_margin, "actuator_force_rating": spec.force}
+
+
+def evaluate_mechanism(mech, evaluation, seed: int, choices: dict | None = None
+                       ) -> tuple[dict, dict]:
     """Every evaluator ``evaluation`` asks for, in order → ``(metrics, notes)``.
 
+    ``choices`` are the design's evaluation choices (``{"actuator": catalogue name}``).
     Raises :class:`ParameterError` / :class:`NumericalError` for an invalid design or a
     declared numerical failure, anything else for a programming error.
     """
-    ctx = Context(evaluation, seed)
+    ctx = Context(evaluation, seed, choices=dict(choices or {}))
     _ = mech.nominal_pose      # ParameterError if no level pose reaches mid-stroke
     metrics: dict = {}
     for name in evaluation.evaluators:
@@ -242,7 +293,8 @@ def evaluate_design(space, design: dict | None, evaluation, seed: int) -> dict:
     notes: dict = {}
     try:
         mech = space.decode(design)
-        metrics, notes = evaluate_mechanism(mech, evaluation, seed)
+        metrics, notes = evaluate_mechanism(mech, evaluation, seed,
+                                            space.evaluation_choices(design))
         status, reason = "ok", ""
     except ParameterError as exc:
         status, reason = "invalid", str(exc)

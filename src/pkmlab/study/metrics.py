@@ -10,7 +10,8 @@ Kinds of number (``statistic``):
 * ``grid`` — exact in z, on the workspace's x-y grid and sampled orientation set (volumes:
   carry their error estimate in ``workspace_volume_error``);
 * ``worst-case`` — the extreme over *every* voxel of the workspace grid and *every* sample of
-  its orientation set (never a random sample's extreme);
+  its orientation set (never a random sample's extreme), or over every sample of every
+  required motion and every actuator;
 * ``bound`` — a bracketed optimum: the value is the largest verified level, the bracket the
   search resolution (``<name>_bracket``);
 * ``sampled`` — a Monte-Carlo statistic over random poses (its name says so, or it carries a
@@ -108,6 +109,42 @@ _ALL = [
            "1 if Hopkins & Williams' ±2 in / ±30° motion stays within the stroke"),
     Metric("paper_motion_margin", "trajectory", "mm", "exact",
            "smallest stroke margin along that motion (negative: the overshoot)"),
+    # requirements: the task (a required workspace)
+    Metric("task_contained", "task", "", "flag",
+           "1 if every position of the task region works at every orientation sample of its "
+           "set (exact over the continuous region for psu6/ups6; sampled for luzi3, see notes)"),
+    Metric("task_margin", "task", "mm", "bound",
+           "largest growth of the task region that stays contained (a lower bound of its "
+           "distance to the workspace boundary, bracket 0.01 mm); negative: the erosion needed"),
+    Metric("task_orientation_margin", "task", "deg", "bound",
+           "largest widening of the task's orientation set that stays contained (bracket "
+           "0.01°); negative: the narrowing needed"),
+    # requirements: required motions with the payload (inverse dynamics)
+    Metric("motions_feasible", "motions", "", "flag",
+           "1 if every sample of every required motion is within the stroke and not singular"),
+    Metric("peak_actuator_force", "motions", "N", "worst-case",
+           "largest |actuator force| over every sample of every required motion (Newton–Euler "
+           "of platform + payload, f = J⁻ᵀ·w)"),
+    Metric("rms_actuator_force", "motions", "N", "worst-case",
+           "largest RMS actuator force (time-weighted, per actuator and motion)"),
+    Metric("peak_actuator_speed", "motions", "mm/s", "worst-case",
+           "largest |actuator speed| over every sample of every required motion"),
+    Metric("peak_actuator_power", "motions", "W", "worst-case",
+           "largest |actuator force × speed| over every sample of every required motion"),
+    # requirements: actuators
+    Metric("actuators_fit", "actuators", "", "flag",
+           "1 if the chosen actuator meets force, speed, torque–speed and stroke along every "
+           "required motion"),
+    Metric("actuator_force_margin", "actuators", "%", "worst-case",
+           "100·(1 − peak |force| / force limit); negative: exceeded"),
+    Metric("actuator_speed_margin", "actuators", "%", "worst-case",
+           "100·(1 − peak |speed| / speed limit); negative: exceeded"),
+    Metric("actuator_torque_speed_margin", "actuators", "%", "worst-case",
+           "100·min over samples of (available − required motor torque) / peak curve torque"),
+    Metric("actuator_stroke_margin", "actuators", "mm", "worst-case",
+           "actuator travel − the largest travel an actuator uses over the motions"),
+    Metric("actuator_force_rating", "actuators", "N", "exact",
+           "force limit of the chosen actuator (its size)"),
 ]
 
 #: name → :class:`Metric`

@@ -165,6 +165,8 @@ class Variable:
     high: float | None = None
     choices: tuple = ()
     levels: int = 5
+    role: str = "mechanism"
+    baseline: object = None
 
     @property
     def unit(self) -> str:
@@ -218,8 +220,15 @@ class DesignSpace:
 
     def baseline_values(self) -> dict:
         """Each variable's value in the baseline design (``None`` for free parameters)."""
-        return {v.name: None if v.target is None else get_path(self.base_spec, v.target)
+        return {v.name: v.baseline if v.role != "mechanism" else
+                None if v.target is None else get_path(self.base_spec, v.target)
                 for v in self.variables}
+
+    def evaluation_choices(self, design: dict | None) -> dict:
+        """``{role: value}`` of the variables that choose for the evaluation (``actuator``)
+        rather than the mechanism; the baseline's when ``design`` is ``None``."""
+        src = self.baseline_values() if design is None else design
+        return {v.role: src[v.name] for v in self.variables if v.role != "mechanism"}
 
     # ---- optimiser views -----------------------------------------------------------------------
     def bounds(self) -> np.ndarray:

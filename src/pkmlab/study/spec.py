@@ -72,6 +72,9 @@ class DesignVariableSpec(_Model):
     path: str | None = Field(None, description="mechanism field, e.g. generator.base_radii[1]; "
                              "none for a free parameter used by 'derived'")
     quantity: Literal["length", "angle", "number", "text"] | None = None
+    target: Literal["actuator"] | None = Field(None, description="'actuator': the choices "
+                                               "are catalogue entries of evaluate.actuators "
+                                               "(not a mechanism field)")
     levels: int = Field(5, ge=2, le=1000, description="grid optimiser: values per variable")
 
 
@@ -108,6 +111,14 @@ class EvaluateSpec(_Model):
     orientation_capability: bool = False
     dexterity: DexteritySpec | None = None
     trajectory: TrajectorySpec | None = None
+    task: dict[str, Any] | None = Field(None, description="a required workspace: shape (box, "
+                                        "cylinder, points), size / radius + height / points "
+                                        "or file, frame, centre, and an orientation set")
+    motions: list[dict[str, Any]] | None = Field(None, description="required motions: "
+                                                 "[{name, file | sinusoid | paper: true}]")
+    payload: dict[str, Any] | None = Field(None, description="mass, com, inertia; platform; "
+                                           "legs")
+    actuators: dict[str, Any] | None = Field(None, description="catalogue + use, or spec")
 
 
 class OptimizerSpec(_Model):
@@ -185,8 +196,24 @@ def _target(name: str, where: str, path: str | None, family: str, spec) -> tuple
     return parts
 
 
-def _variable(name: str, v: DesignVariableSpec, family: str, spec) -> Variable:
+def _variable(name: str, v: DesignVariableSpec, family: str, spec,
+              evaluation: Evaluation) -> Variable:
     field = f"design.{name}"
+    if v.target == "actuator":
+        acts = evaluation.actuators
+        if acts is None or len(acts.catalogue) < 1:
+            raise ParameterError(f"{field}.target", "used with an evaluate.actuators block "
+                                 "that names a catalogue", v.target)
+        if v.path is not None or v.quantity not in (None, "text") or not v.choices \
+                or v.type not in (None, "choice"):
+            raise ParameterError(field, "'choices' of catalogue entry names (no path, range "
+                                 "or quantity)", v.model_dump(exclude_none=True))
+        for c in v.choices:
+            if c not in acts.catalogue:
+                raise ParameterError(f"{field}.choices", f"catalogue entries "
+                                     f"{sorted(acts.catalogue)}", c)
+        return Variable(name, None, "text", "choice", choices=tuple(v.choices),
+                        role="actuator", baseline=acts.default)
     alias = DESIGN_ALIASES[family].get(name)
     target = _target(name, f"{field}.path", v.path, family, spec)
     quantity = v.quantity or (alias[1] if alias else None)
@@ -253,7 +280,7 @@ def _metric(name: Any, where: str, evaluation: Evaluation) -> str:
     return name
 
 
-def _evaluation(ev: EvaluateSpec) -> Evaluation:
+def _evaluation(ev: EvaluateSpec, base: Path) -> Evaluation:
     ws = None if ev.workspace is None else workspace_spec(ev.workspace,
                                                           prefix="evaluate.workspace.")
     for block in ("inscribed", "orientation_capability", "dexterity"):
@@ -267,7 +294,25 @@ def _evaluation(ev: EvaluateSpec) -> Evaluation:
         dexterity=None if dx is None else DexterityPlan(dx.characteristic_length,
                                                         dx.gci_samples, dx.force_limit),
         trajectory=None if ev.trajectory is None else TrajectoryPlan(
-            ev.trajectory.segment_time, ev.trajectory.payload))
+            ev.trajectory.segment_time, ev.trajectory.payload),
+        **_requirements(ev, base))
+
+
+def _requirements(ev: EvaluateSpec, base: Path) -> dict:
+    """The requirement blocks (pkmlab.requirements.spec), files read and checked now."""
+    from ..requirements import spec as rq
+
+    if ev.motions is not None and ev.payload is None:
+        raise ParameterError("evaluate.payload", "given with evaluate.motions (the mass the "
+                             "motions move: payload and platform)", None)
+    if ev.actuators is not None and ev.motions is None:
+        raise ParameterError("evaluate.actuators", "used with evaluate.motions (the actuators "
+                             "are checked along the required motions)", "no motions")
+    return {"task": None if ev.task is None else rq.build_task(ev.task, base),
+            "motions": None if ev.motions is None else rq.build_motions(ev.motions, base),
+            "payload": None if ev.payload is None else rq.build_payload(ev.payload),
+            "actuators": None if ev.actuators is None else rq.build_actuators(ev.actuators,
+                                                                            base)}
 
 
 def study_from_mapping(data: Any, base: Path | None = None,
@@ -300,7 +345,9 @@ def study_from_mapping(data: Any, base: Path | None = None,
         raise ParameterError(f"mechanism.{exc.field}", exc.allowed, exc.got,
                              where=exc.where) from None
     family = mech_spec.family
-    variables = tuple(_variable(n, v, family, mech_spec) for n, v in spec.design.items())
+    evaluation = _evaluation(spec.evaluate, base)
+    variables = tuple(_variable(n, v, family, mech_spec, evaluation)
+                      for n, v in spec.design.items())
     names = {v.name for v in variables}
     derived = []
     for key, text in spec.derived.items():
@@ -316,11 +363,13 @@ def study_from_mapping(data: Any, base: Path | None = None,
         raise ParameterError("design", "variables and derived fields that each set a "
                              "different mechanism field", "a field set twice")
     used = {n for d in derived for n in d.expression.names}
+    if sum(v.role == "actuator" for v in variables) > 1:
+        raise ParameterError("design", "at most one variable with target: actuator",
+                             [v.name for v in variables if v.role == "actuator"])
     for v in variables:
-        if v.target is None and v.name not in used:
+        if v.target is None and v.role == "mechanism" and v.name not in used:
             raise ParameterError(f"design.{v.name}", "a mechanism field (alias or 'path') or "
                                  "a parameter used by 'derived'", v.name)
-    evaluation = _evaluation(spec.evaluate)
     objectives = []
     for i, o in enumerate(spec.objectives):
         if len(o) != 1:

@@ -1,0 +1,72 @@
+"""Requirements benchmark: task containment against the workspace itself, inverse dynamics.
+
+Prints, in one run:
+
+* the time of ``task_contained`` for a 50 × 50 × 50 mm box about the nominal pose at the ±15°
+  simultaneous Euler box (7×7×7 orientations) on the Hopkins & Williams 6-PSU and on the
+  Kotlarski 6-UPS, and the time of the dexterous workspace computation itself (same
+  orientation set, 2.5 mm) — the target is ≤ 2× the workspace (median of repeats);
+* the time of ``task_margins`` (the bisections behind ``task_margin`` and
+  ``task_orientation_margin``) on the same request;
+* inverse dynamics throughput: trajectory samples per second of ``inverse_dynamics`` on a
+  10⁶-sample sinusoidal motion with a 150 kg payload (6-UPS and 6-PSU) — target ≥ 10⁶/s.
+
+Run: ``.venv/bin/python benchmarks/bench_requirements.py``.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from pkmlab import load_mechanism
+from pkmlab.requirements.dynamics import inverse_dynamics
+from pkmlab.requirements.motions import sinusoid_motion
+from pkmlab.requirements.payload import MassProperties
+from pkmlab.requirements.task import TaskRegion, task_contained, task_margins
+from pkmlab.workspaces import OrientationSet, workspace
+
+ROOT = Path(__file__).resolve().parents[1]
+MECH = ROOT / "studies" / "mechanisms"
+BOX = OrientationSet.box(np.radians([15.0, 15.0, 15.0]), "simultaneous", samples=7)
+
+
+def timed(fn, repeats=7):
+    fn()
+    ts = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        out = fn()
+        ts.append(time.perf_counter() - t)
+    return float(np.median(ts)), out
+
+
+def main() -> None:
+    task = TaskRegion("box", size=(50.0, 50.0, 50.0))
+    for name in ("hopkins-williams-6psu", "gough-stewart-6ups"):
+        mech = load_mechanism(MECH / f"{name}.yaml")
+        t_ws, res = timed(lambda mech=mech: workspace(mech, "dexterous", BOX, 2.5))
+        t_task, chk = timed(lambda mech=mech: task_contained(mech, task, BOX), 21)
+        t_marg, m = timed(lambda mech=mech: task_margins(mech, task, BOX), 3)
+        print(f"{name}: task_contained {t_task * 1e3:.2f} ms ({chk.method}, "
+              f"contained={chk.contained}) vs dexterous workspace {t_ws * 1e3:.1f} ms "
+              f"(volume {res.volume / 1e3:.1f} cm³): ratio {t_task / t_ws:.3f} (target ≤ 2); "
+              f"task_margins {t_marg * 1e3:.1f} ms (margin {m['margin_mm']} mm, orientation "
+              f"{m['orientation_margin_deg']} deg)")
+    body = MassProperties(150.0, np.array([10.0, 20.0, 300.0]),
+                          np.array([[2.5e7, 1e5, 0], [1e5, 2.2e7, 0], [0, 0, 1.2e7]]))
+    for name, amp in (("gough-stewart-6ups", [20, 20, 20, 0.1, 0.1, 0.1]),
+                      ("hopkins-williams-6psu", [5, 5, 5, 0.05, 0.05, 0.05])):
+        mech = load_mechanism(MECH / f"{name}.yaml")
+        motion = sinusoid_motion(mech, amp, [1, 1.3, 0.7, 0.5, 0.9, 1.1], duration=10.0,
+                                 rate=100_000)
+        t, r = timed(lambda mech=mech, motion=motion: inverse_dynamics(mech, motion, body), 3)
+        print(f"{name}: inverse dynamics {len(motion.t) / t / 1e6:.2f} M samples/s "
+              f"({len(motion.t)} samples in {t:.3f} s, {int(np.sum(r.ok))} feasible; "
+              "target ≥ 1 M/s)")
+
+
+if __name__ == "__main__":
+    main()

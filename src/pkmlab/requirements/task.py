@@ -1,0 +1,455 @@
+"""Required workspaces: a task region (box, cylinder or point set) × an orientation set.
+
+A :class:`TaskRegion` is a set of tool positions in mm, given relative to the base frame or to
+the nominal pose's position (``frame``). :func:`task_contained` decides whether *every* position
+of the region works at *every* orientation of an :class:`~pkmlab.workspaces.OrientationSet`
+(relative to the nominal orientation, sampled exactly as the workspace engine samples it), and
+:func:`task_margins` measures how much room is left, in mm and in degrees.
+
+Method (``TaskCheck.method``):
+
+* ``exact`` — families with radial column intervals (``Mechanism.column_radial``: ``psu6``,
+  ``ups6``). At one orientation, leg i admits along the column ``(x, y)`` the z interval
+  ``[a_i(d), b_i(d)]`` (the workspace engine's ``column_leg``), where ``d`` is the horizontal
+  distance from the leg's column axis ``-w_i,xy`` (``w_i = R·u_i - b_i``) and ``a_i``, ``b_i``
+  and the existence flag are monotone in ``d``. A box or cylinder task with z extent
+  ``[z0, z1]`` and footprint ``F`` is inside leg i's set iff it is at the two extreme
+  distances ``d_min = dist(-w_i,xy, F)`` and ``d_max = max dist(-w_i,xy, F)``: the worst ends
+  of monotone functions over ``[d_min, d_max]`` are at the ends. So containment is decided over
+  the *continuous* footprint — no x-y grid, no sampling of the task — and is exact for the
+  sampled orientation set (the same samples as the dexterous workspace; denser ``samples``
+  converge to the continuous set). A point set is a set of zero-size boxes.
+* ``sampled`` — other families (``luzi3``) or workspace constraints beyond the stroke
+  (joint limits, link diameter, κ): the task is sampled on a grid of spacing at most the
+  resolution h, boundary included, and every sample is checked by inverse kinematics at every
+  orientation. Stated error: a failure inside a gap of the sample grid can be missed; any
+  missed region lies within h·√3/2 mm of a checked sample.
+
+Margins (:func:`task_margins`, the largest verified level of a bisection, kind ``bound``):
+
+* ``margin_mm`` — the largest δ such that the task grown by δ (box half-sizes + δ, cylinder
+  radius and half-height + δ, each point a cube of half-size δ) is contained: a lower bound of
+  the distance from the task to the workspace boundary (the grown box contains the δ-ball
+  neighbourhood). Negative when not contained: −(the smallest erosion that fits). Bracket
+  ``MARGIN_TOL_MM`` (sampled method: a quarter of the resolution, bisecting on the task's
+  boundary samples).
+* ``orientation_margin_deg`` — the largest Δ such that the task is contained at the
+  orientation set widened by Δ (every non-zero half-range, tilt and torsion + Δ; a fixed
+  orientation becomes a ±Δ simultaneous box), negative when it must be narrowed. Bracket
+  ``ORIENTATION_TOL_DEG``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from ..errors import ParameterError
+from ..poses import as_frames, matrix_to_euler
+from ..workspaces.constraints import Constraints, check
+from ..workspaces.orientations import OrientationSet
+
+__all__ = ["TaskRegion", "TaskCheck", "task_contained", "task_margins", "task_mesh",
+           "task_outline", "MARGIN_TOL_MM", "ORIENTATION_TOL_DEG"]
+
+MARGIN_TOL_MM = 0.01
+ORIENTATION_TOL_DEG = 0.01
+_SHAPES = ("box", "cylinder", "points")
+_FRAMES = ("nominal", "base")
+
+
+@dataclass(frozen=True)
+class TaskRegion:
+    """A required set of tool positions (mm).
+
+    Attributes:
+        shape: ``"box"`` (axis-aligned, ``size`` = full edges), ``"cylinder"`` (vertical axis,
+            ``radius`` and ``height``) or ``"points"`` (``points (N, 3)``).
+        frame: ``"nominal"`` — coordinates relative to the nominal pose's position — or
+            ``"base"`` — the base frame.
+        centre: box / cylinder centre (mm) in ``frame``.
+    """
+
+    shape: str
+    frame: str = "nominal"
+    centre: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    size: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    radius: float = 0.0
+    height: float = 0.0
+    points: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.shape not in _SHAPES:
+            raise ParameterError("task.shape", f"one of {list(_SHAPES)}", self.shape)
+        if self.frame not in _FRAMES:
+            raise ParameterError("task.frame", f"one of {list(_FRAMES)}", self.frame)
+        if self.shape == "box" and (len(self.size) != 3 or min(self.size) < 0):
+            raise ParameterError("task.size", "three edge lengths >= 0 mm", self.size)
+        if self.shape == "cylinder" and not (self.radius >= 0 and self.height >= 0):
+            raise ParameterError("task.radius", "a radius and a height >= 0 mm",
+                                 [self.radius, self.height])
+        if self.shape == "points":
+            P = np.asarray(self.points, dtype=float)
+            if P.ndim != 2 or P.shape[1] != 3 or len(P) == 0 or not np.all(np.isfinite(P)):
+                raise ParameterError("task.points", "a non-empty (N, 3) array of finite mm",
+                                     None if self.points is None else P.shape)
+            P = P.copy()
+            P.setflags(write=False)
+            object.__setattr__(self, "points", P)
+
+    def offset(self, mech) -> np.ndarray:
+        """Base-frame position of the task frame's origin (mm)."""
+        return np.asarray(mech.nominal_pose[:3]) if self.frame == "nominal" else np.zeros(3)
+
+    def boxes(self, mech, grow: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """Box / point task as base-frame boxes ``(lo (B, 3), hi (B, 3))`` grown by ``grow``
+        (negative: eroded, never below a point)."""
+        o = self.offset(mech)
+        if self.shape == "box":
+            c = np.asarray(self.centre) + o
+            half = np.maximum(np.asarray(self.size) / 2 + grow, 0.0)
+            return (c - half)[None], (c + half)[None]
+        P = self.points + o
+        g = max(grow, 0.0)
+        return P - g, P + g
+
+    def cylinder(self, mech, grow: float = 0.0) -> tuple[np.ndarray, float, float]:
+        """Cylinder task in the base frame grown by ``grow``: ``(centre, radius, half height)``."""
+        c = np.asarray(self.centre) + self.offset(mech)
+        return c, max(self.radius + grow, 0.0), max(self.height / 2 + grow, 0.0)
+
+    @property
+    def extent(self) -> float:
+        """Largest half-extent (mm): how far an erosion can go."""
+        if self.shape == "box":
+            return float(max(self.size) / 2)
+        if self.shape == "cylinder":
+            return float(max(self.radius, self.height / 2))
+        return 0.0
+
+    def describe(self) -> dict:
+        d: dict = {"shape": self.shape, "frame": self.frame}
+        if self.shape == "box":
+            d.update(centre_mm=list(self.centre), size_mm=list(self.size))
+        elif self.shape == "cylinder":
+            d.update(centre_mm=list(self.centre), radius_mm=self.radius,
+                     height_mm=self.height)
+        else:
+            d.update(points=int(len(self.points)))
+        return d
+
+
+@dataclass(frozen=True)
+class TaskCheck:
+    """Result of :func:`task_contained`.
+
+    ``contained``; ``method`` (``exact`` or ``sampled``); ``resolution`` (mm, the sample
+    spacing of the ``sampled`` method, 0 for ``exact``); ``orientations`` (samples used);
+    ``failures`` (count of failing leg × orientation extremes or samples); ``note``.
+    """
+
+    contained: bool
+    method: str
+    resolution: float
+    orientations: int
+    failures: int
+    note: str = ""
+
+
+# ---- exact check on radial column families ---------------------------------------------------
+
+
+@functools.cache
+def _leg_eval(leg):
+    """A numba driver evaluating the family's ``column_leg`` at given horizontal distances."""
+
+    @njit(cache=False)
+    def run(D, W, P, out_a, out_b, out_ok):
+        # D (n,), W (n, 3) leg offsets, P (n, 3) leg params → interval at distance D
+        for k in range(D.shape[0]):
+            a, b, ok = leg(D[k] - W[k, 0], -W[k, 1], W[k, 0], W[k, 1], W[k, 2],
+                           P[k, 0], P[k, 1], P[k, 2])
+            out_a[k] = a
+            out_b[k] = b
+            out_ok[k] = ok
+
+    return run
+
+
+def _legs_at(mech, W, dmin, dmax):
+    """Intervals of every leg at ``dmin`` and ``dmax``: ``W (M, 6, 3)``, ``d* (B, M, 6)`` →
+    ``(a, b, ok)`` each ``(2, B, M, 6)``."""
+    B = dmin.shape[0]
+    D = np.stack([dmin, dmax]).ravel()
+    Wf = np.ascontiguousarray(np.broadcast_to(W, (2, B) + W.shape).reshape(-1, 3))
+    P = np.asarray(mech.column_params(), dtype=float)
+    Pf = np.ascontiguousarray(np.broadcast_to(P, (2, B, W.shape[0], 6, 3)).reshape(-1, 3))
+    n = len(D)
+    a, b, ok = np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
+    _leg_eval(type(mech).column_leg)(np.ascontiguousarray(D), Wf, Pf, a, b, ok)
+    shape = (2, B) + W.shape[:2]
+    return a.reshape(shape), b.reshape(shape), ok.reshape(shape)
+
+
+def _exact_fail(mech, R, task: TaskRegion, grow: float = 0.0) -> np.ndarray:
+    """``(B, M, 6)`` True where leg × orientation fails some part of the task."""
+    W = mech.leg_offsets(R)                                     # (M, 6, 3)
+    axis = -W[..., :2]                                          # column axes (M, 6, 2)
+    if task.shape == "cylinder":
+        c, r, hz = task.cylinder(mech, grow)
+        dc = np.linalg.norm(axis - c[:2], axis=-1)[None]        # (1, M, 6)
+        dmin, dmax = np.maximum(dc - r, 0.0), dc + r
+        z0, z1 = np.array([c[2] - hz]), np.array([c[2] + hz])
+    else:
+        lo, hi = task.boxes(mech, grow)                         # (B, 3)
+        l, h = lo[:, None, None, :2], hi[:, None, None, :2]
+        gap = np.maximum(np.maximum(l - axis, axis - h), 0.0)
+        far = np.maximum(np.abs(axis - l), np.abs(h - axis))
+        dmin, dmax = np.linalg.norm(gap, axis=-1), np.linalg.norm(far, axis=-1)
+        z0, z1 = lo[:, 2], hi[:, 2]
+    a, b, ok = _legs_at(mech, W, dmin, dmax)
+    z0 = z0[None, :, None, None]
+    z1 = z1[None, :, None, None]
+    good = ok & (a <= z0) & (b >= z1)
+    return ~np.all(good, axis=0)
+
+
+# ---- sampled fallback ------------------------------------------------------------------------
+
+
+def _samples(mech, task: TaskRegion, h: float, grow: float = 0.0,
+             surface: bool = False) -> np.ndarray:
+    """Task positions (base frame) on a grid of spacing <= h, boundary included (only the
+    boundary with ``surface``)."""
+    def axis(a, b):
+        n = max(1, math.ceil((b - a) / h - 1e-9))
+        return np.linspace(a, b, n + 1) if b > a else np.array([a])
+
+    if task.shape == "cylinder":
+        c, r, hz = task.cylinder(mech, grow)
+        zs = axis(c[2] - hz, c[2] + hz)
+        pts = [np.zeros((1, 2))]
+        for rho in axis(0.0, r)[1:]:
+            m = max(6, math.ceil(2 * math.pi * rho / h))
+            ang = 2 * math.pi * np.arange(m) / m
+            pts.append(np.stack([rho * np.cos(ang), rho * np.sin(ang)], axis=1))
+        xy = np.concatenate(pts) + c[:2]
+        p = np.concatenate([np.column_stack([xy, np.full(len(xy), z)]) for z in zs])
+        if surface:
+            rim = np.linalg.norm(p[:, :2] - c[:2], axis=1) >= r - 1e-9
+            p = p[rim | (p[:, 2] <= zs[0]) | (p[:, 2] >= zs[-1])]
+        return p
+    lo, hi = task.boxes(mech, grow)
+    out = []
+    for a, b in zip(lo, hi):
+        g = np.meshgrid(*[axis(a[k], b[k]) for k in range(3)], indexing="ij")
+        p = np.stack([x.ravel() for x in g], axis=1)
+        if surface:
+            p = p[np.any((p <= a) | (p >= b), axis=1)]
+        out.append(p)
+    return np.concatenate(out)
+
+
+def _sampled_fail(mech, R, task, h, cons, grow=0.0, surface=False) -> int:
+    p = _samples(mech, task, h, grow, surface)
+    lo_q, hi_q = mech.stroke
+    bad = 0
+    for m in range(len(R)):
+        Rm = np.ascontiguousarray(np.broadcast_to(R[m], (len(p), 3, 3)))
+        ok = mech.inverse((p, Rm), stroke=(lo_q, hi_q)).valid
+        if cons.extra:
+            idx = np.nonzero(ok)[0]
+            ok[idx] = check(mech, p[idx], Rm[idx], cons)
+        bad += int(np.sum(~ok))
+    return bad
+
+
+# ---- public ------------------------------------------------------------------------------------
+
+
+def _prepare(mech, orientations: OrientationSet | None, constraints: Constraints | None):
+    cons = constraints or Constraints()
+    if cons.stroke is not True:
+        mech = dataclasses.replace(mech, stroke_window=cons.stroke)
+    oset = orientations or OrientationSet.fixed()
+    _, Rn = as_frames(mech.nominal_pose)
+    return mech, oset.centred(tuple(matrix_to_euler(Rn[0]))), cons
+
+
+def _check(mech, oset, task, resolution, cons, grow=0.0, surface=False) -> TaskCheck:
+    R = oset.rotations()
+    exact = bool(getattr(type(mech), "column_radial", False)) and mech.column_method \
+        is not None and not cons.extra
+    if exact:
+        fail = _exact_fail(mech, R, task, grow)
+        n = int(fail.sum())
+        return TaskCheck(n == 0, "exact", 0.0, len(R), n)
+    why = ("no radial column intervals for family " + repr(mech.family)) if not cons.extra \
+        else "constraints beyond the stroke"
+    n = _sampled_fail(mech, R, task, resolution, cons, grow, surface)
+    return TaskCheck(n == 0, "sampled", float(resolution), len(R), n,
+                     f"sampled at spacing <= {resolution:g} mm ({why}): a failure between "
+                     f"samples (within {resolution * math.sqrt(3) / 2:.3g} mm of one) can "
+                     "be missed")
+
+
+def task_contained(mech, task: TaskRegion, orientations: OrientationSet | None = None,
+                   resolution: float = 2.5, constraints: Constraints | None = None
+                   ) -> TaskCheck:
+    """Is every position of ``task`` feasible at every orientation of ``orientations``?
+
+    ``orientations`` are relative to the nominal orientation (default: the nominal one);
+    ``resolution`` (mm) is the sample spacing of the sampled fallback; ``constraints`` as
+    for :func:`pkmlab.workspaces.workspace` (the stroke window override is honoured; other
+    constraints force the sampled method). See the module docstring for the method.
+    """
+    mech, oset, cons = _prepare(mech, orientations, constraints)
+    return _check(mech, oset, task, resolution, cons)
+
+
+def _widened(oset: OrientationSet, delta: float) -> OrientationSet:
+    if oset.kind == "fixed":
+        if delta <= 0:
+            return oset
+        return OrientationSet.box((delta,) * 3, "simultaneous", oset.samples,
+                                  centre=tuple(np.asarray(oset.centre) + oset.angles))
+    if oset.kind == "box":
+        return dataclasses.replace(oset, angles=tuple(max(a + delta, 0.0) if a > 0 else a
+                                                      for a in oset.angles))
+    return dataclasses.replace(oset, tilt=max(oset.tilt + delta, 0.0) if oset.tilt > 0
+                               else oset.tilt,
+                               torsion=max(oset.torsion + delta, 0.0) if oset.torsion > 0
+                               else oset.torsion)
+
+
+def _bisect(ok, lo: float, hi: float, tol: float) -> tuple[float, float]:
+    """Largest verified level in [lo, hi] (ok(lo) True, ok(hi) False) and the bracket."""
+    while hi - lo > tol:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
+    return lo, hi - lo
+
+
+def task_margins(mech, task: TaskRegion, orientations: OrientationSet | None = None,
+                 resolution: float = 2.5, constraints: Constraints | None = None,
+                 max_growth: float | None = None) -> dict:
+    """Position and orientation margins of ``task`` (see the module docstring).
+
+    Returns ``{"check": TaskCheck, "margin_mm", "margin_bracket_mm", "orientation_margin_deg",
+    "orientation_bracket_deg", "notes": {...}}``; a margin that does not exist (no part of the
+    task fits, or not even its nominal orientation) is ``None`` with a note.
+    """
+    mech, oset, cons = _prepare(mech, orientations, constraints)
+    base = _check(mech, oset, task, resolution, cons)
+    notes: dict = {}
+    out = {"check": base, "notes": notes}
+
+    # the sampled method bisects on the boundary samples only, to a quarter of its spacing
+    surface = base.method == "sampled"
+    tol = max(MARGIN_TOL_MM, resolution / 4) if surface else MARGIN_TOL_MM
+    otol = 10 * ORIENTATION_TOL_DEG if surface else ORIENTATION_TOL_DEG
+
+    def fits(g):
+        return _check(mech, oset, task, resolution, cons, grow=g, surface=surface).contained
+
+    if base.contained:
+        cap = max_growth if max_growth is not None else 2.0 * mech.scale
+        g = 1.0
+        while g < cap and fits(g):
+            g *= 2.0
+        if g >= cap and fits(cap):
+            out["margin_mm"], out["margin_bracket_mm"] = cap, 0.0
+            notes["task_margin"] = f"not bounded by the search (grown by {cap:g} mm)"
+        else:
+            g = min(g, cap)
+            out["margin_mm"], out["margin_bracket_mm"] = _bisect(fits, g / 2 if g > 1 else 0.0,
+                                                                 g, tol)
+    else:
+        e = task.extent
+        if e > 0 and fits(-e):
+            lo, br = _bisect(lambda g: not fits(-g), 0.0, e, tol)
+            out["margin_mm"], out["margin_bracket_mm"] = -(lo + br), br
+        else:
+            out["margin_mm"] = out["margin_bracket_mm"] = None
+            notes["task_margin"] = ("a point of the task is outside the workspace at some "
+                                    "orientation" if task.shape == "points" else
+                                    "the task's centre is outside the workspace")
+
+    def ofits(d_deg):
+        return _check(mech, _widened(oset, math.radians(d_deg)), task, resolution, cons,
+                      surface=surface).contained
+
+    if base.contained:
+        if ofits(90.0):
+            out["orientation_margin_deg"], out["orientation_bracket_deg"] = 90.0, 0.0
+            notes["task_orientation_margin"] = "not bounded by the search (+90°)"
+        else:
+            out["orientation_margin_deg"], out["orientation_bracket_deg"] = _bisect(
+                ofits, 0.0, 90.0, otol)
+    else:
+        widest = max([*oset.angles] if oset.kind == "box" else
+                     [oset.tilt, oset.torsion] if oset.kind == "tilt-torsion" else [0.0])
+        if widest > 0 and ofits(-math.degrees(widest)):
+            lo, br = _bisect(lambda d: not ofits(-d), 0.0, math.degrees(widest), otol)
+            out["orientation_margin_deg"], out["orientation_bracket_deg"] = -(lo + br), br
+        else:
+            out["orientation_margin_deg"] = out["orientation_bracket_deg"] = None
+            notes["task_orientation_margin"] = "the task does not fit even at the centre " \
+                "orientation"
+    return out
+
+
+# ---- geometry for drawing ----------------------------------------------------------------------
+
+
+def task_mesh(mech, task: TaskRegion, segments: int = 48) -> tuple[np.ndarray, np.ndarray]:
+    """Triangle mesh of the task region in the base frame: ``(vertices (V, 3) mm,
+    faces (F, 3))``; a point set gives one small cube (0.5 mm) per point."""
+    if task.shape == "cylinder":
+        c, r, hz = task.cylinder(mech)
+        ang = 2 * np.pi * np.arange(segments) / segments
+        ring = np.stack([c[0] + r * np.cos(ang), c[1] + r * np.sin(ang)], axis=1)
+        V = np.concatenate([np.column_stack([ring, np.full(segments, c[2] - hz)]),
+                            np.column_stack([ring, np.full(segments, c[2] + hz)]),
+                            [[c[0], c[1], c[2] - hz], [c[0], c[1], c[2] + hz]]])
+        F = []
+        for k in range(segments):
+            n = (k + 1) % segments
+            F += [[k, n, segments + n], [k, segments + n, segments + k],
+                  [2 * segments, n, k], [2 * segments + 1, segments + k, segments + n]]
+        return V, np.array(F)
+    lo, hi = task.boxes(mech, 0.0) if task.shape == "box" else task.boxes(mech, 0.25)
+    cube = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0],
+                     [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], dtype=float)
+    faces = np.array([[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4],
+                      [1, 2, 6], [1, 6, 5], [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7]])
+    V = (lo[:, None, :] + cube[None] * (hi - lo)[:, None, :]).reshape(-1, 3)
+    F = (faces[None] + 8 * np.arange(len(lo))[:, None, None]).reshape(-1, 3)
+    return V, F
+
+
+def task_outline(mech, task: TaskRegion, z: float, segments: int = 96) -> list[np.ndarray]:
+    """Cross-section of the task at height ``z`` (base frame): closed polygons ``(n, 2)``
+    in mm (empty list where the plane misses the task; a point set gives its points there,
+    each as a one-vertex polygon)."""
+    if task.shape == "cylinder":
+        c, r, hz = task.cylinder(mech)
+        if abs(z - c[2]) > hz:
+            return []
+        ang = 2 * np.pi * np.arange(segments + 1) / segments
+        return [np.stack([c[0] + r * np.cos(ang), c[1] + r * np.sin(ang)], axis=1)]
+    lo, hi = task.boxes(mech)
+    out = []
+    for a, b in zip(lo, hi):
+        if a[2] <= z <= b[2]:
+            if task.shape == "points":
+                out.append(a[None, :2].copy())
+            else:
+                out.append(np.array([[a[0], a[1]], [b[0], a[1]], [b[0], b[1]], [a[0], b[1]],
+                                     [a[0], a[1]]]))
+    return out
