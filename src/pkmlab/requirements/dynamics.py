@@ -25,11 +25,14 @@ given), has NaN forces and a status naming why (``DynamicsResult.status``).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit, prange
+from numba import types as nt
 
+from .._jit import cached_kernel
 from ..dexterity.metrics import is_singular
 from ..poses import as_frames
 from .motions import Motion
@@ -131,8 +134,7 @@ def platform_energy(p, R, twist, body: MassProperties, tool_offset,
     return (kin + pot) * 1e-6
 
 
-@njit(parallel=True, cache=True)
-def _solve(J, R, tw, ac, mass, rc, Ic, g0, w, f, qd, pw, piv):
+def _solve_kernel(J, R, tw, ac, mass, rc, Ic, g0, w, f, qd, pw, piv):
     """Per sample: the Newton–Euler wrench ``w``, ``Jᵀ f = w`` by LU with partial pivoting,
     ``q̇ = J t`` and ``f·q̇`` (the same formulas as :func:`platform_wrench`)."""
     n = J.shape[0]
@@ -145,6 +147,14 @@ def _solve(J, R, tw, ac, mass, rc, Ic, g0, w, f, qd, pw, piv):
         A = np.empty((6, 6))
         for k in range(blk * 256, min(n, blk * 256 + 256)):
             _one(k, J, R, tw, ac, mass, rc, Ic, g0, w, f, qd, pw, piv, r, IA, IW, b, A)
+
+
+@functools.cache
+def _solver():
+    """:func:`_solve_kernel` compiled once, cached on disk safely (:mod:`pkmlab._jit`)."""
+    F1, F2, F3 = nt.float64[::1], nt.float64[:, ::1], nt.float64[:, :, ::1]
+    return cached_kernel(_solve_kernel, nt.void(F3, F3, F2, F2, nt.float64, F1, F2, nt.float64,
+                                                F2, F2, F2, F2, F1), parallel=True)
 
 
 @njit(inline="always")
@@ -244,8 +254,8 @@ def inverse_dynamics(mech, motion: Motion, body: MassProperties,
             idx = np.flatnonzero(~ik.valid)
             reasons.update(zip((s + idx).tolist(), np.asarray(ik.reason_text)[idx].tolist()))
         J = np.ascontiguousarray(mech.jacobian((p, R)))
-        _solve(J, R, tw[s:e], ac[s:e], float(body.mass), rc, Ic, float(gravity), w[s:e],
-               f[s:e], qd[s:e], pw[s:e], piv[s:e])
+        _solver()(J, np.ascontiguousarray(R), tw[s:e], ac[s:e], float(body.mass), rc, Ic,
+                  float(gravity), w[s:e], f[s:e], qd[s:e], pw[s:e], piv[s:e])
         sus = np.flatnonzero(ik.valid & ~(piv[s:e] > _SUSPECT))
         if len(sus):
             sing.append(s + sus[is_singular(J[sus])])

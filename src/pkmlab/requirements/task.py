@@ -42,14 +42,13 @@ Margins (:func:`task_margins`, the largest verified level of a bisection, kind `
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from ..errors import ParameterError
+from ..mechanisms._kernels import make_leg_eval
 from ..poses import as_frames, matrix_to_euler
 from ..workspaces.constraints import Constraints, check
 from ..workspaces.orientations import OrientationSet
@@ -164,23 +163,6 @@ class TaskCheck:
 # ---- exact check on radial column families ---------------------------------------------------
 
 
-@functools.cache
-def _leg_eval(leg):
-    """A numba driver evaluating the family's ``column_leg`` at given horizontal distances."""
-
-    @njit(cache=False)
-    def run(D, W, P, out_a, out_b, out_ok):
-        # D (n,), W (n, 3) leg offsets, P (n, 3) leg params → interval at distance D
-        for k in range(D.shape[0]):
-            a, b, ok = leg(D[k] - W[k, 0], -W[k, 1], W[k, 0], W[k, 1], W[k, 2],
-                           P[k, 0], P[k, 1], P[k, 2])
-            out_a[k] = a
-            out_b[k] = b
-            out_ok[k] = ok
-
-    return run
-
-
 def _legs_at(mech, W, dmin, dmax):
     """Intervals of every leg at ``dmin`` and ``dmax``: ``W (M, 6, 3)``, ``d* (B, M, 6)`` →
     ``(a, b, ok)`` each ``(2, B, M, 6)``."""
@@ -189,9 +171,8 @@ def _legs_at(mech, W, dmin, dmax):
     Wf = np.ascontiguousarray(np.broadcast_to(W, (2, B) + W.shape).reshape(-1, 3))
     P = np.asarray(mech.column_params(), dtype=float)
     Pf = np.ascontiguousarray(np.broadcast_to(P, (2, B, W.shape[0], 6, 3)).reshape(-1, 3))
-    n = len(D)
-    a, b, ok = np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
-    _leg_eval(type(mech).column_leg)(np.ascontiguousarray(D), Wf, Pf, a, b, ok)
+    # the leg's interval on the column at horizontal distance D along its own x axis
+    a, b, ok = make_leg_eval(type(mech).column_leg)(D - Wf[:, 0], -Wf[:, 1], Wf, Pf)
     shape = (2, B) + W.shape[:2]
     return a.reshape(shape), b.reshape(shape), ok.reshape(shape)
 
