@@ -133,11 +133,12 @@ def dexterity(
                                values=vals, label=mmap.label)
             files.append(tmp / f"{metric}_slices.png")
             fig.savefig(files[-1], dpi=120)
-            m = res.mesh()
-            m.visual.vertex_colors = mesh_colours(m, mmap)
-            for fmt in ("ply", "glb"):
-                files.append(tmp / f"workspace_{metric}.{fmt}")
-                m.export(files[-1])
+            if res.mesh_problem is None:
+                m = res.mesh()
+                m.visual.vertex_colors = mesh_colours(m, mmap)
+                for fmt in ("ply", "glb"):
+                    files.append(tmp / f"workspace_{metric}.{fmt}")
+                    m.export(files[-1])
         for f in files:
             shutil.move(str(f), out_dir / f.name)
             written.append(out_dir / f.name)
@@ -169,6 +170,9 @@ def _print_dexterity(rep, force_limit, well_conditioned, force_required, written
               f"{g(n['stiffness_translational_min_N_per_mm'], '.0f')} N/mm")
     if agg["empty"]:
         out.print("  workspace: [bold]empty[/] — no aggregates")
+    elif agg.get("no_samples"):
+        out.print(escape(f"  workspace {agg['workspace_volume_cm3']:.4f} cm³, no aggregates: "
+                         f"{agg['no_samples']}"), highlight=False)
     else:
         k, w = agg["kappa"], agg["worst_case"]
         out.print(f"  over the {rep.result.kind} workspace ({agg['workspace_volume_cm3']:.2f} "

@@ -268,7 +268,7 @@ def _export_one(d: Path, study: Study, r: dict, rank: int) -> None:
     res = workspace(mech, **ev.request)
     ws = ev.workspace
     res.plot_slices(d / "slices.png", window=ws.slice_window, spacing=ws.slice_spacing)
-    if res.empty:
+    if res.mesh_problem is not None:
         return
     res.save_mesh(d / "workspace.stl")
     length = dx.resolve_length(mech, r["metrics"].get("characteristic_length"))

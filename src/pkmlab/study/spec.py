@@ -129,7 +129,7 @@ class MechanismSource(_Model):
 class StudySpec(_Model):
     """A design study file (docs/studies.md): what to vary, evaluate, optimise and keep."""
 
-    study: str = Field(pattern=r"^[A-Za-z0-9._-]+$")
+    study: str = Field(pattern=r"^[A-Za-z0-9_][A-Za-z0-9._-]*$", max_length=100)
     description: str = ""
     mechanism: MechanismSource
     design: dict[str, DesignVariableSpec] = Field(min_length=1)

@@ -18,8 +18,11 @@ def boundary_mesh(result):
     import trimesh
     from skimage.measure import marching_cubes
 
-    if result.empty:
-        raise ValueError("the workspace is empty: there is no boundary to mesh")
+    from ..errors import NumericalError
+
+    problem = result.mesh_problem
+    if problem is not None:           # marching cubes needs a grid point inside
+        raise NumericalError("mesh", problem)
     h = result.resolution
     f = np.pad(result.field, 1, constant_values=-h)
     verts, faces, _, _ = marching_cubes(f, level=0.0, spacing=(h, h, h))
