@@ -84,8 +84,10 @@ class Store:
     """SQLite store of evaluations (``evaluations.sqlite`` in the study's output folder).
 
     The file is in WAL mode: commits go to ``evaluations.sqlite-wal`` and are folded into the
-    main file every :data:`CHECKPOINT_EVERY` commits and on :meth:`close`; copy the folder (or
-    all three files), not ``evaluations.sqlite`` alone, while a run is going on.
+    main file every :data:`CHECKPOINT_EVERY` commits; :meth:`close` switches the file back to a
+    rollback journal, so a finished (or interrupted but closed) run is one self-contained
+    file. While a run is going on, copy the folder (or all three files), not
+    ``evaluations.sqlite`` alone.
     """
 
     def __init__(self, path: str | Path, *, read_only: bool = False):
@@ -169,8 +171,9 @@ class Store:
                 "notes": json.loads(r[8] or "{}")}
 
     def close(self) -> None:
-        try:
-            self.checkpoint()
-        except sqlite3.Error:       # busy or read-only: the log stays, nothing is lost
-            pass
+        if not self.read_only:
+            try:        # fold the log in and leave one self-contained file behind
+                self.conn.execute("PRAGMA journal_mode=DELETE")
+            except sqlite3.Error:   # busy (another reader): the log stays, nothing is lost
+                pass
         self.conn.close()

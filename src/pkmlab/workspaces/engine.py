@@ -27,8 +27,8 @@ from .._intervals import label_pieces
 from ..dexterity.metrics import resolve_length
 from ..errors import ParameterError
 from ..limits import RESOLUTION_MM
-from ..memory import coarser_resolution, format_bytes, require
 from ..mechanisms import NO_STROKE
+from ..memory import coarser_resolution, require
 from ..poses import as_frames, matrix_to_euler
 from .constraints import Constraints, check
 from .field import interval_field
@@ -44,6 +44,8 @@ KINDS = ("constant", "reachable", "dexterous")
 _CHUNK = 200_000
 #: voxels evaluated per x slab on the sampled method
 _SLAB = 1_000_000
+#: start of the note on a mechanism singular at its nominal pose
+SINGULAR_NOTE = "singular at the nominal pose"
 #: interval pieces kept per column (union of orientations, sampled runs)
 _K = 8
 
@@ -102,6 +104,9 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
         cons = dataclasses.replace(cons, characteristic_length=length.length)
         notes.append(f"kappa_max: L = {length.length:.6g} mm ({length.status}): "
                      f"{length.reason}")
+    sing = _nominal_singularity(mech)
+    if sing:
+        notes.append(sing)
     oset = orientations or OrientationSet.fixed()
     if kind == "constant" and oset.kind != "fixed":
         raise ParameterError("orientations", "a single fixed orientation for kind 'constant'",
@@ -306,6 +311,20 @@ def _voxel_extras(mech, xs, ys, zs, R, mode, cons, field, h):
     bad = idx[~ok]
     out[bad[:, 0], bad[:, 1], bad[:, 2]] = -h
     return out
+
+
+def _nominal_singularity(mech) -> str | None:
+    """A note when the Jacobian is rank-deficient at the nominal pose (architecturally
+    singular designs: platform equal to the base, collinear joints), where the stroke-feasible
+    volume says nothing about what the mechanism can hold or control."""
+    from ..dexterity.metrics import is_singular
+
+    X = mech.nominal_pose
+    J = mech.jacobian(X)
+    if not bool(is_singular(J, mech.scale)[0]):
+        return None
+    return (f"{SINGULAR_NOTE} (the Jacobian is rank-deficient there): the mechanism cannot "
+            "resist or control every load and motion; the volume counts stroke only")
 
 
 def _crop(xs, ys, lo, hi):
