@@ -380,6 +380,7 @@ def test_kill_9_leaves_no_workers_and_resume_finishes(tmp_path, when):
     while time.time() < deadline and not workers and when == "mid":
         workers = {c for c in _children(proc.pid)}
         time.sleep(0.1)
+    assert workers or when == "early", "no loky workers seen"
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     deadline = time.time() + 15
@@ -400,8 +401,7 @@ def test_ctrl_c_stops_the_run_cleanly_and_resume_finishes(tmp_path):
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
-    assert "Traceback" not in err and err.strip().splitlines()[-1] == "interrupted"
-    assert not (tmp_path / "out" / ".lock").read_text() or True
+    assert "Traceback" not in err and len(err.strip().splitlines()) <= 1, err
     store = run_study(load_study(p), SerialRunner(), resume=True)
     assert len(store.all()) == 65
     store.close()
