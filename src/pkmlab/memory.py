@@ -64,7 +64,9 @@ def coarser_resolution(h: float, need: float, exponent: float = 2.0) -> float:
     """A grid spacing that would fit: memory scales as ``h**-exponent``; rounded up to a
     readable value."""
     limit = memory_limit()
-    target = h * (need / max(limit, 1)) ** (1.0 / exponent) * 1.05
+    target = h * (max(need, 1.0) / max(limit, 1)) ** (1.0 / exponent) * 1.05
+    if not math.isfinite(target) or target <= 0:
+        return h
     mag = 10 ** math.floor(math.log10(target))
     for step in (1, 1.25, 1.5, 2, 2.5, 3, 4, 5, 6, 8, 10):
         if step * mag >= target:
