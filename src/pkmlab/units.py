@@ -49,7 +49,13 @@ def parse_quantity(value: Any, field: str, units: dict[str, float], default_unit
 
 def parse_length(value: Any, field: str, default_unit: str = "mm") -> float:
     """Length in mm from a bare number (``default_unit``) or a string such as ``"4 in"``."""
-    return parse_quantity(value, field, LENGTH_UNITS, default_unit) / LENGTH_UNITS["mm"]
+    from .limits import LENGTH_MAX_MM
+
+    mm = parse_quantity(value, field, LENGTH_UNITS, default_unit) / LENGTH_UNITS["mm"]
+    if abs(mm) > LENGTH_MAX_MM:
+        raise ParameterError(field, f"a length of at most {LENGTH_MAX_MM:g} mm (1 km) in "
+                             "magnitude", value)
+    return mm
 
 
 def parse_angle(value: Any, field: str, default_unit: str = "deg") -> float:

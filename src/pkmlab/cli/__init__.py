@@ -51,7 +51,11 @@ def main() -> None:
     """Console entry point: input errors exit 2 (one line); a file-system error exits 2 with
     its path; a candidate's programming error exits 1 with its traceback and parameters; any
     other unexpected error exits 1 with one line (``--debug``: the traceback)."""
+    import sqlite3
+
+    from ..errors import NumericalError, ParameterError
     from ..study.run import CandidateError
+    from ..yamlio import locate_error
 
     try:
         code = app(standalone_mode=False)      # click returns an Exit's code in this mode
@@ -70,6 +74,21 @@ def main() -> None:
     except CandidateError as exc:
         sys.stderr.write(f"error: {exc}\n")
         raise SystemExit(1) from None
+    except ParameterError as exc:                 # bad input found late: one line, exit 2
+        locate_error(exc)
+        sys.stderr.write("error: " + " ".join(str(exc).split()) + "\n")
+        raise SystemExit(2) from None
+    except NumericalError as exc:                 # the request has no defined answer
+        sys.stderr.write("error: " + " ".join(str(exc).split()) + "\n")
+        raise SystemExit(2) from None
+    except MemoryError:
+        sys.stderr.write("error: out of memory: use a coarser resolution, fewer samples or a "
+                         "smaller population (PKMLAB_MEMORY_LIMIT sets the budget checked "
+                         "before allocating)\n")
+        raise SystemExit(2) from None
+    except sqlite3.DatabaseError as exc:
+        sys.stderr.write(f"error: results store: {exc}\n")
+        raise SystemExit(2) from None
     except OSError as exc:
         if _DEBUG["on"]:
             raise

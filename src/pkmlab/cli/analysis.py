@@ -134,13 +134,14 @@ def dexterity(
             fig = slice_figure(res, **spec.slice_options(), values=vals, label=mmap.label)
             files.append(tmp / f"{metric}_slices.png")
             fig.savefig(files[-1], dpi=120)
-            m = res.mesh()
-            colours = mesh_colours(m, mmap)
-            for fmt in ("ply", "glb"):       # PLY in mm with the metric per vertex; GLB in m
-                files.append(tmp / f"workspace_{metric}.{fmt}")
-                res.save_mesh(files[-1], colors=colours,
-                              values={metric: vertex_values(m, mmap)} if fmt == "ply"
-                              else None)
+            if res.mesh_problem is None:
+                m = res.mesh()
+                colours = mesh_colours(m, mmap)
+                for fmt in ("ply", "glb"):   # PLY in mm with the metric per vertex; GLB in m
+                    files.append(tmp / f"workspace_{metric}.{fmt}")
+                    res.save_mesh(files[-1], colors=colours,
+                                  values={metric: vertex_values(m, mmap)} if fmt == "ply"
+                                  else None)
         for f in files:
             shutil.move(str(f), out_dir / f.name)
             written.append(out_dir / f.name)
@@ -172,6 +173,9 @@ def _print_dexterity(rep, force_limit, well_conditioned, force_required, written
               f"{g(n['stiffness_translational_min_N_per_mm'], '.0f')} N/mm")
     if agg["empty"]:
         out.print("  workspace: [bold]empty[/] — no aggregates")
+    elif agg.get("no_samples"):
+        out.print(escape(f"  workspace {agg['workspace_volume_cm3']:.4f} cm³, no aggregates: "
+                         f"{agg['no_samples']}"), highlight=False)
     else:
         k, w = agg["kappa"], agg["worst_case"]
         out.print(f"  over the {rep.result.kind} workspace ({agg['workspace_volume_cm3']:.2f} "

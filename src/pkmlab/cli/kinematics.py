@@ -43,7 +43,8 @@ def inspect(mech_file: MechArg, as_json: JsonOpt = False) -> None:
         "nominal_pose": _pose_json(nominal),
         "nominal_actuators": rep["actuators"],
         "nominal_valid": rep["valid"],
-        "nominal_reason": rep["reason"],
+        "nominal_reason": (rep["reason"] if not (rep["valid"] and rep["singular"]) else
+                           "singular: the Jacobian is rank-deficient at the nominal pose"),
         "actuator_limits": {n: list(map(float, lim))
                             for n, lim in zip(mech.actuator_names, mech.actuator_limits)},
         "kappa": rep["kappa"],

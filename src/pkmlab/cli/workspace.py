@@ -46,8 +46,10 @@ def _write_workspace(res, out_dir: Path, mesh_formats: list[str], slices: dict) 
     with staged(out_dir) as tmp:
         files = [res.save_npz(tmp / "workspace.npz"), res.save_json(tmp / "workspace.json"),
                  res.plot_slices(tmp / "slices.png", **slices)]
-        if not res.empty:
+        if res.mesh_problem is None:
             files += [res.save_mesh(tmp / f"workspace.{fmt}") for fmt in mesh_formats]
+        elif not res.empty:
+            res.notes.append(f"no mesh written: {res.mesh_problem}")
     return [out_dir / f.name for f in files]
 
 

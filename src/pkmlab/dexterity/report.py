@@ -131,6 +131,8 @@ class DexterityReport:
 
 def _stats(values: np.ndarray) -> dict:
     v = np.asarray(values, dtype=float)
+    if v.size == 0:       # a workspace thinner than a grid cell has no sample inside
+        return dict.fromkeys(("min", "mean", "p5", "p50", "max"))
     return {"min": float(v.min()), "mean": float(v.mean()), "p5": float(np.percentile(v, 5)),
             "p50": float(np.percentile(v, 50)), "max": float(v.max())}
 
@@ -176,7 +178,9 @@ def dexterity_report(mech, request: dict, *, L: float | CharacteristicLength | N
                           actuator_stiffness=actuator_stiffness)
     agg: dict = {"workspace_volume_cm3": res.volume / 1e3, "empty": res.empty}
     mmap = None
-    if not res.empty:
+    if not res.empty and res.mesh_problem is not None:    # no grid sample inside
+        agg["no_samples"] = res.mesh_problem
+    elif not res.empty:
         log.info("dexterity: κ over %d voxels × %d orientations", int(res.occupancy.sum()),
                  len(res.orientations.rotations()))
         g = kappa_grid(mech, res, length)
@@ -203,8 +207,8 @@ def dexterity_report(mech, request: dict, *, L: float | CharacteristicLength | N
             "well_conditioned_fraction": wc_vol.fraction,
             "force_all_directions_N": _stats(fmap.values),
             "force_required_N": force_required,
-            "force_capable_volume_cm3": float(np.mean(fmap.values >= force_required))
-            * res.volume / 1e3,
+            "force_capable_volume_cm3": (float(np.mean(fmap.values >= force_required))
+                                         * res.volume / 1e3) if fmap.values.size else None,
         })
     data = {"mechanism": mech.name, "workspace": res.metrics(), "nominal": nominal,
             "aggregates": agg, "metric": metric, "characteristic_length": length.as_dict()}

@@ -389,9 +389,9 @@ class Mechanism:
             if np.isfinite(a) and np.isfinite(b) and a * b <= 0:
                 z = brentq(mean_q, zs[k + 1], zs[k], xtol=TOL.nominal_z_mm)
                 return np.array([0.0, 0.0, z, 0.0, 0.0, yaw])
-        raise ParameterError(f"{self.family}.stroke",
-                             "a window whose mid-point is reachable by a level, centred platform",
-                             list(self.stroke))
+        raise ParameterError("stroke", "a window whose mid-point is reachable by a level, "
+                             "centred platform (the nominal pose: give 'nominal' or change the "
+                             "stroke or the link lengths)", list(self.stroke))
 
     def _random_starts(self, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
         rng = np.random.default_rng(seed)

@@ -36,6 +36,7 @@ from ..requirements.dynamics import inverse_dynamics
 from ..requirements.task import task_margins
 from ..trajectory import check_trajectory, paper_motion
 from ..workspaces import OrientationSet, workspace
+from ..workspaces.engine import SINGULAR_NOTE
 from .metrics import metrics_of
 
 log = logging.getLogger(__name__)
@@ -91,6 +92,9 @@ def _workspace(mech, ctx: Context) -> dict:
            "workspace_empty": float(res.empty),
            "z_span": 0.0 if zr is None else float(zr[1] - zr[0])}
     out[f"{res.kind}_volume"] = vol
+    for note in res.notes:
+        if note.startswith(SINGULAR_NOTE):
+            ctx.notes["workspace_volume"] = note
     return out
 
 

@@ -163,7 +163,9 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
         step("slices")
         res.plot_slices(d / "slices.png", **opts)
         files.append("slices.png")
-        if not res.empty:
+        if res.mesh_problem is not None:
+            info["mesh"] = res.mesh_problem
+        else:
             length = dx.resolve_length(mech, r["metrics"].get("characteristic_length"))
             L = length.length if length.status != "fallback" else None
             mesh = res.mesh()

@@ -17,7 +17,7 @@ import numpy as np
 
 from .definition import PENALTY
 
-__all__ = ["OPTIMISERS", "expected_evaluations"]
+__all__ = ["OPTIMISERS", "expected_evaluations", "check_memory"]
 
 log = logging.getLogger(__name__)
 
@@ -109,6 +109,25 @@ def expected_evaluations(space, opt) -> int:
     if opt.method == "nsga2":
         return opt.population * opt.generations + 2
     return opt.population * (opt.generations + 1) + 1
+
+
+def check_memory(n_var: int, opt) -> None:
+    """Refuse optimiser settings whose own arrays exceed the memory budget, before any
+    evaluation: NSGA-II sorts with ``population²`` distance and dominance matrices, Latin
+    hypercube sampling builds every sample at once (Sobol and grids are generated lazily)."""
+    from ..memory import memory_limit, require
+
+    if opt.method == "nsga2":
+        need = 8.0 * opt.population ** 2 + 200.0 * opt.population * max(n_var, 1)
+        fit = int((memory_limit() / 8.0) ** 0.5 * 0.9)
+        require("optimizer.population", need, "a population whose sorting matrices",
+                f"{opt.population}", f"try <= {fit}")
+    elif opt.method == "lhs":
+        need = 32.0 * opt.samples * max(n_var, 1)
+        fit = int(memory_limit() / (32.0 * max(n_var, 1)) * 0.9)
+        require("optimizer.samples", need, "a Latin hypercube whose samples",
+                f"{opt.samples}", f"try <= {fit}, or method 'sobol', generated lazily")
+
 
 
 OPTIMISERS = {"grid": _grid, "sobol": _sobol, "lhs": _lhs, "nsga2": _nsga2, "de": _de}

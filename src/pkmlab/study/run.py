@@ -118,6 +118,20 @@ class OutputLock:
         self.fh.close()
 
 
+def check_output(out: Path, source: Path | None = None) -> None:
+    """Refuse a results folder that would hold (and on --overwrite delete) other files: the
+    file system root, the working directory, the study file's folder or a parent of them."""
+    target = Path(out).expanduser().resolve()
+    protected = [Path.cwd().resolve()]
+    if source is not None:
+        protected.append(Path(source).resolve().parent)
+    for p in protected:
+        if target == p or target in p.parents or target == Path(target.anchor):
+            raise ParameterError("output", "a results folder of its own (not the working "
+                                 "directory, the study's folder, a parent of them or /)",
+                                 str(out))
+
+
 def _prepare(out: Path, fp: str, resume: bool, overwrite: bool) -> Store:
     path = out / "evaluations.sqlite"
     if path.exists() and resume:
@@ -160,6 +174,7 @@ def run_study(study: Study, runner, *, resume: bool = False, overwrite: bool = F
         CandidateError: a candidate raised an undeclared exception (recorded first).
     """
     out = Path(study.output)
+    check_output(out, study.source)
     fp = study.fingerprint()
     with OutputLock(out):
         store = _prepare(out, fp, resume, overwrite)

@@ -15,7 +15,41 @@ __all__ = ["SerialRunner", "JoblibRunner", "DaskRunner", "make_runner"]
 log = logging.getLogger(__name__)
 
 
-def _call(fn, task_id, args):
+#: seconds to reach a Dask scheduler before giving up
+DASK_CONNECT_TIMEOUT = 5.0
+_WATCHDOG = {"started": False}
+
+
+def _watch_parent(parent: int, period: float = 0.5) -> None:
+    """In a worker process: exit as soon as the process that started the run is gone (a
+    killed ``pkmlab run`` must not leave workers evaluating for minutes)."""
+    import os
+    import threading
+    import time
+
+    if _WATCHDOG["started"] or parent == os.getpid():
+        return
+    _WATCHDOG["started"] = True
+    ppid = os.getppid()
+
+    def watch():
+        while True:
+            time.sleep(period)
+            try:
+                os.kill(parent, 0)
+            except ProcessLookupError:
+                os._exit(1)
+            except PermissionError:
+                pass
+            if os.getppid() != ppid:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="pkmlab-parent-watchdog", daemon=True).start()
+
+
+def _call(fn, task_id, args, parent=None):
+    if parent is not None:
+        _watch_parent(parent)
     return task_id, fn(*args)
 
 
@@ -44,9 +78,12 @@ class JoblibRunner:
         self.pool = Parallel(n_jobs=jobs, backend="loky", return_as="generator_unordered")
 
     def map(self, fn, tasks):
+        import os
+
         from joblib import delayed
 
-        yield from self.pool(delayed(_call)(fn, tid, args) for tid, args in tasks)
+        parent = os.getpid()
+        yield from self.pool(delayed(_call)(fn, tid, args, parent) for tid, args in tasks)
 
     def close(self) -> None:
         pass
@@ -61,7 +98,24 @@ class DaskRunner:
         from distributed import Client
 
         self._own = client is None
-        self.client = client if client is not None else Client(scheduler)
+        if client is None:
+            import logging as _logging
+
+            quiet = _logging.getLogger("distributed")
+            level = quiet.level
+            quiet.setLevel(_logging.CRITICAL)       # one line from us, not a page of retries
+            try:
+                client = Client(scheduler, timeout=DASK_CONNECT_TIMEOUT)
+            except (OSError, TimeoutError, ValueError) as exc:
+                from ..errors import ParameterError
+
+                raise ParameterError("--scheduler", "a reachable Dask scheduler address "
+                                     f"(connection within {DASK_CONNECT_TIMEOUT:g} s)",
+                                     f"{scheduler}: {' '.join(str(exc).split())[:160]}") \
+                    from None
+            finally:
+                quiet.setLevel(level)
+        self.client = client
 
     def map(self, fn, tasks):
         from distributed import as_completed

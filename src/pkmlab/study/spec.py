@@ -27,6 +27,7 @@ from .definition import (
     TrajectoryPlan,
 )
 from .metrics import KIND_VOLUMES, METRICS
+from .optimisers import check_memory
 from .space import Derived, DesignSpace, Expression, Variable, get_path, parse_path
 
 __all__ = ["load_study", "study_from_mapping", "StudySpec", "study_schema", "DESIGN_ALIASES"]
@@ -140,7 +141,7 @@ class MechanismSource(_Model):
 class StudySpec(_Model):
     """A design study file (docs/studies.md): what to vary, evaluate, optimise and keep."""
 
-    study: str = Field(pattern=r"^[A-Za-z0-9._-]+$")
+    study: str = Field(pattern=r"^[A-Za-z0-9_][A-Za-z0-9._-]*$", max_length=100)
     description: str = ""
     mechanism: MechanismSource
     design: dict[str, DesignVariableSpec] = Field(min_length=1)
@@ -409,6 +410,7 @@ def study_from_mapping(data: Any, base: Path | None = None,
     if opt.method in ("nsga2", "de") and any(v.kind == "choice" for v in variables):
         raise ParameterError("optimizer.method", "'grid', 'sobol' or 'lhs' with choice "
                              "variables", opt.method)
+    check_memory(len(variables), opt)
     output = Path("results") / spec.study if spec.output is None else base / spec.output
     return Study(name=spec.study, description=spec.description,
                  space=DesignSpace(mech_spec, variables, tuple(derived)),

@@ -42,8 +42,53 @@ def _clean(obj):
     return obj
 
 
+#: A write-ahead-log checkpoint every this many commits (and on close): evaluations since the
+#: last checkpoint live only in ``evaluations.sqlite-wal`` until then.
+CHECKPOINT_EVERY = 50
+
+
+def diagnose(path: str | Path) -> str:
+    """What can be read from a damaged store: SQLite's integrity check and the number of
+    evaluation rows that still decode (one line)."""
+    try:
+        conn = sqlite3.connect(f"file:{Path(path)}?mode=ro", uri=True)
+    except sqlite3.Error as exc:
+        return f"cannot be opened ({exc})"
+    try:
+        try:
+            check = conn.execute("PRAGMA integrity_check").fetchone()[0]
+        except sqlite3.Error as exc:
+            check = str(exc)
+        readable = 0
+        try:
+            for row in conn.execute(f"SELECT {_COLUMNS} FROM evaluations"):
+                try:
+                    Store._row(row)
+                    readable += 1
+                except (ValueError, TypeError):
+                    pass
+        except sqlite3.Error:
+            pass
+    finally:
+        conn.close()
+    return (f"sqlite integrity_check: {check}; {readable} evaluations readable (copy them out "
+            "with the sqlite3 tool's .recover, or rerun the study with --overwrite)")
+
+
+def _damaged(path: Path, exc: Exception) -> ParameterError:
+    return ParameterError("store", "a readable pkmlab results store",
+                          f"{path}: {exc}; {diagnose(path)}")
+
+
 class Store:
-    """SQLite store of evaluations (``evaluations.sqlite`` in the study's output folder)."""
+    """SQLite store of evaluations (``evaluations.sqlite`` in the study's output folder).
+
+    The file is in WAL mode: commits go to ``evaluations.sqlite-wal`` and are folded into the
+    main file every :data:`CHECKPOINT_EVERY` commits; :meth:`close` switches the file back to a
+    rollback journal, so a finished (or interrupted but closed) run is one self-contained
+    file. While a run is going on, copy the folder (or all three files), not
+    ``evaluations.sqlite`` alone.
+    """
 
     def __init__(self, path: str | Path, *, read_only: bool = False):
         self.path = Path(path)
@@ -68,8 +113,8 @@ class Store:
                     self.set_meta("schema", SCHEMA)
                     version = SCHEMA
         except sqlite3.DatabaseError as exc:
-            raise ParameterError("store", "a readable pkmlab results store",
-                                 f"{self.path}: {exc}") from None
+            raise _damaged(self.path, exc) from None
+        self._commits = 0
         if version != SCHEMA:
             self.conn.close()
             raise ParameterError("store", f"a results store of layout {SCHEMA} (made by this "
@@ -86,9 +131,12 @@ class Store:
 
     # ---- evaluations -----------------------------------------------------------------------
     def get(self, key: str) -> dict | None:
-        row = self.conn.execute(f"SELECT {_COLUMNS} FROM evaluations WHERE key = ?",
-                                (key,)).fetchone()
-        return None if row is None else self._row(row)
+        try:
+            row = self.conn.execute(f"SELECT {_COLUMNS} FROM evaluations WHERE key = ?",
+                                    (key,)).fetchone()
+            return None if row is None else self._row(row)
+        except (sqlite3.DatabaseError, ValueError, TypeError) as exc:
+            raise _damaged(self.path, exc) from None
 
     def put(self, key: str, role: str, params: dict, result: dict) -> dict:
         """Commit one finished evaluation (ignored if the key is already stored)."""
@@ -98,11 +146,23 @@ class Store:
             (key, role, _canon(params), _canon(_clean(result["metrics"])), result["status"],
              result["reason"], float(result["seconds"]), _canon(result.get("notes", {}))))
         self.conn.commit()
+        self._commits += 1
+        if self._commits % CHECKPOINT_EVERY == 0:
+            self.checkpoint()
         return self.get(key)
 
+    def checkpoint(self) -> None:
+        """Fold the write-ahead log into ``evaluations.sqlite``."""
+        if not self.read_only:
+            self.conn.execute("PRAGMA wal_checkpoint(TRUNCATE)")
+
     def all(self) -> list[dict]:
-        rows = self.conn.execute(f"SELECT {_COLUMNS} FROM evaluations ORDER BY seq").fetchall()
-        return [self._row(r) for r in rows]
+        try:
+            rows = self.conn.execute(f"SELECT {_COLUMNS} FROM evaluations "
+                                     "ORDER BY seq").fetchall()
+            return [self._row(r) for r in rows]
+        except (sqlite3.DatabaseError, ValueError, TypeError) as exc:
+            raise _damaged(self.path, exc) from None
 
     @staticmethod
     def _row(r) -> dict:
@@ -111,4 +171,9 @@ class Store:
                 "notes": json.loads(r[8] or "{}")}
 
     def close(self) -> None:
+        if not self.read_only:
+            try:        # fold the log in and leave one self-contained file behind
+                self.conn.execute("PRAGMA journal_mode=DELETE")
+            except sqlite3.Error:   # busy (another reader): the log stays, nothing is lost
+                pass
         self.conn.close()

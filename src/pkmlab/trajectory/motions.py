@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
+from ..limits import SEGMENT_TIME_S
 from ..mechanisms.base import Mechanism
 from ._args import finite as _finite
 from ._args import positive as _positive
@@ -79,6 +80,10 @@ def paper_motion_phases(segment_time: float = 1.0, dwell: float = 1.0
     lobes (``4·segment_time`` long) and consecutive windows are separated by ``dwell``.
     """
     segment_time = _positive(segment_time, "segment_time", "s")
+    lo_t, hi_t = SEGMENT_TIME_S
+    if not lo_t <= segment_time <= hi_t:   # shorter: the motion collapses below the sampling
+        raise ParameterError("segment_time", f"a duration in [{lo_t:g}, {hi_t:g}] s",
+                             segment_time)
     dwell = _positive(dwell, "dwell", "s", allow_zero=True)
     out = []
     start = dwell

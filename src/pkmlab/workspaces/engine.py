@@ -5,8 +5,12 @@ of different runs and geometries share voxels. For families with column kernels
 (``Mechanism.column_method``) every (x, y) column gets its exact stroke-feasible z set as a
 few intervals; the volume is then integrated exactly in z and only the x-y footprint is
 discretised. Other families (and constraints that depend on z along a column) are sampled on
-the voxel grid. The voxel grid and a signed field (positive inside, zero on the boundary) are
-kept for display: slices, meshes.
+the voxel grid, one slab of x columns at a time, and kept as the same column intervals (runs
+of inside voxels), so memory grows with the footprint (nx·ny), not with the volume (nx·ny·nz).
+The signed field (positive inside, zero on the boundary) is built on first use for display
+(slices, meshes) over the kept workspace's bounding box only. The memory a request needs is
+estimated before anything is allocated (:func:`estimate_bytes`) and a request over the budget
+(:mod:`pkmlab.memory`) is refused.
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ from ..dexterity.metrics import resolve_length
 from ..errors import ParameterError
 from ..limits import RESOLUTION_MM
 from ..mechanisms import NO_STROKE
+from ..memory import coarser_resolution, require
 from ..poses import as_frames, matrix_to_euler
 from .constraints import Constraints, check
 from .field import interval_field
@@ -33,10 +38,30 @@ from .result import WorkspaceResult
 
 log = logging.getLogger(__name__)
 
-__all__ = ["workspace", "orientation_convergence", "KINDS"]
+__all__ = ["workspace", "orientation_convergence", "estimate_bytes", "KINDS"]
 
 KINDS = ("constant", "reachable", "dexterous")
 _CHUNK = 200_000
+#: voxels evaluated per x slab on the sampled method
+_SLAB = 1_000_000
+#: start of the note on a mechanism singular at its nominal pose
+SINGULAR_NOTE = "singular at the nominal pose"
+#: interval pieces kept per column (union of orientations, sampled runs)
+_K = 8
+
+
+def estimate_bytes(nx: int, ny: int, nz: int, M: int, columns: bool, dense: bool) -> float:
+    """Peak bytes of a workspace request on an ``nx × ny`` footprint, ``nz`` z samples and
+    ``M`` orientations: the ``(nx, ny, K)`` intervals with their working copies (lo, hi,
+    component labels, masks), an orientation mask ``(nx, ny, M)``, the sampled slab buffers
+    and, for z-dependent constraints on the column method (``dense``), the voxel field."""
+    cols = nx * ny
+    b = cols * _K * (2 * 8 * 3 + 8 + 8 + 1) + cols * M + cols * 64
+    if not columns:
+        b += 80 * _SLAB
+    if dense:
+        b += 4 * 4 * nx * ny * max(nz, 1)
+    return float(b)
 
 
 def workspace(mech, kind: str = "constant", orientations: OrientationSet | None = None,
@@ -79,6 +104,9 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
         cons = dataclasses.replace(cons, characteristic_length=length.length)
         notes.append(f"kappa_max: L = {length.length:.6g} mm ({length.status}): "
                      f"{length.reason}")
+    sing = _nominal_singularity(mech)
+    if sing:
+        notes.append(sing)
     oset = orientations or OrientationSet.fixed()
     if kind == "constant" and oset.kind != "fixed":
         raise ParameterError("orientations", "a single fixed orientation for kind 'constant'",
@@ -94,7 +122,14 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
                              "(it has no column kernel)", method)
 
     xs, ys, zb = _grid_xy(mech, R, mode, h)
+    nz = int(max(0.0, zb[1] - zb[0]) / h) + 1
+    need = estimate_bytes(len(xs), len(ys), nz, len(R), use_columns,
+                          use_columns and bool(cons.extra) and not mech.column_invariant)
+    require("resolution", need, "a grid whose arrays",
+            f"{h:g} mm ({len(xs)} × {len(ys)} columns, {len(R)} orientations)",
+            f"try >= {coarser_resolution(h, need):g} mm")
     timings = {}
+    sampled = False
     lo = hi = field = None
     p_nom = mech.nominal_pose[:3]
     if use_columns and len(xs) and len(ys):
@@ -131,15 +166,23 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
             zs = np.empty(0)
         else:
             zs = np.arange(math.ceil(zb[0] / h), math.floor(zb[1] / h) + 1) * h
-        field = _sampled_field(mech, xs, ys, zs, R, mode, cons, h)
+        lo, hi, overflow = _sampled_columns(mech, xs, ys, zs, R, mode, cons, h)
+        if overflow:
+            notes.append(f"{overflow} columns had more than {_K} separate runs of voxels; "
+                         "their sets are truncated")
+        sampled = not use_columns
+        zs = _z_axis(lo, hi, h)
         timings["sampled_s"] = time.perf_counter() - t
 
     if lo is not None:
-        n_comp, keep, nominal_inside = _piece_components(lo, hi, xs, ys, p_nom)
+        # sampled runs touch when 26-connected voxels do; exact pieces within h of each other
+        n_comp, keep, nominal_inside = _piece_components(lo, hi, xs, ys, p_nom,
+                                                         0.0 if sampled else None)
         if cons.connected and n_comp > 1:
             lo = np.where(keep, lo, np.inf)
             hi = np.where(keep, hi, -np.inf)
-            zs = _z_axis(lo, hi, h)
+        xs, ys, lo, hi = _crop(xs, ys, lo, hi)
+        zs = _z_axis(lo, hi, h)
     else:
         n_comp, keep, nominal_inside = _components(field >= 0, xs, ys, zs, p_nom, h)
         if cons.connected and n_comp > 1:
@@ -147,7 +190,9 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
     if cons.connected and n_comp > 1:
         notes.append(f"{n_comp} connected components; kept the one "
                      f"{'containing' if nominal_inside else 'nearest to'} the nominal position")
-    if lo is not None:
+    if sampled:
+        method_used = "sampled voxels"
+    elif lo is not None:
         method_used = f"columns ({mech.column_method}), exact in z"
     elif use_columns:
         method_used = "columns for the stroke, voxels for z-dependent constraints"
@@ -268,6 +313,71 @@ def _voxel_extras(mech, xs, ys, zs, R, mode, cons, field, h):
     return out
 
 
+def _nominal_singularity(mech) -> str | None:
+    """A note when the Jacobian is rank-deficient at the nominal pose (architecturally
+    singular designs: platform equal to the base, collinear joints), where the stroke-feasible
+    volume says nothing about what the mechanism can hold or control."""
+    from ..dexterity.metrics import is_singular
+
+    X = mech.nominal_pose
+    J = mech.jacobian(X)
+    if not bool(is_singular(J, mech.scale)[0]):
+        return None
+    return (f"{SINGULAR_NOTE} (the Jacobian is rank-deficient there): the mechanism cannot "
+            "resist or control every load and motion; the volume counts stroke only")
+
+
+def _crop(xs, ys, lo, hi):
+    """The columns that hold a piece, and their bounding footprint (the display field and the
+    stored arrays then cover the workspace, not the search box)."""
+    alive = np.any(lo <= hi, axis=-1)
+    if not alive.any():
+        return xs, ys, lo, hi
+    ix, iy = np.nonzero(alive.any(axis=1))[0], np.nonzero(alive.any(axis=0))[0]
+    sx, sy = slice(ix[0], ix[-1] + 1), slice(iy[0], iy[-1] + 1)
+    lo, hi = lo[sx, sy], hi[sx, sy]
+    # pieces first in each column (a dropped component may leave a hole in the slots)
+    order = np.argsort(~(lo <= hi), axis=-1, kind="stable")
+    used = max(1, int(np.max(np.sum(lo <= hi, axis=-1))))
+    order = order[..., :used]
+    return (xs[sx], ys[sy], np.ascontiguousarray(np.take_along_axis(lo, order, -1)),
+            np.ascontiguousarray(np.take_along_axis(hi, order, -1)))
+
+
+def _sampled_columns(mech, xs, ys, zs, R, mode, cons, h):
+    """The sampled voxel grid as column intervals, one x slab at a time: each run of inside
+    voxels ``k0..k1`` becomes ``[z_k0 - h/2, z_k1 + h/2]`` (its length is the voxel count)."""
+    nx, ny, nz = len(xs), len(ys), len(zs)
+    lo = np.full((nx, ny, _K), np.inf)
+    hi = np.full((nx, ny, _K), -np.inf)
+    overflow = 0
+    if nx * ny * nz == 0:
+        return lo, hi, overflow
+    per = max(1, _SLAB // (ny * nz))
+    for i0 in range(0, nx, per):
+        f = _sampled_field(mech, xs[i0:i0 + per], ys, zs, R, mode, cons, h)
+        overflow += _runs(f >= 0, zs, h, lo[i0:i0 + per], hi[i0:i0 + per])
+    return lo, hi, overflow
+
+
+def _runs(occ, zs, h, lo, hi) -> int:
+    """Write the runs of ``occ (n, ny, nz)`` along z into ``lo, hi (n, ny, K)``; returns the
+    number of columns with more than K runs."""
+    n, ny, nz = occ.shape
+    d = np.diff(np.pad(occ.reshape(n * ny, nz), ((0, 0), (1, 1))).astype(np.int8), axis=1)
+    c0, k0 = np.nonzero(d == 1)
+    _, k1 = np.nonzero(d == -1)               # end (exclusive), same order as the starts
+    if len(c0) == 0:
+        return 0
+    first = np.searchsorted(c0, c0, side="left")
+    rank = np.arange(len(c0)) - first
+    ok = rank < lo.shape[-1]
+    lo2, hi2 = lo.reshape(n * ny, -1), hi.reshape(n * ny, -1)
+    lo2[c0[ok], rank[ok]] = zs[k0[ok]] - 0.5 * h
+    hi2[c0[ok], rank[ok]] = zs[k1[ok] - 1] + 0.5 * h
+    return int(len(np.unique(c0[~ok])))
+
+
 def _sampled_field(mech, xs, ys, zs, R, mode, cons, h):
     """Actuator-stroke margin (mm) over the voxel grid, min (all) or max (any) over R."""
     shape = (len(xs), len(ys), len(zs))
@@ -301,10 +411,10 @@ def _sampled_field(mech, xs, ys, zs, R, mode, cons, h):
     return np.clip(f, -h, h).reshape(shape).astype(np.float32)
 
 
-def _piece_components(lo, hi, xs, ys, p_nom):
+def _piece_components(lo, hi, xs, ys, p_nom, tol=None):
     """Components of column pieces; keep mask ``(nx, ny, K)`` of the nominal one."""
     h = xs[1] - xs[0] if len(xs) > 1 else 1.0
-    labels, n = label_pieces(lo, hi, h)
+    labels, n = label_pieces(lo, hi, h if tol is None else tol)
     if n == 0:
         return 0, labels >= 0, False
     ix, iy, k = np.nonzero(labels >= 0)

@@ -65,6 +65,12 @@ class WorkspaceResult:
         """
         if self.voxel_field is not None:
             return self.voxel_field
+        from ..memory import coarser_resolution, require
+
+        need = 16.0 * len(self.xs) * len(self.ys) * len(self.zs)   # field, padding, meshing
+        require("resolution", need, "a display grid (slices, mesh) whose field would",
+                f"{self.resolution:g} mm ({len(self.xs)} × {len(self.ys)} × {len(self.zs)})",
+                f"try >= {coarser_resolution(self.resolution, need, 3.0):g} mm")
         return interval_field(self.xs, self.ys, self.zs, self.lo, self.hi, self.resolution)
 
     @cached_property
@@ -223,6 +229,17 @@ class WorkspaceResult:
         n = int(math.floor((zhi - zlo) / spacing)) + 1
         start = zlo + 0.5 * ((zhi - zlo) - (n - 1) * spacing)   # centre the stack
         return start + spacing * np.arange(n)
+
+    @cached_property
+    def mesh_problem(self) -> str | None:
+        """Why there is no boundary mesh (``None`` when there is one)."""
+        if self.empty:
+            return "the workspace is empty: there is no boundary to mesh"
+        if not bool(np.any(self.field > 0)):
+            return (f"the workspace is thinner than one grid cell ({self.resolution:g} mm): no "
+                    "grid point lies inside it, so there is no surface to mesh (use a finer "
+                    "resolution)")
+        return None
 
     # ---- exporters ---------------------------------------------------------------------------
     def save_npz(self, path) -> Path:
