@@ -43,9 +43,14 @@ def cli(capsys, *args, env: dict | None = None, monkeypatch=None) -> tuple[int, 
     return code, o, e
 
 
+def error_lines(err: str) -> list[str]:
+    """stderr without pkmlab's progress log lines (``pkmlab: …``), which are not errors."""
+    return [ln for ln in err.strip().splitlines() if not ln.startswith("pkmlab: ")]
+
+
 def one_line(code, err, *fragments):
     assert code == 2, (code, err)
-    lines = err.strip().splitlines()
+    lines = error_lines(err)
     assert len(lines) == 1 and lines[0].startswith("error: "), err
     assert "Traceback" not in err
     for f in fragments:
@@ -271,7 +276,7 @@ def test_damaged_store_is_diagnosed(capsys, finished, tmp_path, damage):
     for args in runs:
         code, _, err = cli(capsys, *args)
         assert code == 2, (args, err)
-        assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+        assert "Traceback" not in err and len(error_lines(err)) == 1, err
 
 
 def test_report_works_on_a_read_only_finished_folder(capsys, finished, tmp_path):
@@ -408,15 +413,26 @@ def test_ctrl_c_stops_the_run_cleanly_and_resume_finishes(tmp_path):
 
 
 def test_two_concurrent_runs_one_is_refused(tmp_path):
-    p, first = _start(tmp_path)
-    db = tmp_path / "out" / "evaluations.sqlite"
-    assert _wait_rows(db, 1)
-    second = subprocess.run([sys.executable, "-m", "pkmlab.cli", "run", str(p), "--resume"],
-                            capture_output=True, text=True, timeout=60)
-    first.send_signal(signal.SIGKILL)
-    first.wait()
-    assert second.returncode == 2, second.stderr
-    assert "in use by pid" in second.stderr and len(second.stderr.strip().splitlines()) == 1
+    """A run holds its folder for as long as it runs: a second run into it is refused."""
+    p = small_study(tmp_path, optimizer={"method": "sobol", "samples": 64})
+    out = tmp_path / "out"
+    holder = subprocess.Popen(      # the first run's lock, held without racing its evaluations
+        [sys.executable, "-c", "import time; from pkmlab.study.run import OutputLock; "
+         f"lock = OutputLock({str(out)!r}).__enter__(); print('held', flush=True); "
+         "time.sleep(60)"],
+        stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        for extra in ([], ["--resume"], ["--overwrite"]):
+            second = subprocess.run([sys.executable, "-m", "pkmlab.cli", "run", str(p), *extra],
+                                    capture_output=True, text=True, timeout=120)
+            assert second.returncode == 2, second.stderr
+            assert f"in use by pid {holder.pid}" in second.stderr
+            assert len(error_lines(second.stderr)) == 1, second.stderr
+    finally:
+        holder.kill()
+        holder.wait()
+    assert not (out / "evaluations.sqlite").exists()
 
 
 def test_mesh_in_slabs_is_the_same_watertight_mesh(monkeypatch):
