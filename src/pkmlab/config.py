@@ -25,7 +25,7 @@ from pydantic import (
 
 from . import limits
 from .errors import ParameterError, format_value, from_validation_error
-from .mechanisms import PSU6, UPS6, Luzi3, Mechanism
+from .mechanisms import PSU6, RSS6, UPS6, Luzi3, Mechanism
 from .units import ANGLE_UNITS, LENGTH_UNITS, parse_angle, parse_length
 from .yamlio import load_yaml, remember, where
 
@@ -220,6 +220,80 @@ class UPS6Spec(_Common):
                                  tool_offset=self.tool_offset, **self._kw())
 
 
+def _angle_window(v: Any) -> list[float]:
+    if not isinstance(v, list | tuple) or len(v) != 2:
+        raise _Invalid(f"must be [min, max], two servo angles (deg or with units); got "
+                       f"{format_value(v)}")
+    vals = [_angle(x) for x in v]
+    if vals[0] >= vals[1]:
+        raise _Invalid(f"must be [min, max] with min < max; got {format_value(v)}")
+    return vals
+
+
+def _directions(v: Any) -> list[list[float]]:
+    if (not isinstance(v, list | tuple) or len(v) != 6
+            or not all(isinstance(r, list | tuple) and len(r) == 3 for r in v)):
+        raise _Invalid(f"must be six [x, y, z] directions; got {format_value(v)}")
+    return [[float(x) for x in row] for row in v]
+
+
+def _branches(v: Any) -> list[float]:
+    vals = v if isinstance(v, list | tuple) else [v] * 6
+    if len(vals) != 6 or any(x not in (-1, 1) for x in vals):
+        raise _Invalid(f"must be -1 or +1, or a list of six of them; got {format_value(v)}")
+    return [float(x) for x in vals]
+
+
+AngleWindow = Annotated[list[float], BeforeValidator(_angle_window), _json_list(2)]
+Directions = Annotated[list[list[float]], BeforeValidator(_directions),
+                       _json_list(6, {"type": "array", "items": {"type": "number"}})]
+Branches = Annotated[list[float], BeforeValidator(_branches),
+                     WithJsonSchema({"anyOf": [{"enum": [-1, 1]},
+                                               {"type": "array", "items": {"enum": [-1, 1]}}]})]
+
+
+class ServoCircles(PairedCircles):
+    """Generator of the 6-RSS: servo pairs on the paired circles (see ``RSS6.from_circles``)."""
+
+    crank_plane: Literal["radial", "tangential"] = Field(
+        "radial", description="'radial': servo axes tangent to the base circle; 'tangential': "
+        "servo axes radial")
+    zero_direction: Literal["outward", "inward"] = Field(
+        "outward", description="crank zero direction (horizontal): radially out/in, or away "
+        "from / towards the pair partner")
+
+
+class RSS6Spec(_Common):
+    """6-RSS rotary-servo Stewart platform. ``stroke`` is the servo-angle range (deg)."""
+
+    family: Literal["rss6"]
+    generator: ServoCircles | None = None
+    stroke: AngleWindow = Field(description="servo-angle range [min, max] (deg or with units)")
+    crank_length: LinkLengths
+    rod_length: LinkLengths
+    servo_axes: Directions | None = None
+    zero_directions: Directions | None = None
+    branch: Branches = Field(default_factory=lambda: [-1.0] * 6)
+
+    def build(self) -> Mechanism:
+        if self._explicit("generator"):
+            if self.servo_axes is None or self.zero_directions is None:
+                raise ParameterError("servo_axes" if self.servo_axes is None
+                                     else "zero_directions",
+                                     "given with explicit base_points (or use a generator)",
+                                     None)
+            return RSS6(self.base_points, self.platform_points, self.servo_axes,
+                        self.zero_directions, self.crank_length, self.rod_length, self.stroke,
+                        self.branch, self.tool_offset, **self._kw())
+        if self.servo_axes is not None or self.zero_directions is not None:
+            raise ParameterError("servo_axes", "absent with a generator (it sets the axes)",
+                                 "given")
+        m = RSS6.from_circles(**self.generator.model_dump(), crank_length=self.crank_length,
+                              rod_length=self.rod_length, stroke=self.stroke,
+                              branch=self.branch, tool_offset=self.tool_offset, **self._kw())
+        return m
+
+
 class Luzi3Generator(_Model):
     base_diameter: PositiveLength
     phi: Angle = Field(description="angle between consecutive base points of different chains")
@@ -246,9 +320,11 @@ class Luzi3Spec(_Common):
                                 **self._kw())
 
 
-MechanismSpec = Annotated[PSU6Spec | UPS6Spec | Luzi3Spec, Field(discriminator="family")]
+MechanismSpec = Annotated[PSU6Spec | UPS6Spec | Luzi3Spec | RSS6Spec,
+                          Field(discriminator="family")]
 _ADAPTER = TypeAdapter(MechanismSpec)
-_GENERATOR_FIELDS = set(PairedCircles.model_fields) | set(Luzi3Generator.model_fields) | {"phi"}
+_GENERATOR_FIELDS = (set(ServoCircles.model_fields) | set(Luzi3Generator.model_fields)
+                     | {"phi"})
 
 
 def _translate(exc: ValidationError, prefix: str = "") -> ParameterError:
@@ -437,7 +513,7 @@ def load_workspace_study(source: str | Path):
     return spec, mech, {name: ws.build() for name, ws in spec.workspaces.items()}
 
 
-def mechanism_spec(data: dict, prefix: str = "") -> PSU6Spec | UPS6Spec | Luzi3Spec:
+def mechanism_spec(data: dict, prefix: str = ""):
     """Validate a mechanism mapping into its typed spec (no geometry checks yet)."""
     if not isinstance(data, dict):
         raise ParameterError(prefix or "(mechanism)", "a mapping of mechanism fields",
@@ -488,6 +564,7 @@ def _display_of(validator):
     table = {_length: _fmt_length, _positive_length: _fmt_length, _angle: _fmt_angle,
              _stroke: lambda v: [_fmt_length(x) for x in v],
              _angle_triple: lambda v: [_fmt_angle(x) for x in v],
+             _angle_window: lambda v: [_fmt_angle(x) for x in v],
              _points: lambda v: [[_fmt_length(x) for x in row] for row in v],
              _pose: lambda v: [_fmt_length(x) for x in v[:3]] + [_fmt_angle(x) for x in v[3:]],
              _auto_angle: lambda v: "auto" if v is None else _fmt_angle(v),
