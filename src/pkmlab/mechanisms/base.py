@@ -3,7 +3,8 @@
 Public protocol (what the rest of pkmlab uses; nothing outside :mod:`pkmlab.mechanisms` calls a
 method whose name starts with ``_``):
 
-* ``family``, ``actuator_names``, ``actuator_unit`` (``"mm"`` or ``"rad"``), ``name``, ``stroke``, ``actuator_limits``, ``scale``;
+* ``family``, ``actuator_names``, ``actuator_unit`` (``"mm"`` or ``"rad"``), ``name``,
+  ``stroke``, ``actuator_limits``, ``scale``;
 * ``base_points``, ``platform_points``, ``tool_offset`` and ``tool_points`` (mm);
 * ``nominal_pose`` — level, centred, mid-stroke unless given;
 * ``inverse(poses, stroke=None)`` and ``jacobian(poses)``: ``poses`` is ``(N, 6)`` Euler

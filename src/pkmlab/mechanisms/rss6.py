@@ -167,9 +167,10 @@ class RSS6(Mechanism):
                      base_pair_separation: float = math.radians(30.0),
                      platform_pair_separation: float = math.radians(20.0),
                      pairing: str = "same", crank_length=25.0, rod_length=150.0,
-                     stroke=(-math.radians(80.0), math.radians(80.0)),
+                     stroke=(-1.3962634015954636, 1.3962634015954636),
                      crank_plane: str = "radial", zero_direction: str = "outward",
-                     branch=-1.0, tool_offset=(0.0, 0.0, 0.0), name: str = "", nominal=None) -> RSS6:
+                     branch=-1.0, tool_offset=(0.0, 0.0, 0.0), name: str = "",
+                     nominal=None) -> RSS6:
         """Three servo pairs on circles (joint centres from :func:`.layout.build_paired`).
 
         ``crank_plane="radial"``: servo axes tangent to the base circle, the crank turns in the
@@ -178,7 +179,8 @@ class RSS6(Mechanism):
         common hobby layout), zero direction horizontal and tangent, pointing away from
         ("outward") or towards ("inward") the pair partner. In both, the axis is
         ``n = u × ẑ``, so that ``v = n × u = +ẑ``: a positive angle raises the crank end.
-        Lengths in mm, angles in rad; defaults are hobby-scale, not a specific machine.
+        Lengths in mm, angles in rad (default servo range ±80°); defaults are hobby-scale, not
+        a specific machine.
         """
         from .psu6 import _radii
 
