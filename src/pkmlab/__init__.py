@@ -2,13 +2,13 @@
 
 from .config import load_mechanism
 from .errors import NumericalError, ParameterError
-from .mechanisms import PSU6, REGISTRY, UPS6, Luzi3, Mechanism
+from .mechanisms import PSU6, REGISTRY, RSS6, UPS6, Luzi3, Mechanism
 from .workspaces import Constraints, JointLimits, OrientationSet, WorkspaceResult, workspace
 
 __version__ = "0.1.0"
 
 __all__ = ["load_mechanism", "load_study", "ParameterError", "NumericalError", "REGISTRY",
-           "Mechanism", "PSU6", "UPS6", "Luzi3", "workspace", "OrientationSet", "Constraints",
+           "Mechanism", "PSU6", "UPS6", "Luzi3", "RSS6", "workspace", "OrientationSet", "Constraints",
            "JointLimits", "WorkspaceResult", "open_results", "__version__"]
 
 
