@@ -8,8 +8,8 @@ from .workspaces import Constraints, JointLimits, OrientationSet, WorkspaceResul
 __version__ = "0.1.0"
 
 __all__ = ["load_mechanism", "load_study", "ParameterError", "NumericalError", "REGISTRY",
-           "Mechanism", "PSU6", "UPS6", "Luzi3", "RSS6", "workspace", "OrientationSet", "Constraints",
-           "JointLimits", "WorkspaceResult", "open_results", "__version__"]
+           "Mechanism", "PSU6", "UPS6", "Luzi3", "RSS6", "workspace", "OrientationSet",
+           "Constraints", "JointLimits", "WorkspaceResult", "open_results", "__version__"]
 
 
 def __getattr__(name: str):

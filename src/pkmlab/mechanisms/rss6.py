@@ -41,6 +41,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from numba.extending import register_jitable
 
 from ..errors import ParameterError
@@ -50,31 +51,98 @@ from .layout import build_paired
 
 __all__ = ["RSS6"]
 
-# g layout: B 0-17, tool points 18-35, u 36-53, v 54-71, crank 72-77, rod 78-83, branch 84-89.
+# atan2 that LLVM can vectorise: fdlibm's atan (s_atan.c, Sun Microsystems 1993; argument
+# reduction at 7/16 and 11/16 and an 11-term polynomial, < 1 ulp) on min/max of |x|, |y|, then
+# the octant fix-up, all by selects. The quotient adds 1 ulp: within ~3e-16 rad of math.atan2.
+_ATANHI0, _ATANHI1 = 4.63647609000806093515e-01, 7.85398163397448278999e-01
+_ATANLO0, _ATANLO1 = 2.26987774529616870924e-17, 3.06161699786838301793e-17
+_AT = (3.33333333333329318027e-01, -1.99999999998764832476e-01, 1.42857142725034663711e-01,
+       -1.11111104054623557880e-01, 9.09088713343650656196e-02, -7.69187620504482999495e-02,
+       6.66107313738753120669e-02, -5.83357013379057348645e-02, 4.97687799461593236017e-02,
+       -3.65315727442169155270e-02, 1.62858201153657823623e-02)
+_AT0, _AT1, _AT2, _AT3, _AT4, _AT5, _AT6, _AT7, _AT8, _AT9, _AT10 = _AT
+_PIO2_HI, _PIO2_LO = 1.57079632679489655800e+00, 6.12323399573676603587e-17
+_PI_HI, _PI_LO = 3.1415926535897931160e+00, 1.2246467991473531772e-16
+
+
+@njit(cache=True, inline="always")
+def _atan2(y, x):
+    """``atan2(y, x)`` in (-π, π], branch-free (0 for x = y = 0)."""
+    ax, ay = abs(x), abs(y)
+    mx = ax if ax > ay else ay
+    mn = ay if ax > ay else ax
+    t = mn / mx if mx > 0.0 else 0.0                 # in [0, 1]
+    c0 = t < 0.4375
+    c1 = t < 0.6875
+    num = t if c0 else (2.0 * t - 1.0 if c1 else t - 1.0)
+    den = 1.0 if c0 else (2.0 + t if c1 else t + 1.0)
+    hi = 0.0 if c0 else (_ATANHI0 if c1 else _ATANHI1)
+    lo = 0.0 if c0 else (_ATANLO0 if c1 else _ATANLO1)
+    xr = num / den
+    z = xr * xr
+    w = z * z
+    s1 = z * (_AT0 + w * (_AT2 + w * (_AT4 + w * (_AT6 + w * (_AT8 + w * _AT10)))))
+    s2 = w * (_AT1 + w * (_AT3 + w * (_AT5 + w * (_AT7 + w * _AT9))))
+    r = hi - ((xr * (s1 + s2) - lo) - xr)            # atan(t) in [0, π/4]
+    r = (_PIO2_HI - (r - _PIO2_LO)) if ay > ax else r
+    r = (_PI_HI - (r - _PI_LO)) if x < 0.0 else r
+    return -r if y < 0.0 else r
+
+
+# g layout: B 0-17, tool points 18-35, 2a·u 36-53, 2a·v 54-71, a² - s² 72-77, degenerate
+# threshold 1e-24·a⁴ on ρ² 78-83, branch 84-89.
+
+
+@njit(cache=True, inline="always")
+def _rss_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, bx, by, bz, tx, ty, tz,
+             ux, uy, uz, vx, vy, vz, c, eps, b, qmin, qmax):
+    """One leg: ``(α, status)``, α NaN where there is no real solution. ``u``, ``v`` come
+    scaled by 2a, ``c = a² - s²`` and ``eps`` is the degenerate threshold on ρ²."""
+    wx = px + r00 * tx + r01 * ty + r02 * tz - bx
+    wy = py + r10 * tx + r11 * ty + r12 * tz - by
+    wz = pz + r20 * tx + r21 * ty + r22 * tz - bz
+    e = wx * ux + wy * uy + wz * uz
+    f = wx * vx + wy * vy + wz * vz
+    gg = wx * wx + wy * wy + wz * wz + c
+    rho2 = e * e + f * f
+    h2 = rho2 - gg * gg
+    real = h2 >= 0.0
+    h = math.sqrt(h2 if real else 0.0)
+    v = _atan2(f * gg + b * e * h, e * gg - b * f * h)
+    degenerate = rho2 <= eps
+    st = (_kernels.DEGENERATE if degenerate else
+          (_kernels.stroke_status(v, qmin, qmax) if real else _kernels.NO_SOLUTION))
+    return (v if real and not degenerate else np.nan), st
 
 
 @register_jitable(inline="always")
 def _rss_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st, j):
-    """Per-pose inverse kinematics (see :mod:`._kernels`): the crank angle of each leg."""
-    for i in range(6):
-        ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
-        wx = px + r00 * ux + r01 * uy + r02 * uz - g[3 * i]
-        wy = py + r10 * ux + r11 * uy + r12 * uz - g[3 * i + 1]
-        wz = pz + r20 * ux + r21 * uy + r22 * uz - g[3 * i + 2]
-        a, s, b = g[72 + i], g[78 + i], g[84 + i]
-        e = 2.0 * a * (wx * g[36 + 3 * i] + wy * g[37 + 3 * i] + wz * g[38 + 3 * i])
-        f = 2.0 * a * (wx * g[54 + 3 * i] + wy * g[55 + 3 * i] + wz * g[56 + 3 * i])
-        gg = wx * wx + wy * wy + wz * wz + a * a - s * s
-        rho2 = e * e + f * f
-        h2 = rho2 - gg * gg
-        real = h2 >= 0.0
-        h = math.sqrt(h2 if real else 0.0)
-        v = math.atan2(f * gg + b * e * h, e * gg - b * f * h)
-        degenerate = rho2 <= 1e-24 * (a * a) * (a * a)
-        k = i * _kernels.ROW + j
-        q[k] = v if real and not degenerate else np.nan
-        st[k] = (_kernels.DEGENERATE if degenerate else
-                 (_kernels.stroke_status(v, qmin, qmax) if real else _kernels.NO_SOLUTION))
+    """Per-pose inverse kinematics (see :mod:`._kernels`): the crank angle of each leg, the
+    loop over legs unrolled by hand so that ``g`` is indexed by constants."""
+    v, c = _rss_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22,
+                    g[0], g[1], g[2], g[18], g[19], g[20], g[36], g[37], g[38],
+                    g[54], g[55], g[56], g[72], g[78], g[84], qmin, qmax)
+    q[j], st[j] = v, c
+    v, c = _rss_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22,
+                    g[3], g[4], g[5], g[21], g[22], g[23], g[39], g[40], g[41],
+                    g[57], g[58], g[59], g[73], g[79], g[85], qmin, qmax)
+    q[_kernels.ROW + j], st[_kernels.ROW + j] = v, c
+    v, c = _rss_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22,
+                    g[6], g[7], g[8], g[24], g[25], g[26], g[42], g[43], g[44],
+                    g[60], g[61], g[62], g[74], g[80], g[86], qmin, qmax)
+    q[2 * _kernels.ROW + j], st[2 * _kernels.ROW + j] = v, c
+    v, c = _rss_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22,
+                    g[9], g[10], g[11], g[27], g[28], g[29], g[45], g[46],
+                    g[47], g[63], g[64], g[65], g[75], g[81], g[87], qmin, qmax)
+    q[3 * _kernels.ROW + j], st[3 * _kernels.ROW + j] = v, c
+    v, c = _rss_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22,
+                    g[12], g[13], g[14], g[30], g[31], g[32], g[48], g[49],
+                    g[50], g[66], g[67], g[68], g[76], g[82], g[88], qmin, qmax)
+    q[4 * _kernels.ROW + j], st[4 * _kernels.ROW + j] = v, c
+    v, c = _rss_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22,
+                    g[15], g[16], g[17], g[33], g[34], g[35], g[51], g[52],
+                    g[53], g[69], g[70], g[71], g[77], g[83], g[89], qmin, qmax)
+    q[5 * _kernels.ROW + j], st[5 * _kernels.ROW + j] = v, c
 
 
 def _unit_rows(value, field: str) -> np.ndarray:
@@ -220,9 +288,12 @@ class RSS6(Mechanism):
                      + np.max(self.crank_length) + np.max(self.rod_length))
 
     def _gparams(self) -> np.ndarray:
+        a2 = 2.0 * self.crank_length[:, None]
         return np.concatenate([self.base_points.ravel(), self.tool_points.ravel(),
-                               self.zero_directions.ravel(), self.v_directions.ravel(),
-                               self.crank_length, self.rod_length, self.branch])
+                               (a2 * self.zero_directions).ravel(),
+                               (a2 * self.v_directions).ravel(),
+                               self.crank_length**2 - self.rod_length**2,
+                               1e-24 * self.crank_length**4, self.branch])
 
     def crank_ends(self, q: np.ndarray) -> np.ndarray:
         """Crank end points C_i ``(N, 6, 3)`` (mm, base frame) for servo angles ``q (N, 6)``."""

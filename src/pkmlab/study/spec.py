@@ -49,6 +49,13 @@ _PAIRED = {
 DESIGN_ALIASES: dict[str, dict[str, tuple[str, str]]] = {
     "psu6": {**_PAIRED, "link_length": ("link_length", "length")},
     "ups6": dict(_PAIRED),
+    "rss6": {**{k: v for k, v in _PAIRED.items() if not k.startswith("stroke")},
+             "crank_length": ("crank_length", "length"),
+             "rod_length": ("rod_length", "length"),
+             "servo_min": ("stroke[0]", "angle"),
+             "servo_max": ("stroke[1]", "angle"),
+             "crank_plane": ("generator.crank_plane", "text"),
+             "zero_direction": ("generator.zero_direction", "text")},
     "luzi3": {"base_diameter": ("generator.base_diameter", "length"),
               "platform_diameter": ("generator.platform_diameter", "length"),
               "phi": ("generator.phi", "angle"),
