@@ -7,6 +7,10 @@ from .workspaces import Constraints, JointLimits, OrientationSet, WorkspaceResul
 
 __version__ = "0.1.0"
 
+from .mechanisms import load_plugins as _load_plugins  # noqa: E402
+
+_load_plugins()     # family plugins (entry points "pkmlab.families"), now that pkmlab is whole
+
 __all__ = ["load_mechanism", "load_study", "ParameterError", "NumericalError", "REGISTRY",
            "Mechanism", "PSU6", "UPS6", "Luzi3", "RSS6", "workspace", "OrientationSet",
            "Constraints", "JointLimits", "WorkspaceResult", "open_results", "__version__"]

@@ -29,7 +29,8 @@ from .mechanisms import PSU6, RSS6, UPS6, Luzi3, Mechanism
 from .units import ANGLE_UNITS, LENGTH_UNITS, parse_angle, parse_length
 from .yamlio import load_yaml, remember, where
 
-__all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec", "workspace_spec", "WorkspaceSpec",
+__all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec", "FamilySpec", "mechanism_specs",
+           "workspace_spec", "WorkspaceSpec",
            "load_workspace_study", "WorkspaceStudySpec", "to_display", "read_yaml",
            "validate_model"]
 
@@ -195,6 +196,16 @@ class _Common(_Model):
         return {"name": self.name, "nominal": nominal}
 
 
+class FamilySpec(_Common):
+    """Base of a plugin family's YAML model: ``name``, ``source``, ``stroke`` (mm),
+    ``tool_offset``, ``nominal_pose``, ``base_points``, ``platform_points`` — declare
+    ``family: Literal["<name>"]``, the family's own fields and ``build()``."""
+
+    def explicit_kw(self) -> dict:
+        """``name`` and ``nominal`` keyword arguments of the mechanism constructor."""
+        return self._kw()
+
+
 class PSU6Spec(_Common):
     family: Literal["psu6"]
     generator: PairedCircles | None = None
@@ -322,14 +333,37 @@ class Luzi3Spec(_Common):
 
 MechanismSpec = Annotated[PSU6Spec | UPS6Spec | Luzi3Spec | RSS6Spec,
                           Field(discriminator="family")]
-_ADAPTER = TypeAdapter(MechanismSpec)
+_BUILTIN_SPECS = (PSU6Spec, UPS6Spec, Luzi3Spec, RSS6Spec)
+_ADAPTERS: dict[tuple, tuple[Any, TypeAdapter]] = {}
+
+
+def mechanism_specs() -> tuple[type[BaseModel], ...]:
+    """The YAML models of every registered family: built-ins, then plugins' ``spec_model``."""
+    from .mechanisms import REGISTRY, load_plugins
+
+    load_plugins()
+    plugins = tuple(cls.spec_model for name, cls in REGISTRY.items()
+                    if getattr(cls, "spec_model", None) is not None
+                    and cls.spec_model not in _BUILTIN_SPECS)
+    return _BUILTIN_SPECS + plugins
+
+
+def _mechanism_adapter() -> tuple[Any, TypeAdapter]:
+    """``(union annotation, TypeAdapter)`` over :func:`mechanism_specs`, cached per set."""
+    specs = mechanism_specs()
+    if specs not in _ADAPTERS:
+        union = MechanismSpec if specs == _BUILTIN_SPECS else \
+            Annotated[typing.Union[specs], Field(discriminator="family")]  # noqa: UP007
+        _ADAPTERS[specs] = (union, TypeAdapter(union))
+    return _ADAPTERS[specs]
 _GENERATOR_FIELDS = (set(ServoCircles.model_fields) | set(Luzi3Generator.model_fields)
                      | {"phi"})
 
 
 def _translate(exc: ValidationError, prefix: str = "") -> ParameterError:
     """Pydantic's errors → ``<field> (<file>, line, column): must be …; got …``."""
-    root = globals().get(exc.title, MechanismSpec)  # a model's name, or the mechanism union
+    # a model's name, or the mechanism union
+    root = globals().get(exc.title) or _mechanism_adapter()[0]
     return from_validation_error(exc, root, prefix, where)
 
 
@@ -519,7 +553,7 @@ def mechanism_spec(data: dict, prefix: str = ""):
         raise ParameterError(prefix or "(mechanism)", "a mapping of mechanism fields",
                              type(data).__name__)
     try:
-        return _ADAPTER.validate_python(data)
+        return _mechanism_adapter()[1].validate_python(data)
     except ValidationError as exc:
         raise _translate(exc, prefix) from None
 

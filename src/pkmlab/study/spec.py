@@ -65,6 +65,15 @@ DESIGN_ALIASES: dict[str, dict[str, tuple[str, str]]] = {
 }
 
 
+def family_aliases(family: str) -> dict[str, tuple[str, str]]:
+    """Named design variables of a family: built-in, or a plugin class's ``design_aliases``."""
+    if family in DESIGN_ALIASES:
+        return DESIGN_ALIASES[family]
+    from ..mechanisms import REGISTRY
+
+    return dict(getattr(REGISTRY.get(family), "design_aliases", None) or {})
+
+
 class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
@@ -177,7 +186,7 @@ def _merge(base: dict, over: dict) -> dict:
 
 
 def _target(name: str, where: str, path: str | None, family: str, spec) -> tuple | None:
-    alias = DESIGN_ALIASES[family].get(name)
+    alias = family_aliases(family).get(name)
     text = path or (alias[0] if alias else None)
     if text is None:
         return None
@@ -194,7 +203,7 @@ def _target(name: str, where: str, path: str | None, family: str, spec) -> tuple
 
 def _variable(name: str, v: DesignVariableSpec, family: str, spec) -> Variable:
     field = f"design.{name}"
-    alias = DESIGN_ALIASES[family].get(name)
+    alias = family_aliases(family).get(name)
     target = _target(name, f"{field}.path", v.path, family, spec)
     quantity = v.quantity or (alias[1] if alias else None)
     if target is None and alias is None and v.path is None and quantity not in (None,
@@ -202,7 +211,7 @@ def _variable(name: str, v: DesignVariableSpec, family: str, spec) -> Variable:
         raise ParameterError(f"{field}.path", "given for a non-number variable", None)
     if target is None and quantity is None:
         raise ParameterError(field, f"a known variable of family {family!r} "
-                             f"{sorted(DESIGN_ALIASES[family])}, one with 'path' and "
+                             f"{sorted(family_aliases(family))}, one with 'path' and "
                              "'quantity', or a free parameter with 'quantity: number'", name)
     if quantity is None:
         raise ParameterError(f"{field}.quantity", "one of ['length', 'angle', 'number', "
@@ -314,7 +323,7 @@ def study_from_mapping(data: Any, base: Path | None = None,
         where = f"derived.{key}"
         if key in names:
             raise ParameterError(where, "a field no design variable sets", key)
-        target = _target(key, where, None if key in DESIGN_ALIASES[family] else key, family,
+        target = _target(key, where, None if key in family_aliases(family) else key, family,
                          mech_spec)
         derived.append(Derived(key, target, Expression.parse(text, where, names)))
     written = [v.target for v in variables if v.target is not None] + \
