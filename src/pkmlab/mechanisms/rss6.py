@@ -48,6 +48,7 @@ from ..errors import ParameterError
 from . import _kernels
 from .base import NO_STROKE, Mechanism, as_points, as_positive, as_vector3
 from .layout import build_paired
+from .psu6 import _radii
 
 __all__ = ["RSS6"]
 
@@ -250,8 +251,6 @@ class RSS6(Mechanism):
         Lengths in mm, angles in rad (default servo range ±80°); defaults are hobby-scale, not
         a specific machine.
         """
-        from .psu6 import _radii
-
         if crank_plane not in ("radial", "tangential"):
             raise ParameterError("crank_plane", "one of ['radial', 'tangential']", crank_plane)
         if zero_direction not in ("outward", "inward"):
