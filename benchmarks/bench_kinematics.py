@@ -1,6 +1,7 @@
 """IK throughput (poses/s) on 10⁶ random poses per family, and FK solves/s.
 
-Run: .venv/bin/python benchmarks/bench_kinematics.py   (targets: 6-PSU, 6-UPS IK ≥ 20 M/s)
+Run: .venv/bin/python benchmarks/bench_kinematics.py   (targets: 6-PSU, 6-UPS IK ≥ 20 M/s;
+6-RSS ≥ 15 M/s). ``python benchmarks/bench_kinematics.py rss6`` runs one family.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import pkmlab
 
 ROOT = Path(__file__).resolve().parents[1]
 FILES = {"psu6": "hopkins-williams-6psu.yaml", "ups6": "gough-stewart-6ups.yaml",
-         "luzi3": "luzi-3chain.yaml"}
+         "luzi3": "luzi-3chain.yaml", "rss6": "instructables-servo-6rss.yaml"}
 N_IK, N_FK = 1_000_000, 2_000
 
 
@@ -28,10 +29,12 @@ def best_of(fn, repeat: int = 7) -> float:
     return min(times)
 
 
-def main() -> None:
+def main(only: list[str] | None = None) -> None:
     print(f"numba threads: {numba.get_num_threads()}, poses per IK batch: {N_IK:,}")
     rng = np.random.default_rng(0)
     for family, fname in FILES.items():
+        if only and family not in only:
+            continue
         mech = pkmlab.load_mechanism(ROOT / "studies" / "mechanisms" / fname)
         X = mech.nominal_pose + np.concatenate(
             [rng.uniform(-40, 40, (N_IK, 3)), np.radians(rng.uniform(-15, 15, (N_IK, 3)))],
@@ -49,4 +52,6 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    import sys
+
+    main(sys.argv[1:] or None)

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 import pkmlab
 from pkmlab.mechanisms import REGISTRY, Luzi3
+from pkmlab.testing import random_valid_poses  # noqa: F401 (used by the test modules)
 
 ROOT = Path(__file__).resolve().parents[1]
 MECH_DIR = ROOT / "studies" / "mechanisms"
@@ -32,18 +32,6 @@ assert {m.family for m in MECHANISMS.values()} == set(REGISTRY), "a family has n
 @pytest.fixture(params=sorted(MECHANISMS), ids=sorted(MECHANISMS))
 def mech(request):
     return MECHANISMS[request.param]
-
-
-def random_valid_poses(mech, n: int, seed: int, lin: float = 25.0, ang_deg: float = 10.0):
-    """``n`` poses near the nominal pose whose inverse kinematics is valid."""
-    rng = np.random.default_rng(seed)
-    out = []
-    while sum(len(o) for o in out) < n:
-        X = mech.nominal_pose + np.concatenate(
-            [rng.uniform(-lin, lin, (4 * n, 3)),
-             np.radians(rng.uniform(-ang_deg, ang_deg, (4 * n, 3)))], axis=1)
-        out.append(X[mech.inverse(X).valid])
-    return np.concatenate(out)[:n]
 
 
 # ---- one tiny study run through the CLI, shared by the report tests ---------------------------

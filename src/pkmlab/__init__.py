@@ -2,14 +2,18 @@
 
 from .config import load_mechanism
 from .errors import NumericalError, ParameterError
-from .mechanisms import PSU6, REGISTRY, UPS6, Luzi3, Mechanism
+from .mechanisms import PSU6, REGISTRY, RSS6, UPS6, Luzi3, Mechanism
 from .workspaces import Constraints, JointLimits, OrientationSet, WorkspaceResult, workspace
 
 __version__ = "0.1.0"
 
+from .mechanisms import load_plugins as _load_plugins  # noqa: E402
+
+_load_plugins()     # family plugins (entry points "pkmlab.families"), now that pkmlab is whole
+
 __all__ = ["load_mechanism", "load_study", "ParameterError", "NumericalError", "REGISTRY",
-           "Mechanism", "PSU6", "UPS6", "Luzi3", "workspace", "OrientationSet", "Constraints",
-           "JointLimits", "WorkspaceResult", "open_results", "__version__"]
+           "Mechanism", "PSU6", "UPS6", "Luzi3", "RSS6", "workspace", "OrientationSet",
+           "Constraints", "JointLimits", "WorkspaceResult", "open_results", "__version__"]
 
 
 def __getattr__(name: str):

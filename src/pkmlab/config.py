@@ -25,133 +25,44 @@ from pydantic import (
 
 from . import limits
 from .errors import ParameterError, format_value, from_validation_error
-from .mechanisms import PSU6, UPS6, Luzi3, Mechanism
-from .units import ANGLE_UNITS, LENGTH_UNITS, parse_angle, parse_length
+from .mechanisms import PSU6, RSS6, UPS6, Luzi3, Mechanism
+from .quantities import (  # noqa: F401 (re-exported for plugins' spec models)
+    _NUMBER_OR_UNIT,
+    Angle,
+    AngleWindow,
+    AutoAngle,
+    AutoLength,
+    Branches,
+    Directions,
+    LinkLengths,
+    Points,
+    Pose,
+    PositiveLength,
+    Radii,
+    Stroke,
+    Vector3,
+    _angle,
+    _angle_window,
+    _auto_angle,
+    _auto_positive_length,
+    _Invalid,
+    _json_list,
+    _length,
+    _length_list,
+    _link_lengths,
+    _points,
+    _pose,
+    _positive_length,
+    _Shown,
+    _stroke,
+)
+from .units import ANGLE_UNITS, LENGTH_UNITS
 from .yamlio import load_yaml, remember, where
 
-__all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec", "workspace_spec", "WorkspaceSpec",
+__all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec", "FamilySpec", "mechanism_specs",
+           "workspace_spec", "WorkspaceSpec",
            "load_workspace_study", "WorkspaceStudySpec", "to_display", "read_yaml",
            "validate_model"]
-
-
-class _Shown(str):
-    """A value already rendered for an error message (not quoted again)."""
-
-    def __repr__(self) -> str:
-        return str(self)
-
-
-class _Invalid(ValueError):
-    """Raised inside validators; the loader prefixes the field path."""
-
-
-def _checked(parse, *args):
-    try:
-        return parse(*args)
-    except ParameterError as exc:
-        raise _Invalid(f"must be {exc.allowed}; got {format_value(exc.got)}") from None
-
-
-def _length(v: Any) -> float:
-    return _checked(parse_length, v, "")
-
-
-def _angle(v: Any) -> float:
-    return _checked(parse_angle, v, "")
-
-
-def _length_list(n: int | None):
-    def parse(v: Any) -> list[float]:
-        if not isinstance(v, list | tuple) or (n is not None and len(v) != n):
-            what = f"a list of {n} lengths" if n else "a list of lengths"
-            raise _Invalid(f"must be {what} (mm or with units); got {format_value(v)}")
-        return [_length(x) for x in v]
-    return parse
-
-
-def _points(v: Any) -> list[list[float]]:
-    if not isinstance(v, list | tuple) or not all(isinstance(r, list | tuple) for r in v):
-        raise _Invalid(f"must be a list of [x, y, z] points (mm); got {format_value(v)}")
-    rows = []
-    for row in v:
-        if len(row) != 3:
-            raise _Invalid(f"must be a list of [x, y, z] points (mm); got the point "
-                           f"{format_value(row)}")
-        rows.append([_length(x) for x in row])
-    return rows
-
-
-def _pose(v: Any) -> list[float]:
-    if not isinstance(v, list | tuple) or len(v) != 6:
-        raise _Invalid("must be [x, y, z, θx, θy, θz] (lengths in mm, angles in deg or with "
-                       f"units); got {format_value(v)}")
-    return [_length(x) for x in v[:3]] + [_angle(x) for x in v[3:]]
-
-
-def _stroke(v: Any) -> list[float]:
-    vals = _length_list(2)(v)
-    if vals[0] >= vals[1]:
-        raise _Invalid(f"must be [min, max] with min < max; got {format_value(v)}")
-    return vals
-
-
-def _positive_length(v: Any) -> float:
-    x = _length(v)
-    if x <= 0:
-        raise _Invalid(f"must be a length > 0 mm; got {format_value(v)}")
-    return x
-
-
-def _link_lengths(v: Any) -> float | list[float]:
-    if isinstance(v, list | tuple):
-        vals = _length_list(6)(v)
-        if min(vals) <= 0:
-            raise _Invalid(f"must be lengths > 0 mm; got {format_value(v)}")
-        return vals
-    return _positive_length(v)
-
-
-def _auto_angle(v: Any) -> float | None:
-    return None if v == "auto" else _angle(v)
-
-
-def _auto_positive_length(v: Any) -> float | None:
-    return None if v in ("auto", None) else _positive_length(v)
-
-
-# JSON Schema of the quantity types: a bare number (in the documented unit) or a string with
-# its unit, so that editors accept what the loader accepts.
-_NUMBER_OR_UNIT = {"anyOf": [{"type": "number"}, {"type": "string"}]}
-
-
-def _json_list(n: int | None, item: dict = _NUMBER_OR_UNIT) -> WithJsonSchema:
-    schema: dict = {"type": "array", "items": item}
-    if n is not None:
-        schema.update(minItems=n, maxItems=n)
-    return WithJsonSchema(schema)
-
-
-_LENGTH_JSON = WithJsonSchema({**_NUMBER_OR_UNIT, "description": "mm, or a string with units "
-                               "('225 mm', '4 in')"})
-_ANGLE_JSON = WithJsonSchema({**_NUMBER_OR_UNIT, "description": "deg, or a string with units "
-                              "('33.7 deg', '0.5 rad')"})
-
-Length = Annotated[float, BeforeValidator(_length), _LENGTH_JSON]
-PositiveLength = Annotated[float, BeforeValidator(_positive_length), _LENGTH_JSON]
-Angle = Annotated[float, BeforeValidator(_angle), _ANGLE_JSON]
-AutoAngle = Annotated[float | None, BeforeValidator(_auto_angle), _ANGLE_JSON]
-AutoLength = Annotated[float | None, BeforeValidator(_auto_positive_length),
-                       WithJsonSchema({**_NUMBER_OR_UNIT,
-                                       "description": "'auto', mm, or a string with units"})]
-Radii = Annotated[list[float], BeforeValidator(_length_list(2)), _json_list(2)]
-Stroke = Annotated[list[float], BeforeValidator(_stroke), _json_list(2)]
-Points = Annotated[list[list[float]], BeforeValidator(_points),
-                   _json_list(None, {"type": "array", "items": _NUMBER_OR_UNIT})]
-Vector3 = Annotated[list[float], BeforeValidator(_length_list(3)), _json_list(3)]
-Pose = Annotated[list[float], BeforeValidator(_pose), _json_list(6)]
-LinkLengths = Annotated[float | list[float], BeforeValidator(_link_lengths),
-                        WithJsonSchema({"anyOf": [_NUMBER_OR_UNIT,
-                                                  {"type": "array", "items": _NUMBER_OR_UNIT}]})]
 
 
 class _Model(BaseModel):
@@ -195,6 +106,16 @@ class _Common(_Model):
         return {"name": self.name, "nominal": nominal}
 
 
+class FamilySpec(_Common):
+    """Base of a plugin family's YAML model: ``name``, ``source``, ``stroke`` (mm),
+    ``tool_offset``, ``nominal_pose``, ``base_points``, ``platform_points`` — declare
+    ``family: Literal["<name>"]``, the family's own fields and ``build()``."""
+
+    def explicit_kw(self) -> dict:
+        """``name`` and ``nominal`` keyword arguments of the mechanism constructor."""
+        return self._kw()
+
+
 class PSU6Spec(_Common):
     family: Literal["psu6"]
     generator: PairedCircles | None = None
@@ -218,6 +139,48 @@ class UPS6Spec(_Common):
                         **self._kw())
         return UPS6.from_circles(**self.generator.model_dump(), stroke=self.stroke,
                                  tool_offset=self.tool_offset, **self._kw())
+
+
+class ServoCircles(PairedCircles):
+    """Generator of the 6-RSS: servo pairs on the paired circles (see ``RSS6.from_circles``)."""
+
+    crank_plane: Literal["radial", "tangential"] = Field(
+        "radial", description="'radial': servo axes tangent to the base circle; 'tangential': "
+        "servo axes radial")
+    zero_direction: Literal["outward", "inward"] = Field(
+        "outward", description="crank zero direction (horizontal): radially out/in, or away "
+        "from / towards the pair partner")
+
+
+class RSS6Spec(_Common):
+    """6-RSS rotary-servo Stewart platform. ``stroke`` is the servo-angle range (deg)."""
+
+    family: Literal["rss6"]
+    generator: ServoCircles | None = None
+    stroke: AngleWindow = Field(description="servo-angle range [min, max] (deg or with units)")
+    crank_length: LinkLengths
+    rod_length: LinkLengths
+    servo_axes: Directions | None = None
+    zero_directions: Directions | None = None
+    branch: Branches = Field(default_factory=lambda: [-1.0] * 6)
+
+    def build(self) -> Mechanism:
+        if self._explicit("generator"):
+            if self.servo_axes is None or self.zero_directions is None:
+                raise ParameterError("servo_axes" if self.servo_axes is None
+                                     else "zero_directions",
+                                     "given with explicit base_points (or use a generator)",
+                                     None)
+            return RSS6(self.base_points, self.platform_points, self.servo_axes,
+                        self.zero_directions, self.crank_length, self.rod_length, self.stroke,
+                        self.branch, self.tool_offset, **self._kw())
+        if self.servo_axes is not None or self.zero_directions is not None:
+            raise ParameterError("servo_axes", "absent with a generator (it sets the axes)",
+                                 "given")
+        m = RSS6.from_circles(**self.generator.model_dump(), crank_length=self.crank_length,
+                              rod_length=self.rod_length, stroke=self.stroke,
+                              branch=self.branch, tool_offset=self.tool_offset, **self._kw())
+        return m
 
 
 class Luzi3Generator(_Model):
@@ -246,14 +209,39 @@ class Luzi3Spec(_Common):
                                 **self._kw())
 
 
-MechanismSpec = Annotated[PSU6Spec | UPS6Spec | Luzi3Spec, Field(discriminator="family")]
-_ADAPTER = TypeAdapter(MechanismSpec)
-_GENERATOR_FIELDS = set(PairedCircles.model_fields) | set(Luzi3Generator.model_fields) | {"phi"}
+MechanismSpec = Annotated[PSU6Spec | UPS6Spec | Luzi3Spec | RSS6Spec,
+                          Field(discriminator="family")]
+_BUILTIN_SPECS = (PSU6Spec, UPS6Spec, Luzi3Spec, RSS6Spec)
+_ADAPTERS: dict[tuple, tuple[Any, TypeAdapter]] = {}
+
+
+def mechanism_specs() -> tuple[type[BaseModel], ...]:
+    """The YAML models of every registered family: built-ins, then plugins' ``spec_model``."""
+    from .mechanisms import REGISTRY, load_plugins
+
+    load_plugins()
+    plugins = tuple(cls.spec_model for name, cls in REGISTRY.items()
+                    if getattr(cls, "spec_model", None) is not None
+                    and cls.spec_model not in _BUILTIN_SPECS)
+    return _BUILTIN_SPECS + plugins
+
+
+def _mechanism_adapter() -> tuple[Any, TypeAdapter]:
+    """``(union annotation, TypeAdapter)`` over :func:`mechanism_specs`, cached per set."""
+    specs = mechanism_specs()
+    if specs not in _ADAPTERS:
+        union = MechanismSpec if specs == _BUILTIN_SPECS else \
+            Annotated[typing.Union[specs], Field(discriminator="family")]  # noqa: UP007
+        _ADAPTERS[specs] = (union, TypeAdapter(union))
+    return _ADAPTERS[specs]
+_GENERATOR_FIELDS = (set(ServoCircles.model_fields) | set(Luzi3Generator.model_fields)
+                     | {"phi"})
 
 
 def _translate(exc: ValidationError, prefix: str = "") -> ParameterError:
     """Pydantic's errors → ``<field> (<file>, line, column): must be …; got …``."""
-    root = globals().get(exc.title, MechanismSpec)  # a model's name, or the mechanism union
+    # a model's name, or the mechanism union
+    root = globals().get(exc.title) or _mechanism_adapter()[0]
     return from_validation_error(exc, root, prefix, where)
 
 
@@ -437,13 +425,13 @@ def load_workspace_study(source: str | Path):
     return spec, mech, {name: ws.build() for name, ws in spec.workspaces.items()}
 
 
-def mechanism_spec(data: dict, prefix: str = "") -> PSU6Spec | UPS6Spec | Luzi3Spec:
+def mechanism_spec(data: dict, prefix: str = ""):
     """Validate a mechanism mapping into its typed spec (no geometry checks yet)."""
     if not isinstance(data, dict):
         raise ParameterError(prefix or "(mechanism)", "a mapping of mechanism fields",
                              type(data).__name__)
     try:
-        return _ADAPTER.validate_python(data)
+        return _mechanism_adapter()[1].validate_python(data)
     except ValidationError as exc:
         raise _translate(exc, prefix) from None
 
@@ -488,6 +476,7 @@ def _display_of(validator):
     table = {_length: _fmt_length, _positive_length: _fmt_length, _angle: _fmt_angle,
              _stroke: lambda v: [_fmt_length(x) for x in v],
              _angle_triple: lambda v: [_fmt_angle(x) for x in v],
+             _angle_window: lambda v: [_fmt_angle(x) for x in v],
              _points: lambda v: [[_fmt_length(x) for x in row] for row in v],
              _pose: lambda v: [_fmt_length(x) for x in v[:3]] + [_fmt_angle(x) for x in v[3:]],
              _auto_angle: lambda v: "auto" if v is None else _fmt_angle(v),

@@ -248,7 +248,8 @@ def trajectory(
         (tmp / "trajectory.json").write_text(json.dumps(summary, indent=2, default=float)
                                              + "\n")
         names = mech.actuator_names
-        header = ",".join(["t", *[f"{n}_mm" for n in names], *[f"{n}_rate_mm_s" for n in names],
+        u = mech.actuator_unit     # internal units: mm, or rad for rotary families
+        header = ",".join(["t", *[f"{n}_{u}" for n in names], *[f"{n}_rate_{u}_s" for n in names],
                            *[f"{n}_force_N" for n in names], "status"])
         rows = [",".join([f"{t[i]:.6g}", *[f"{v:.6g}" for v in rep.q[i]],
                           *[f"{v:.6g}" for v in rep.qdot[i]], *[f"{v:.6g}" for v in

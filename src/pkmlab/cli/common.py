@@ -27,7 +27,8 @@ err = Console(stderr=True, soft_wrap=True)  # one line per error, whatever the w
 
 POSE_KEYS = ("x", "y", "z", "theta_x", "theta_y", "theta_z")
 JSON_HELP = ("Print JSON. Pose keys: x, y, z (mm), theta_x, theta_y, theta_z (deg, Z-Y-X Euler); "
-             "actuators: {name: mm} with the family's actuator names.")
+             "actuators: {name: value} with the family's actuator names, in mm (prismatic) or "
+             "deg (rotary families such as rss6; the key actuator_unit says which).")
 
 
 def _fail(exc: Exception) -> None:
@@ -67,8 +68,36 @@ def _pose_json(pose: np.ndarray) -> dict:
     return {k: (None if not np.isfinite(v) else float(v)) for k, v in zip(POSE_KEYS, vals)}
 
 
+def _act_unit(mech: Mechanism) -> str:
+    """Display unit of the actuator values: ``"mm"``, or ``"deg"`` for rotary (rad) families."""
+    return "deg" if mech.actuator_unit == "rad" else mech.actuator_unit
+
+
+def _act_display(mech: Mechanism, q) -> np.ndarray:
+    """Actuator values (internal units) in the display unit of :func:`_act_unit`."""
+    q = np.asarray(q, dtype=float)
+    return np.degrees(q) if mech.actuator_unit == "rad" else q
+
+
 def _act_json(mech: Mechanism, q: np.ndarray) -> dict:
+    q = _act_display(mech, q)
     return {n: (None if not np.isfinite(v) else float(v)) for n, v in zip(mech.actuator_names, q)}
+
+
+def _act_str(mech: Mechanism, q, digits: int = 4) -> str:
+    return ", ".join(f"{n}=" + ("none" if not np.isfinite(v) else f"{v:.{digits}f}")
+                     for n, v in zip(mech.actuator_names, _act_display(mech, q)))
+
+
+def _parse_actuators(mech: Mechanism, text: str) -> np.ndarray:
+    """``"q1,…,q6"``: mm (or with units) for prismatic families, deg (or with units) for
+    rotary ones."""
+    parts = _parse_csv(text, "--actuators", 6)
+    parse = parse_angle if mech.actuator_unit == "rad" else parse_length
+    try:
+        return np.array([parse(p, f"--actuators[{i}]") for i, p in enumerate(parts)])
+    except ParameterError as exc:
+        _fail(exc)
 
 
 def _pose_str(pose: np.ndarray) -> str:

@@ -11,17 +11,19 @@ from rich.markup import escape
 from rich.table import Table
 
 from ..errors import ParameterError
-from ..units import parse_length
 from .common import (
     POSE_KEYS,
     JsonOpt,
     MechArg,
+    _act_display,
     _act_json,
+    _act_str,
+    _act_unit,
     _emit,
     _fail,
     _kappa_text,
     _load,
-    _parse_csv,
+    _parse_actuators,
     _parse_pose,
     _pose_json,
     _pose_str,
@@ -41,11 +43,12 @@ def inspect(mech_file: MechArg, as_json: JsonOpt = False) -> None:
     data = {
         "geometry": mech.describe(),
         "nominal_pose": _pose_json(nominal),
-        "nominal_actuators": rep["actuators"],
+        "actuator_unit": _act_unit(mech),
+        "nominal_actuators": _act_json(mech, mech.inverse(nominal).q[0]),
         "nominal_valid": rep["valid"],
         "nominal_reason": (rep["reason"] if not (rep["valid"] and rep["singular"]) else
                            "singular: the Jacobian is rank-deficient at the nominal pose"),
-        "actuator_limits": {n: list(map(float, lim))
+        "actuator_limits": {n: list(map(float, _act_display(mech, lim)))
                             for n, lim in zip(mech.actuator_names, mech.actuator_limits)},
         "kappa": rep["kappa"],
         "singular": rep["singular"],
@@ -67,9 +70,8 @@ def inspect(mech_file: MechArg, as_json: JsonOpt = False) -> None:
                                      if i < len(g[k]) else "") for k in pts])
     out.print(table)
     out.print(f"nominal pose: {_pose_str(nominal)}")
-    out.print("nominal actuators (mm): " + ", ".join(
-        f"{n}={v:.4f}" for n, v in zip(mech.actuator_names, mech.inverse(nominal).q[0]))
-        + escape(f"  [{rep['reason']}]"))
+    out.print(f"nominal actuators ({_act_unit(mech)}): "
+              + _act_str(mech, mech.inverse(nominal).q[0]) + escape(f"  [{rep['reason']}]"))
     out.print(escape(f"at nominal: {_kappa_text(rep)}"), highlight=False)
     if rep["characteristic_length"]["status"] not in ("angeles", "given"):
         out.print(escape(f"  note: {rep['characteristic_length']['reason']}"), highlight=False)
@@ -88,15 +90,15 @@ def ik(mech_file: MechArg,
     rep = pose_report(mech, X)
     legs = [rep["reason"]] if rep["valid"] else [
         f"{n}: {st}" for n, st in rep["leg_status"].items() if st != "ok"]
-    data = {"pose": _pose_json(X), "actuators": rep["actuators"], "valid": rep["valid"],
+    data = {"pose": _pose_json(X), "actuator_unit": _act_unit(mech),
+            "actuators": _act_json(mech, mech.inverse(X).q[0]), "valid": rep["valid"],
             "reason": rep["reason"], "leg_status": rep["leg_status"], "kappa": rep["kappa"],
             "singular": rep["singular"], "characteristic_length": rep["characteristic_length"]}
     if as_json:
         _emit(data)
         return
     out.print(f"pose: {_pose_str(X)}")
-    out.print("actuators (mm): " + ", ".join(
-        f"{n}=" + ("none" if v is None else f"{v:.6f}") for n, v in rep["actuators"].items()))
+    out.print(f"actuators ({_act_unit(mech)}): " + _act_str(mech, mech.inverse(X).q[0], 6))
     out.print(("[green]valid[/]" if rep["valid"] else "[red]invalid[/]") + ": "
               + escape("; ".join(legs)))
     out.print(escape(_kappa_text(rep)), highlight=False)
@@ -110,7 +112,8 @@ def mech_status(code: int) -> str:
 
 @app.command()
 def fk(mech_file: MechArg,
-       actuators: Annotated[str, typer.Option(help='Actuator values "q1,…,q6" in mm.')],
+       actuators: Annotated[str, typer.Option(help='Actuator values "q1,…,q6" in mm, or in '
+                                              'deg for rotary families (rss6).')],
        all_modes: Annotated[bool, typer.Option("--all", help="List every assembly mode found "
                                                "by the multi-start search.")] = False,
        guess: Annotated[str | None, typer.Option(help='Start pose "x,y,z,θx,θy,θz" (mm, deg); '
@@ -120,14 +123,11 @@ def fk(mech_file: MechArg,
        as_json: JsonOpt = False) -> None:
     """Forward kinematics (Newton from the nominal pose or --guess); --all for every mode."""
     mech = _load(mech_file)
-    parts = _parse_csv(actuators, "--actuators", 6)
-    try:
-        q = np.array([parse_length(p, f"--actuators[{i}]") for i, p in enumerate(parts)])
-    except ParameterError as exc:
-        _fail(exc)
+    q = _parse_actuators(mech, actuators)
     g = None if guess is None else _parse_pose(guess, "--guess")
     res = mech.forward(q, g)
-    data = {"actuators": _act_json(mech, q), "pose": _pose_json(res.pose[0]),
+    data = {"actuator_unit": _act_unit(mech), "actuators": _act_json(mech, q),
+            "pose": _pose_json(res.pose[0]),
             "converged": bool(res.converged[0]), "residual_mm": float(res.residual[0]),
             "iterations": int(res.iterations[0]), "status": str(res.status[0])}
     if all_modes:
@@ -169,9 +169,8 @@ def demo(folder: Annotated[Path, typer.Argument(help="Folder of mechanism YAML f
         X = mech.nominal_pose + np.array([10.0, -5.0, 8.0, *np.radians([5.0, -4.0, 10.0])])
         res = mech.inverse(X)
         out.print(f"IK of a displaced pose {_pose_str(X)}:")
-        out.print("  " + ", ".join(f"{n}={v:.4f}" for n, v in zip(mech.actuator_names,
-                                                                   res.q[0]))
-                  + escape(f" mm [{res.reason_text[0]}]"))
+        out.print("  " + _act_str(mech, res.q[0])
+                  + escape(f" {_act_unit(mech)} [{res.reason_text[0]}]"))
         back = mech.forward(res.q[0])
         errp = np.abs(back.pose[0] - X)
         out.print(f"FK back from the nominal pose: {back.status[0]} in {back.iterations[0]} "

@@ -3,7 +3,8 @@
 Public protocol (what the rest of pkmlab uses; nothing outside :mod:`pkmlab.mechanisms` calls a
 method whose name starts with ``_``):
 
-* ``family``, ``actuator_names``, ``name``, ``stroke``, ``actuator_limits``, ``scale``;
+* ``family``, ``actuator_names``, ``actuator_unit`` (``"mm"`` or ``"rad"``), ``name``,
+  ``stroke``, ``actuator_limits``, ``scale``;
 * ``base_points``, ``platform_points``, ``tool_offset`` and ``tool_points`` (mm);
 * ``nominal_pose`` — level, centred, mid-stroke unless given;
 * ``inverse(poses, stroke=None)`` and ``jacobian(poses)``: ``poses`` is ``(N, 6)`` Euler
@@ -131,6 +132,9 @@ class Mechanism:
 
     family: ClassVar[str] = ""
     actuator_names: ClassVar[tuple[str, ...]] = ("q1", "q2", "q3", "q4", "q5", "q6")
+    #: unit of the actuator values: ``"mm"`` (prismatic) or ``"rad"`` (rotary; the CLI and its
+    #: JSON show these in degrees)
+    actuator_unit: ClassVar[str] = "mm"
     name: str = field(default="", kw_only=True)
     nominal: np.ndarray | None = field(default=None, kw_only=True, repr=False)
     description: dict = field(default_factory=dict, kw_only=True, repr=False, compare=False)

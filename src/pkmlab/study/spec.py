@@ -17,6 +17,7 @@ from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSche
 from .. import limits
 from ..config import mechanism_spec, read_yaml, validate_model, workspace_spec
 from ..errors import ParameterError
+from ..mechanisms import REGISTRY
 from ..units import parse_angle, parse_length
 from .definition import (
     Constraint,
@@ -50,6 +51,13 @@ _PAIRED = {
 DESIGN_ALIASES: dict[str, dict[str, tuple[str, str]]] = {
     "psu6": {**_PAIRED, "link_length": ("link_length", "length")},
     "ups6": dict(_PAIRED),
+    "rss6": {**{k: v for k, v in _PAIRED.items() if not k.startswith("stroke")},
+             "crank_length": ("crank_length", "length"),
+             "rod_length": ("rod_length", "length"),
+             "servo_min": ("stroke[0]", "angle"),
+             "servo_max": ("stroke[1]", "angle"),
+             "crank_plane": ("generator.crank_plane", "text"),
+             "zero_direction": ("generator.zero_direction", "text")},
     "luzi3": {"base_diameter": ("generator.base_diameter", "length"),
               "platform_diameter": ("generator.platform_diameter", "length"),
               "phi": ("generator.phi", "angle"),
@@ -57,6 +65,13 @@ DESIGN_ALIASES: dict[str, dict[str, tuple[str, str]]] = {
               "stroke_min": ("stroke[0]", "length"),
               "stroke_max": ("stroke[1]", "length")},
 }
+
+
+def family_aliases(family: str) -> dict[str, tuple[str, str]]:
+    """Named design variables of a family: built-in, or a plugin class's ``design_aliases``."""
+    if family in DESIGN_ALIASES:
+        return DESIGN_ALIASES[family]
+    return dict(getattr(REGISTRY.get(family), "design_aliases", None) or {})
 
 
 class _Model(BaseModel):
@@ -182,7 +197,7 @@ def _merge(base: dict, over: dict) -> dict:
 
 
 def _target(name: str, where: str, path: str | None, family: str, spec) -> tuple | None:
-    alias = DESIGN_ALIASES[family].get(name)
+    alias = family_aliases(family).get(name)
     text = path or (alias[0] if alias else None)
     if text is None:
         return None
@@ -215,7 +230,7 @@ def _variable(name: str, v: DesignVariableSpec, family: str, spec,
                                      f"{sorted(acts.catalogue)}", c)
         return Variable(name, None, "text", "choice", choices=tuple(v.choices),
                         role="actuator", baseline=acts.default)
-    alias = DESIGN_ALIASES[family].get(name)
+    alias = family_aliases(family).get(name)
     target = _target(name, f"{field}.path", v.path, family, spec)
     quantity = v.quantity or (alias[1] if alias else None)
     if target is None and alias is None and v.path is None and quantity not in (None,
@@ -223,7 +238,7 @@ def _variable(name: str, v: DesignVariableSpec, family: str, spec,
         raise ParameterError(f"{field}.path", "given for a non-number variable", None)
     if target is None and quantity is None:
         raise ParameterError(field, f"a known variable of family {family!r} "
-                             f"{sorted(DESIGN_ALIASES[family])}, one with 'path' and "
+                             f"{sorted(family_aliases(family))}, one with 'path' and "
                              "'quantity', or a free parameter with 'quantity: number'", name)
     if quantity is None:
         raise ParameterError(f"{field}.quantity", "one of ['length', 'angle', 'number', "
@@ -355,7 +370,7 @@ def study_from_mapping(data: Any, base: Path | None = None,
         where = f"derived.{key}"
         if key in names:
             raise ParameterError(where, "a field no design variable sets", key)
-        target = _target(key, where, None if key in DESIGN_ALIASES[family] else key, family,
+        target = _target(key, where, None if key in family_aliases(family) else key, family,
                          mech_spec)
         derived.append(Derived(key, target, Expression.parse(text, where, names)))
     written = [v.target for v in variables if v.target is not None] + \

@@ -1,0 +1,206 @@
+"""The mechanism contract suite, as plain functions a family's own tests (or a plugin's) can run.
+
+Every check takes a :class:`~pkmlab.mechanisms.Mechanism` and raises ``AssertionError`` naming
+what failed; :func:`run_contract` runs them all and returns the names of the checks that passed.
+They use only the public protocol (``inverse``, ``jacobian``, ``forward``, ``assembly_modes``,
+``stroke``, ``nominal_pose``, ``actuator_unit``)::
+
+    from pkmlab.testing import run_contract
+    run_contract(MyFamily(...))
+
+The checks:
+
+* :func:`check_round_trip` — IK → FK of poses near nominal recovers the pose to 1e-9;
+* :func:`check_jacobian` — the analytic Jacobian against Richardson-extrapolated central
+  differences of the inverse kinematics (error O(h⁴), so the tolerance can be tight);
+* :func:`check_batching` — a pose's results do not depend on the batch it is part of, and
+  transform / Euler inputs agree;
+* :func:`check_statuses` — stroke violations are flagged with their reason and finite values,
+  non-finite poses are flagged, forward kinematics reports failure as data (NaN and a status);
+* :func:`check_assembly_modes` — the nominal pose is the first mode and doubling the starts finds
+  nothing new;
+* :func:`check_bad_shapes` — malformed pose arrays raise a named error.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .mechanisms import LEG_STATUS, NO_STROKE
+from .poses import as_frames, euler_to_matrix, exp_so3, log_so3
+
+__all__ = ["random_valid_poses", "rotation_error", "check_round_trip", "check_jacobian",
+           "check_batching", "check_statuses", "check_assembly_modes", "check_bad_shapes",
+           "CHECKS", "run_contract"]
+
+REASON = {v: k for k, v in LEG_STATUS.items()}
+
+
+def random_valid_poses(mech, n: int, seed: int, lin: float = 25.0, ang_deg: float = 10.0):
+    """``n`` poses near the nominal pose (±``lin`` mm, ±``ang_deg`` deg) whose inverse
+    kinematics is valid."""
+    rng = np.random.default_rng(seed)
+    out, total = [], 0
+    for _ in range(200):
+        X = mech.nominal_pose + np.concatenate(
+            [rng.uniform(-lin, lin, (4 * n, 3)),
+             np.radians(rng.uniform(-ang_deg, ang_deg, (4 * n, 3)))], axis=1)
+        out.append(X[mech.inverse(X).valid])
+        total += len(out[-1])
+        if total >= n:
+            return np.concatenate(out)[:n]
+    raise AssertionError(f"fewer than {n} valid poses near the nominal pose")
+
+
+def rotation_error(X1, X2):
+    """Angle (rad) between the orientations of Euler poses ``X1`` and ``X2`` ``(N, 6)``."""
+    R1, R2 = euler_to_matrix(X1[:, 3:]), euler_to_matrix(X2[:, 3:])
+    return np.linalg.norm(log_so3(np.einsum("nji,njk->nik", R1, R2)), axis=1)
+
+
+def check_round_trip(mech, n: int = 1000, tol: float = 1e-9):
+    X = random_valid_poses(mech, n, seed=1)
+    q = mech.inverse(X).q
+    fk = mech.forward(q)                       # starts from the nominal pose
+    assert fk.converged.all(), f"{(~fk.converged).sum()} of {n} did not converge"
+    err = np.max(np.abs(fk.pose[:, :3] - X[:, :3]))
+    assert err < tol, f"round trip position error {err:.3g} mm"
+    err = np.max(rotation_error(fk.pose, X))
+    assert err < tol, f"round trip rotation error {err:.3g} rad"
+    assert np.max(fk.residual) < tol, f"FK residual {np.max(fk.residual):.3g} mm"
+
+
+def _central(mech, p, R, h):
+    out = np.empty((len(p), 6, 6))
+    for j in range(6):
+        d = np.zeros(6)
+        d[j] = h
+        if j < 3:
+            qp = mech.inverse((p + d[:3], R), stroke=NO_STROKE).q
+            qm = mech.inverse((p - d[:3], R), stroke=NO_STROKE).q
+        else:
+            qp = mech.inverse((p, exp_so3(d[3:]) @ R), stroke=NO_STROKE).q
+            qm = mech.inverse((p, exp_so3(-d[3:]) @ R), stroke=NO_STROKE).q
+        out[:, :, j] = (qp - qm) / (2 * h)
+    return out
+
+
+def check_jacobian(mech, n: int = 40, h: float = 1e-4, tol: float = 1e-7):
+    """Analytic J against ``(4·D(h/2) - D(h))/3`` (D central differences with step h mm / rad),
+    relative to each pose's largest entry, translation and rotation columns separately."""
+    X = random_valid_poses(mech, n, seed=2)
+    p, R = as_frames(X)
+    J = mech.jacobian(X)
+    Jfd = (4.0 * _central(mech, p, R, h / 2) - _central(mech, p, R, h)) / 3.0
+    for cols, what in ((slice(0, 3), "translation"), (slice(3, 6), "rotation")):
+        scale = np.max(np.abs(J[:, :, cols]), axis=(1, 2), keepdims=True)
+        rel = np.abs(J[:, :, cols] - Jfd[:, :, cols]) / scale
+        assert rel.max() < tol, f"Jacobian {what} columns differ from finite differences " \
+                                f"by {rel.max():.3g} (relative)"
+
+
+def check_batching(mech):
+    X = random_valid_poses(mech, 12, seed=3)
+    ik = mech.inverse(X)
+    J = mech.jacobian(X)
+    fk = mech.forward(ik.q)
+    for i in range(len(X)):
+        one = mech.inverse(X[i])
+        np.testing.assert_array_equal(one.q[0], ik.q[i])
+        np.testing.assert_array_equal(one.leg_status[0], ik.leg_status[i])
+        np.testing.assert_array_equal(mech.jacobian(X[i])[0], J[i])
+        np.testing.assert_allclose(mech.forward(ik.q[i]).pose[0], fk.pose[i], atol=1e-12)
+    X = random_valid_poses(mech, 20, seed=4)
+    T = np.zeros((20, 4, 4))
+    T[:, :3, :3] = euler_to_matrix(X[:, 3:])
+    T[:, :3, 3] = X[:, :3]
+    T[:, 3, 3] = 1.0
+    np.testing.assert_allclose(mech.inverse(T).q, mech.inverse(X).q, atol=1e-10)
+    np.testing.assert_allclose(mech.jacobian(T), mech.jacobian(X), atol=1e-10)
+
+
+def check_statuses(mech):
+    # Windows entirely below / above the nominal actuator values flag every leg.
+    X = np.repeat(mech.nominal_pose[None], 2, axis=0)
+    q = mech.inverse(X[:1]).q[0]
+    lo, hi = float(np.min(q)), float(np.max(q))
+    span = mech.stroke[1] - mech.stroke[0]
+    above = mech.inverse(X[:1], stroke=(lo - span, lo - 0.01 * span))
+    below = mech.inverse(X[:1], stroke=(hi + 0.01 * span, hi + span))
+    assert not above.valid[0] and above.reason_text[0] == "stroke above maximum"
+    assert np.all(above.leg_status[0] == REASON["stroke above maximum"])
+    assert not below.valid[0] and below.reason_text[0] == "stroke below minimum"
+    # Values outside the window are still reported (not NaN): they are the geometry's answer.
+    assert np.all(np.isfinite(above.q)) and np.all(np.isfinite(below.q))
+    # Non-finite poses.
+    X[1, 4] = np.nan
+    ik = mech.inverse(X)
+    assert ik.valid.tolist() == [True, False]
+    assert ik.reason_text[1] == "non-finite pose"
+    assert np.all(ik.leg_status[1] == REASON["non-finite pose"])
+    # Far and wide poses: NaN exactly where there is no real solution; valid means finite.
+    rng = np.random.default_rng(5)
+    W = mech.nominal_pose + np.concatenate([rng.uniform(-2, 2, (500, 3)) * mech.scale,
+                                            rng.uniform(-np.pi, np.pi, (500, 3))], axis=1)
+    ik = mech.inverse(W, stroke=NO_STROKE)
+    nan_ok = np.isin(ik.leg_status, [REASON["no real solution"], REASON["degenerate leg "
+                                                                        "geometry"]])
+    assert np.array_equal(np.isnan(ik.q), nan_ok), "NaN actuator values without a status"
+    assert np.all(np.isfinite(ik.q[ik.valid])), "a valid pose with a NaN actuator value"
+    # Forward kinematics reports failure as data. Adjacent actuators at 1 and 5000 (mm: the
+    # triangle inequality; rad: outside (-π, π], no inverse gives it) close no working loop.
+    impossible = np.array([1.0, 5000.0, 1.0, 5000.0, 1.0, 5000.0])
+    fk = mech.forward(np.array([q, impossible, np.full(6, np.nan)]))
+    assert fk.converged.tolist() == [True, False, False], fk.status
+    assert np.all(np.isnan(fk.pose[1:]))
+    assert all(s in ("not converged", "singular") for s in fk.status[1:])
+
+
+def check_assembly_modes(mech):
+    q = mech.inverse(mech.nominal_pose).q[0]
+    a = mech.assembly_modes(q, starts=1000, seed=0)
+    b = mech.assembly_modes(q, starts=2000, seed=1)
+    assert np.allclose(a.pose[0], mech.nominal_pose, atol=1e-8), "nominal pose not first"
+    assert a.working_mode[0]
+    assert np.all(a.residual < 1e-9)
+    assert len(a.residual) == len(b.residual), (len(a.residual), len(b.residual))
+    for X in b.pose:       # every mode of the larger search is in the smaller one
+        d = np.abs(a.pose[:, :3] - X[:3]).max(axis=1) + rotation_error(
+            a.pose, np.repeat(X[None], len(a.pose), 0))
+        assert d.min() < 1e-6
+    # Each working-mode solution really closes the loops: its IK is consistent with q.
+    for X in a.pose[a.working_mode]:
+        np.testing.assert_allclose(mech.inverse(X).q[0], q, atol=1e-7)
+
+
+def check_bad_shapes(mech):
+    for shape in ((5,), (3, 5), (2, 3, 3)):
+        try:
+            mech.jacobian(np.zeros(shape))
+        except ValueError as exc:
+            assert "poses: must be an array of shape" in str(exc), str(exc)
+        else:
+            raise AssertionError(f"a pose array of shape {shape} was accepted")
+
+
+#: name → check, in the order :func:`run_contract` runs them
+CHECKS = {"round_trip": check_round_trip, "jacobian": check_jacobian,
+          "batching": check_batching, "statuses": check_statuses,
+          "assembly_modes": check_assembly_modes, "bad_shapes": check_bad_shapes}
+
+
+def run_contract(mech, skip: tuple[str, ...] = ()) -> list[str]:
+    """Run every check of :data:`CHECKS` (except ``skip``) on ``mech``; returns their names.
+
+    Raises the first check's ``AssertionError``, prefixed with the check's name.
+    """
+    done = []
+    for name, check in CHECKS.items():
+        if name in skip:
+            continue
+        try:
+            check(mech)
+        except AssertionError as exc:
+            raise AssertionError(f"{name}: {exc}") from exc
+        done.append(name)
+    return done
