@@ -20,8 +20,9 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSchema
 
-from ..config import Angle, Length, read_yaml, validate_model
+from ..config import read_yaml, validate_model
 from ..errors import ParameterError, format_value
+from ..quantities import Angle, Length
 from ..units import (
     ANGULAR_SPEED_UNITS,
     FORCE_UNITS,
