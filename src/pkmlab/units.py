@@ -27,17 +27,21 @@ def parse_quantity(value: Any, field: str, units: dict[str, float], default_unit
 
     Bare numbers are taken in ``default_unit``. Raises :class:`ParameterError` naming ``field``.
     """
+    return _parse(value, field, units, default_unit, _QUANTITY, lambda u: u)
+
+
+def _parse(value, field, units, default_unit, pattern, normalise) -> float:
     allowed = f"a number (in {default_unit}) or a string with a unit from {sorted(units)}"
     if isinstance(value, bool):
         raise ParameterError(field, allowed, value)
     if isinstance(value, int | float):
         number, unit = float(value), default_unit
     elif isinstance(value, str):
-        match = _QUANTITY.match(value)
+        match = pattern.match(value)
         if match is None:
             raise ParameterError(field, allowed, value)
         number = float(match.group(1))
-        unit = match.group(2) or default_unit
+        unit = normalise(match.group(2)) or default_unit
         if unit not in units:
             raise ParameterError(field, allowed, value)
     else:
@@ -89,21 +93,4 @@ def parse_physical(value: Any, field: str, units: dict[str, float], default_unit
     """Convert ``value`` (a bare number in ``default_unit`` or a string with a unit from
     ``units``, compound units allowed: ``"500 mm/s"``, ``"1.2 kg·m²"``, ``"3 N m"``) to the
     internal unit (factor 1.0). Raises :class:`ParameterError` naming ``field``."""
-    allowed = f"a number (in {default_unit}) or a string with a unit from {sorted(units)}"
-    if isinstance(value, bool):
-        raise ParameterError(field, allowed, value)
-    if isinstance(value, int | float):
-        number, unit = float(value), default_unit
-    elif isinstance(value, str):
-        match = _ANY_QUANTITY.match(value)
-        if match is None:
-            raise ParameterError(field, allowed, value)
-        number = float(match.group(1))
-        unit = _normalise_unit(match.group(2)) or default_unit
-        if unit not in units:
-            raise ParameterError(field, allowed, value)
-    else:
-        raise ParameterError(field, allowed, value)
-    if not math.isfinite(number):
-        raise ParameterError(field, "a finite " + allowed, value)
-    return number * units[unit]
+    return _parse(value, field, units, default_unit, _ANY_QUANTITY, _normalise_unit)
