@@ -16,10 +16,10 @@ Run: ``.venv/bin/python benchmarks/bench_requirements.py``.
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import numpy as np
+from _timing import timed  # noqa: E402 - the benchmarks folder is on sys.path
 
 from pkmlab import load_mechanism
 from pkmlab.requirements.dynamics import inverse_dynamics
@@ -32,15 +32,6 @@ ROOT = Path(__file__).resolve().parents[1]
 MECH = ROOT / "studies" / "mechanisms"
 BOX = OrientationSet.box(np.radians([15.0, 15.0, 15.0]), "simultaneous", samples=7)
 
-
-def timed(fn, repeats=7):
-    fn()
-    ts = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        out = fn()
-        ts.append(time.perf_counter() - t)
-    return float(np.median(ts)), out
 
 
 def main() -> None:

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSchema
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSchema, create_model
 
 from ..config import read_yaml, validate_model
 from ..errors import ParameterError, format_value
@@ -205,31 +205,17 @@ def build_task(data: Any, base: Path) -> TaskPlan:
 # ---- motions ---------------------------------------------------------------------------------
 
 
-class _Coords(_Model):
-    x: Length = 0.0
-    y: Length = 0.0
-    z: Length = 0.0
-    theta_x: Angle = 0.0
-    theta_y: Angle = 0.0
-    theta_z: Angle = 0.0
+def _per_coordinate(name: str, linear, angular) -> type[BaseModel]:
+    """A model with one value per pose coordinate (x, y, z, theta_x, theta_y, theta_z), each
+    defaulting to 0: ``linear`` is the type of x, y, z, ``angular`` that of the angles."""
+    return create_model(name, __base__=_Model,
+                        **{c: (linear if c in "xyz" else angular, 0.0)
+                           for c in ("x", "y", "z", "theta_x", "theta_y", "theta_z")})
 
 
-class _Frequencies(_Model):
-    x: Frequency = 0.0
-    y: Frequency = 0.0
-    z: Frequency = 0.0
-    theta_x: Frequency = 0.0
-    theta_y: Frequency = 0.0
-    theta_z: Frequency = 0.0
-
-
-class _Phases(_Model):
-    x: Angle = 0.0
-    y: Angle = 0.0
-    z: Angle = 0.0
-    theta_x: Angle = 0.0
-    theta_y: Angle = 0.0
-    theta_z: Angle = 0.0
+_Coords = _per_coordinate("_Coords", Length, Angle)
+_Frequencies = _per_coordinate("_Frequencies", Frequency, Frequency)
+_Phases = _per_coordinate("_Phases", Angle, Angle)
 
 
 class SinusoidSpec(_Model):
