@@ -16,7 +16,6 @@ import numpy as np
 from pydantic import (
     BaseModel,
     BeforeValidator,
-    ConfigDict,
     Field,
     TypeAdapter,
     ValidationError,
@@ -25,6 +24,7 @@ from pydantic import (
 
 from . import limits
 from .errors import ParameterError, format_value, from_validation_error
+from .legspec import SixLegSpec
 from .mechanisms import PSU6, RSS6, UPS6, Luzi3, Mechanism
 from .quantities import (  # noqa: F401 (re-exported for plugins' spec models)
     _NUMBER_OR_UNIT,
@@ -56,6 +56,7 @@ from .quantities import (  # noqa: F401 (re-exported for plugins' spec models)
     _Shown,
     _stroke,
 )
+from .specbase import FamilySpec, PairedCircles, _Common, _Model  # noqa: F401
 from .units import ANGLE_UNITS, LENGTH_UNITS
 from .yamlio import load_yaml, remember, where
 
@@ -63,57 +64,6 @@ __all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec", "FamilySpec", "m
            "workspace_spec", "WorkspaceSpec",
            "load_workspace_study", "WorkspaceStudySpec", "to_display", "read_yaml",
            "validate_model"]
-
-
-class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-class PairedCircles(_Model):
-    """Generator of the paired concentric-circle layout (6-PSU and 6-UPS)."""
-
-    base_radii: Radii = Field(description="[inner, outer] base joint radii (mm)")
-    platform_radii: Radii = Field(description="[inner, outer] platform joint radii (mm)")
-    base_pair_angle: AutoAngle = Field(None, description="β (deg) or 'auto' (equal legs)")
-    platform_rotation: Angle = Field(description="ρ, clockwise from the platform y axis (deg)")
-    base_pair_separation: Angle = 0.0
-    platform_pair_separation: Angle = 0.0
-    pairing: Literal["same", "crossed"] = "same"
-
-
-class _Common(_Model):
-    name: str = ""
-    source: str = ""
-    stroke: Stroke
-    tool_offset: Vector3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    nominal_pose: Pose | None = None
-    base_points: Points | None = None
-    platform_points: Points | None = None
-
-    def _explicit(self, field_gen: str) -> bool:
-        gen = getattr(self, field_gen)
-        have = [self.base_points is not None, self.platform_points is not None]
-        if gen is not None and any(have):
-            raise ParameterError(field_gen, "given alone: either a generator or explicit "
-                                 "base_points/platform_points, not both", "both")
-        if gen is None and not all(have):
-            missing = "base_points" if not have[0] else "platform_points"
-            raise ParameterError(missing, "given (or use a 'generator' block)", None)
-        return gen is None
-
-    def _kw(self) -> dict:
-        nominal = None if self.nominal_pose is None else np.array(self.nominal_pose)
-        return {"name": self.name, "nominal": nominal}
-
-
-class FamilySpec(_Common):
-    """Base of a plugin family's YAML model: ``name``, ``source``, ``stroke`` (mm),
-    ``tool_offset``, ``nominal_pose``, ``base_points``, ``platform_points`` — declare
-    ``family: Literal["<name>"]``, the family's own fields and ``build()``."""
-
-    def explicit_kw(self) -> dict:
-        """``name`` and ``nominal`` keyword arguments of the mechanism constructor."""
-        return self._kw()
 
 
 class PSU6Spec(_Common):
@@ -209,9 +159,9 @@ class Luzi3Spec(_Common):
                                 **self._kw())
 
 
-MechanismSpec = Annotated[PSU6Spec | UPS6Spec | Luzi3Spec | RSS6Spec,
+MechanismSpec = Annotated[PSU6Spec | UPS6Spec | Luzi3Spec | RSS6Spec | SixLegSpec,
                           Field(discriminator="family")]
-_BUILTIN_SPECS = (PSU6Spec, UPS6Spec, Luzi3Spec, RSS6Spec)
+_BUILTIN_SPECS = (PSU6Spec, UPS6Spec, Luzi3Spec, RSS6Spec, SixLegSpec)
 _ADAPTERS: dict[tuple, tuple[Any, TypeAdapter]] = {}
 
 

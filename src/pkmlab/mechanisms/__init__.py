@@ -21,12 +21,14 @@ from .base import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult, Mech
 from .luzi3 import Luzi3
 from .psu6 import PSU6
 from .rss6 import RSS6
+from .sixleg import SixLeg
 from .ups6 import UPS6
 
 log = logging.getLogger(__name__)
 
 #: family name → mechanism class (built-in families, then plugins once loaded)
-REGISTRY: dict[str, type[Mechanism]] = {cls.family: cls for cls in (PSU6, UPS6, Luzi3, RSS6)}
+REGISTRY: dict[str, type[Mechanism]] = {cls.family: cls for cls in (PSU6, UPS6, Luzi3, RSS6,
+                                                                  SixLeg)}
 BUILTIN = frozenset(REGISTRY)
 
 #: entry point group of family plugins
@@ -77,4 +79,4 @@ def load_plugins() -> dict[str, type[Mechanism]]:
 
 __all__ = ["REGISTRY", "BUILTIN", "PLUGIN_GROUP", "PLUGIN_ERRORS", "load_plugins", "NO_STROKE",
            "Mechanism", "IKResult", "FKResult", "AssemblyModes", "LEG_STATUS", "PSU6", "UPS6",
-           "Luzi3", "RSS6"]
+           "Luzi3", "RSS6", "SixLeg"]
