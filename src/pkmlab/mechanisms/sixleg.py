@@ -13,7 +13,9 @@ the tool offset); ``d_i = W_i - B_i``. The actuator is one of three kinds:
 
   ``b = ±1`` is the leg's **branch**: ``b = -1`` puts the platform joint ahead of the slider
   along ``e`` (``(W - S)·e = h ≥ 0``; vertical rails with the platform above, as ``psu6``).
-  ``h² < 0`` has no real solution. Jacobian row, from ``a = W - S = d⊥ - b h e``:
+  ``h² < 0`` has no real solution. Working mode: the link's vertical component keeps the
+  sign it has at the nominal pose (``OTHER_MODE`` otherwise; fixed on vertical rails).
+  Jacobian row, from ``a = W - S = d⊥ - b h e``:
   ``J = [aᵀ, (r × a)ᵀ] / (a·e)`` (serial singularity when the link is perpendicular to the
   rail).
 * **crank** (RSS/RUS): crank of length ``a`` about the axis ``n`` through ``B``, zero direction
@@ -59,7 +61,8 @@ _NAMES = {v: k for k, v in KINDS.items()}
 #: floats per leg in the IK geometry tuple
 _L = 16
 # per leg: B 0-2, tool point 3-5, kind 6, slider e / crank 2a·u 7-9, crank 2a·v 10-12,
-# slider l² / crank a² - s² 13, crank degenerate threshold on ρ² 14, branch (or side) 15
+# slider l² / crank a² - s² 13, slider side / crank degenerate threshold on ρ² 14, branch
+# (prismatic: side) 15. (The drivers take at most 100 floats: numba's parfor tuple limit.)
 
 
 @njit(cache=True, inline="always")
@@ -82,7 +85,9 @@ def _leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, o, qmin, qm
     h2 = g[o + 13] - (nx * nx + ny * ny + nz * nz)
     real = h2 >= 0.0
     qs = t + b * math.sqrt(h2 if real else 0.0)
-    ss = _kernels.stroke_status(qs, qmin, qmax) if real else _kernels.NO_SOLUTION
+    az = nz - b * math.sqrt(h2 if real else 0.0) * ez        # vertical part of the link
+    ss = (_kernels.OTHER_MODE if az * g[o + 14] < 0.0 else
+          _kernels.stroke_status(qs, qmin, qmax)) if real else _kernels.NO_SOLUTION
     qs = qs if real else np.nan
     # crank: E cos α + F sin α = G (ex, ey, ez hold 2a·u)
     e = t
@@ -200,6 +205,28 @@ class SixLeg(Mechanism):
     tool_offset: np.ndarray = (0.0, 0.0, 0.0)  # type: ignore[assignment]
 
     _ik_one = _sixleg_one
+    #: named study variables (paths in the generator form of the YAML model)
+    design_aliases: ClassVar[dict] = {
+        "base_inner_radius": ("generator.base_radii[0]", "length"),
+        "base_outer_radius": ("generator.base_radii[1]", "length"),
+        "platform_inner_radius": ("generator.platform_radii[0]", "length"),
+        "platform_outer_radius": ("generator.platform_radii[1]", "length"),
+        "platform_rotation": ("generator.platform_rotation", "angle"),
+        "base_pair_angle": ("generator.base_pair_angle", "angle"),
+        "base_pair_separation": ("generator.base_pair_separation", "angle"),
+        "platform_pair_separation": ("generator.platform_pair_separation", "angle"),
+        "pairing": ("generator.pairing", "text"),
+        "tool_offset_z": ("tool_offset[2]", "length"),
+        "stroke_min": ("stroke[0]", "length"),
+        "stroke_max": ("stroke[1]", "length"),
+        "link_length": ("generator.actuator.link_length", "length"),
+        "rail_inclination": ("generator.actuator.rail_inclination", "angle"),
+        "rail_heading": ("generator.actuator.rail_heading", "text"),
+        "crank_length": ("generator.actuator.crank_length", "length"),
+        "rod_length": ("generator.actuator.rod_length", "length"),
+        "servo_min": ("stroke[0]", "angle"),
+        "servo_max": ("stroke[1]", "angle"),
+    }
     column_radial: ClassVar[bool] = True
     column_leg = _sixleg_column_leg
 
@@ -308,6 +335,25 @@ class SixLeg(Mechanism):
         sz = pose[2] + self.tool_points @ R[2] - self.base_points[:, 2]
         return np.where(sz < 0, -1.0, 1.0)
 
+    @cached_property
+    def _slider_sides(self) -> np.ndarray:
+        """Working-mode side of each slider leg: the sign of its link's vertical component
+        ``a_z``, kept as at the nominal pose when it is given; otherwise +1 (platform joint
+        above its slider), except on vertical rails, where ``a_z = -b·h·e_z`` has a fixed sign.
+        A leg on the other side is ``OTHER_MODE`` (its link crossed the horizontal: the mirror
+        assembly through the rails' plane)."""
+        fixed = np.where(self._vertical, np.sign(-self.branch * self.axes[:, 2]), 1.0)
+        fixed = np.where(fixed == 0, 1.0, fixed)
+        if self.nominal is None:
+            return fixed
+        pose = np.asarray(self.nominal, dtype=float)
+        d = pose[:3] + self.tool_points @ euler_to_matrix(pose[3:]).T - self.base_points
+        t = np.sum(d * self.axes, axis=1)
+        perp = d - t[:, None] * self.axes
+        h = np.sqrt(np.clip(self.link_length**2 - np.sum(perp**2, axis=1), 0.0, None))
+        az = perp[:, 2] - self.branch * h * self.axes[:, 2]
+        return np.where(self._vertical | (az == 0), fixed, np.sign(az))
+
     @property
     def v_directions(self) -> np.ndarray:
         """``(6, 3)`` ``v = n × u`` of the crank legs (zero for the others)."""
@@ -320,7 +366,9 @@ class SixLeg(Mechanism):
         c = np.where(crank, self.crank_length**2 - self.link_length**2, self.link_length**2)
         b = np.where(self._mask("prismatic"), self._sides, self.branch)
         g = np.column_stack([self.base_points, self.tool_points, self.kinds, first,
-                             a2 * self.v_directions, c, 1e-24 * self.crank_length**4, b])
+                             a2 * self.v_directions, c,
+                             np.where(crank, 1e-24 * self.crank_length**4, self._slider_sides),
+                             b])
         return g.ravel()
 
     # ---- kinematics --------------------------------------------------------------------------
