@@ -70,7 +70,7 @@ def test_without_the_plugin_its_family_is_unknown():
                           str(PLUGIN / "legs6-demo.yaml")], capture_output=True, text=True,
                          env=_env(), timeout=600)
     assert run.returncode != 0
-    assert "must be one of 'psu6', 'ups6', 'luzi3', 'rss6'; got 'legs6'" in run.stderr
+    assert "must be one of 'psu6', 'ups6', 'luzi3', 'rss6', 'sixleg'; got 'legs6'" in run.stderr
 
 
 def test_a_broken_plugin_is_reported_not_fatal(tmp_path):

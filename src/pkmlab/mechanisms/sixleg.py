@@ -453,7 +453,8 @@ class SixLeg(Mechanism):
     def position_bounds(self, R):
         """Per orientation, the intersection over legs of each leg's reach box ``(M, 2, 3)``:
         prismatic within ``qmax`` on its working-mode side; slider: the half ball of radius
-        ``l`` on its branch's side swept along the rail window; crank within ``a + s``."""
+        ``l`` on its branch's side swept along the rail window, above (below) the slider on
+        its working-mode side; crank within ``a + s``."""
         W = self.leg_offsets(R)                              # (M, 6, 3)
         lo_q, hi_q = self.stroke
         box_lo = np.empty((6, 3))
@@ -472,6 +473,10 @@ class SixLeg(Mechanism):
                 lk = self.link_length[i]
                 box_lo[i] = ends.min(axis=0) + lk * np.where(ep <= 0, -1.0, -side)
                 box_hi[i] = ends.max(axis=0) + lk * np.where(ep >= 0, 1.0, side)
+                if self._slider_sides[i] > 0:      # working mode: joint above its slider
+                    box_lo[i, 2] = max(box_lo[i, 2], ends[:, 2].min())
+                else:
+                    box_hi[i, 2] = min(box_hi[i, 2], ends[:, 2].max())
             else:
                 reach = self.crank_length[i] + self.link_length[i]
                 box_lo[i], box_hi[i] = -reach, reach

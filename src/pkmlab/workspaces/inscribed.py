@@ -272,8 +272,11 @@ def _scp(result, x0, points_of, jac_of, objective, lower_bounds, iters=30):
     rho = 0.5 * float(np.max(np.abs(x0[len(x0) // 2:]))) + result.resolution
 
     def stroke_ok(xc):
-        q, _ = _linearise(mech, points_of(xc), R)
-        return bool(np.all(np.isfinite(q)) and np.all(q >= qlo) and np.all(q <= qhi))
+        # every status counts (a working-mode side as well as the stroke), not just q's range
+        pts = points_of(xc)
+        p = np.repeat(pts, len(R), axis=0)
+        Rr = np.ascontiguousarray(np.tile(R, (len(pts), 1, 1)))
+        return bool(np.all(mech.inverse((p, Rr), stroke=(qlo, qhi)).valid))
 
     it = accepted = 0
     problem = ""
