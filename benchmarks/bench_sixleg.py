@@ -1,0 +1,58 @@
+"""The generic six-leg family against the hand-tuned kernels, in the same run.
+
+IK throughput (10⁶ poses near nominal) and the Jacobian (10⁵ poses) of the generic declaration
+(``SixLeg.from_mechanism``) of each shipped 6-PSU / 6-UPS / 6-RSS against the family's own
+kernels (ratio = generic time / fast time), and the Hexaglide-like 6-PUS (sliders on horizontal
+rails): IK throughput and its sampled constant workspace at 5 mm.
+
+Run: .venv/bin/python benchmarks/bench_sixleg.py   (state the load: ``uptime``)
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numba
+import numpy as np
+from _timing import timed
+
+import pkmlab
+from pkmlab.mechanisms import SixLeg
+from pkmlab.workspaces import workspace
+
+ROOT = Path(__file__).resolve().parents[1] / "studies" / "mechanisms"
+FILES = ("hopkins-williams-6psu", "gough-stewart-6ups", "instructables-servo-6rss")
+N_IK, N_J = 1_000_000, 100_000
+
+
+def _poses(mech, n, rng):
+    return mech.nominal_pose + np.concatenate(
+        [rng.uniform(-40, 40, (n, 3)), np.radians(rng.uniform(-15, 15, (n, 3)))], axis=1)
+
+
+def main() -> None:
+    print(f"numba threads: {numba.get_num_threads()}, load average: {os.getloadavg()}")
+    rng = np.random.default_rng(0)
+    for name in FILES:
+        fast = pkmlab.load_mechanism(ROOT / f"{name}.yaml")
+        gen = SixLeg.from_mechanism(fast)
+        X = _poses(fast, N_IK, rng)
+        t_fast, _ = timed(lambda: fast.inverse(X), 5)          # noqa: B023
+        t_gen, _ = timed(lambda: gen.inverse(X), 5)            # noqa: B023
+        XJ = X[:N_J]
+        j_fast, _ = timed(lambda: fast.jacobian(XJ), 3)        # noqa: B023
+        j_gen, _ = timed(lambda: gen.jacobian(XJ), 3)          # noqa: B023
+        print(f"{fast.family}: IK {N_IK / t_fast / 1e6:6.1f} M/s fast, "
+              f"{N_IK / t_gen / 1e6:6.1f} M/s generic (ratio {t_gen / t_fast:4.2f}); "
+              f"Jacobian {j_gen / j_fast:4.2f}x the fast family's time")
+    hx = pkmlab.load_mechanism(ROOT / "hexaglide-6pus.yaml")
+    X = _poses(hx, N_IK, rng)
+    t, _ = timed(lambda: hx.inverse(X), 5)
+    tw, r = timed(lambda: workspace(hx, "constant", resolution=5.0), 3)
+    print(f"hexaglide-6pus: IK {N_IK / t / 1e6:6.1f} M poses/s; constant workspace at 5 mm "
+          f"{tw:.2f} s ({r.method}, {r.volume / 1e3:.1f} ± {r.volume_error / 1e3:.1f} cm3)")
+
+
+if __name__ == "__main__":
+    main()
