@@ -229,12 +229,15 @@ def test_yaml_errors_name_the_field():
     with pytest.raises(ParameterError, match="kind"):
         pkmlab.load_mechanism(bad)
     crank = {**base, "generator": {**base["generator"], "actuator": {
-        "kind": "crank", "crank_length": "20 mm", "rod_length": "120 mm"}},
-        "stroke": ["-100 deg", "250 deg"]}
-    with pytest.raises(ParameterError, match="stroke"):
+        "kind": "crank", "crank_length": "20 mm", "rod_length": "120 mm"}}}
+    with pytest.raises(ParameterError, match="stroke: must be absent: these legs take "
+                                             "'servo_range'"):
         pkmlab.load_mechanism(crank)
-    m = pkmlab.load_mechanism({**crank, "stroke": ["-80 deg", "1.2 rad"]})
-    assert m.stroke == pytest.approx((math.radians(-80), 1.2))
+    crank.pop("stroke")
+    with pytest.raises(ParameterError, match="servo_range"):
+        pkmlab.load_mechanism({**crank, "servo_range": ["-100 deg", "250 deg"]})
+    m = pkmlab.load_mechanism({**crank, "servo_range": ["-80 deg", "1.2 rad"]})
+    assert m.stroke == pytest.approx((math.radians(-80), 1.2)) and m.actuator_unit == "rad"
     legs = generic_yaml(LINEAR["gough-stewart-6ups"])
     legs["legs"][2]["actuator"] = {"kind": "slider", "axis": [0, 0, 0], "link_length": "9 mm"}
     with pytest.raises(ParameterError, match=r"legs\[3\]\.axis"):
@@ -246,8 +249,8 @@ def test_inscribed_box_respects_the_slider_working_mode():
     Hexaglide: grown across the rails' plane into the mirror mode, no box survived)."""
     from pkmlab.workspaces.inscribed import inscribed_box, points_feasible
 
-    r = workspace(_hexaglide(0.0), "constant", resolution=10.0)
-    box = inscribed_box(r, samples=2000)
+    r = workspace(_hexaglide(0.0), "constant", resolution=15.0)
+    box = inscribed_box(r, samples=1000)
     assert box.status != "failed", box.reason
     assert box.shrink == 1.0 and box.lower[2] >= 0.0
     corners = np.array([[x, y, z] for x in (box.lower[0], box.upper[0])
@@ -293,3 +296,34 @@ def test_contract_on_mixed_and_tilted_legs(make):
     testing.check_jacobian(m, h=1e-5)
     testing.check_batching(m)
     testing.check_statuses(m)
+
+
+def test_study_variables_keep_their_units_through_the_typed_spec():
+    """``servo_min`` (an angle, rad inside) and ``link_length`` set through the study's design
+    space build the mechanism in internal units, and the exported display form reloads to the
+    same mechanism (to the 12 digits it writes)."""
+    from pkmlab.config import mechanism_spec, to_display
+    from pkmlab.study.space import DesignSpace, Variable, parse_path
+
+    spec = mechanism_spec({"family": "sixleg", "servo_range": ["-80 deg", "80 deg"],
+                           "generator": {"base_radii": ["100 mm"] * 2,
+                                         "platform_radii": ["75 mm"] * 2,
+                                         "platform_rotation": "30 deg",
+                                         "base_pair_separation": "30 deg",
+                                         "platform_pair_separation": "20 deg",
+                                         "actuator": {"kind": "crank", "crank_length": "25 mm",
+                                                      "rod_length": "150 mm"}}})
+    path, qty = SixLeg.design_aliases["servo_min"]
+    rod, _ = SixLeg.design_aliases["rod_length"]
+    space = DesignSpace(spec, (Variable("servo_min", parse_path(path), qty, "continuous",
+                                        -1.2, -0.5),
+                               Variable("rod_length", parse_path(rod), "length", "continuous",
+                                        120.0, 180.0)))
+    assert space.baseline_values()["servo_min"] == pytest.approx(math.radians(-80))
+    design = {"servo_min": -1.0, "rod_length": 160.0}
+    m = space.decode(design)
+    assert m.stroke[0] == pytest.approx(-1.0) and np.allclose(m.link_length, 160.0)
+    again = pkmlab.load_mechanism(to_display(space.spec_of(design)))   # 12 digits, with units
+    np.testing.assert_allclose(again.stroke, m.stroke, rtol=1e-11)
+    np.testing.assert_allclose(again.link_length, m.link_length, rtol=1e-11)
+    np.testing.assert_allclose(again.base_points, m.base_points, atol=1e-9)

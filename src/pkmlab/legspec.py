@@ -3,8 +3,9 @@
 Either six explicit ``legs``, each ``{base, platform, actuator}``, or a ``generator`` (three
 pairs on two circles, :func:`pkmlab.mechanisms.sixleg_layout.paired_sixleg`) with one
 ``actuator`` template. Quantities carry units and are converted once, here: lengths in mm,
-angles in deg when bare. ``stroke`` is a length window when the legs are prismatic or sliders
-and a servo-angle window (deg or with units) when they are cranks::
+angles in deg when bare. The shared actuator window is ``stroke`` (lengths) when the legs are
+prismatic or sliders and ``servo_range`` (angles) when they are cranks; both are typed
+quantities, so study variables and exported files keep their units::
 
     family: sixleg
     stroke: [0 mm, 300 mm]
@@ -17,7 +18,7 @@ and a servo-angle window (deg or with units) when they are cranks::
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal
+from typing import Annotated, Literal
 
 from pydantic import Field
 
@@ -25,7 +26,7 @@ from .errors import ParameterError
 from .mechanisms import Mechanism
 from .mechanisms.sixleg import SixLeg
 from .mechanisms.sixleg_layout import paired_sixleg
-from .quantities import Angle, PositiveLength, Vector3, _angle_window, _Invalid, _stroke
+from .quantities import Angle, AngleWindow, PositiveLength, Stroke, Vector3
 from .specbase import PairedCircles, _Common, _Model
 
 __all__ = ["SixLegSpec"]
@@ -93,20 +94,14 @@ class SixLegCircles(PairedCircles):
     actuator: ActuatorTemplate
 
 
-def _window(value: Any, angles: bool) -> list[float]:
-    try:
-        return _angle_window(value) if angles else _stroke(value)
-    except _Invalid as exc:
-        text = str(exc).removeprefix("must be ").split("; got")[0]
-        raise ParameterError("stroke", text, value) from None
-
-
 class SixLegSpec(_Common):
     """Generic six-leg mechanism: explicit ``legs`` or a ``generator``."""
 
     family: Literal["sixleg"]
-    stroke: Any = Field(description="shared actuator window [min, max]: lengths (prismatic, "
-                        "slider) or servo angles (crank)")
+    stroke: Stroke | None = Field(None, description="shared actuator window [min, max] of "
+                                  "prismatic and slider legs (lengths)")
+    servo_range: AngleWindow | None = Field(None, description="shared servo-angle window "
+                                            "[min, max] of crank legs (deg or with units)")
     legs: list[LegSpec] | None = Field(None, min_length=6, max_length=6)
     generator: SixLegCircles | None = None
 
@@ -121,14 +116,14 @@ class SixLegSpec(_Common):
         if self.generator is not None:
             g = self.generator.model_dump()
             a = g.pop("actuator")
-            stroke = _window(self.stroke, a["kind"] == "crank")
+            stroke = self._window(a["kind"] == "crank")
             b = a.pop("branch")
             branch = None if b == "auto" else float(b)
             return paired_sixleg(actuator=a.pop("kind"), **g, **a, branch=branch,
                                  stroke=stroke, tool_offset=self.tool_offset, **kw)
         acts = [leg.actuator for leg in self.legs]
         kinds = [a.kind for a in acts]
-        stroke = _window(self.stroke, all(k == "crank" for k in kinds))
+        stroke = self._window(all(k == "crank" for k in kinds))
         z3 = [0.0, 0.0, 0.0]
         return SixLeg([leg.base for leg in self.legs], [leg.platform for leg in self.legs],
                       kinds, [getattr(a, "axis", z3) for a in acts],
@@ -137,3 +132,13 @@ class SixLegSpec(_Common):
                       [getattr(a, "link_length", getattr(a, "rod_length", 0.0)) for a in acts],
                       stroke, [float(getattr(a, "branch", -1)) for a in acts],
                       self.tool_offset, **kw)
+
+    def _window(self, cranks: bool) -> list[float]:
+        given, other = ("servo_range", "stroke") if cranks else ("stroke", "servo_range")
+        if getattr(self, other) is not None:
+            raise ParameterError(other, f"absent: these legs take '{given}' (" + (
+                "servo angles" if cranks else "lengths") + ")", "given")
+        if getattr(self, given) is None:
+            raise ParameterError(given, "given: the legs' shared actuator window [min, max]",
+                                 None)
+        return getattr(self, given)

@@ -187,7 +187,8 @@ class SixLeg(Mechanism):
         link_length: ``(6,)`` slider link or crank rod lengths (mm), 0 for prismatic legs.
         branch: ``(6,)`` ±1: slider and crank branches (default -1); unused for prismatic legs,
             whose working-mode side is taken from the nominal pose as in ``ups6``.
-        stroke_window: shared actuator window (min, max): mm, or rad for cranks.
+        stroke_window: shared actuator window (min, max): mm, or rad for cranks (YAML
+            ``stroke`` or ``servo_range``).
         tool_offset: ``(3,)`` tool-frame origin in the platform frame (mm).
     """
 
@@ -224,8 +225,8 @@ class SixLeg(Mechanism):
         "rail_heading": ("generator.actuator.rail_heading", "text"),
         "crank_length": ("generator.actuator.crank_length", "length"),
         "rod_length": ("generator.actuator.rod_length", "length"),
-        "servo_min": ("stroke[0]", "angle"),
-        "servo_max": ("stroke[1]", "angle"),
+        "servo_min": ("servo_range[0]", "angle"),
+        "servo_max": ("servo_range[1]", "angle"),
     }
     column_radial: ClassVar[bool] = True
     column_leg = _sixleg_column_leg
@@ -260,9 +261,9 @@ class SixLeg(Mechanism):
         set_(self, "link_length", _per_leg(self.link_length, "link_length", slider | crank))
         set_(self, "branch", _per_leg(self.branch, "branch", slider | crank, positive=False))
         if crank.all():
-            w = as_stroke(self.stroke_window, "stroke")
+            w = as_stroke(self.stroke_window, "servo_range")
             if not (-math.pi <= w[0] and w[1] <= math.pi):
-                raise ParameterError("stroke", "[min, max] servo angles with -180 deg <= min "
+                raise ParameterError("servo_range", "[min, max] servo angles with -180 deg <= min "
                                      "< max <= 180 deg", np.degrees(w).tolist())
         else:
             w = as_stroke(self.stroke_window, "stroke", positive=bool(np.all(codes == 0.0)))

@@ -81,11 +81,15 @@ def paired_sixleg(*, actuator: str, base_radii, platform_radii, base_pair_angle=
     if actuator == "crank":
         _need(crank_length, "crank_length")
         _need(rod_length, "rod_length")
-        return _declared(RSS6.from_circles(**layout, crank_length=crank_length,
-                                           rod_length=rod_length, crank_plane=crank_plane,
-                                           zero_direction=zero_direction,
-                                           branch=-1.0 if branch is None else branch, **kw),
-                         actuator)
+        try:
+            rss = RSS6.from_circles(**layout, crank_length=crank_length, rod_length=rod_length,
+                                    crank_plane=crank_plane, zero_direction=zero_direction,
+                                    branch=-1.0 if branch is None else branch, **kw)
+        except ParameterError as exc:       # the sixleg YAML calls the servo window so
+            if exc.field != "stroke":
+                raise
+            raise ParameterError("servo_range", exc.allowed, exc.got) from None
+        return _declared(rss, actuator)
     if actuator != "slider":
         raise ParameterError("actuator.kind", "one of ['prismatic', 'slider', 'crank']",
                              actuator)
