@@ -236,7 +236,7 @@ def _core(leg):
                 jxx = r[0] * ex + r[1] * ey + r[2] * ez
                 jxy = r[3] * ex + r[4] * ey + r[5] * ez
                 jxz = r[6] * ex + r[7] * ey + r[8] * ez
-                qx, qy, qz = ux, ca * uy - sa * uz, sa * uy + ca * uz      # Rx·u
+                qx, qz = ux, sa * uy + ca * uz                             # Rx·u (x, z)
                 kx, ky, kz = qz, 0.0, -qx                                  # e_y × Rx·u
                 mx, my, mz = cb * kx + sb * kz, ky, -sb * kx + cb * kz     # Ry·(...)
                 jyx, jyy, jyz = cc * mx - sc * my, sc * mx + cc * my, mz  # Rz·(...)
