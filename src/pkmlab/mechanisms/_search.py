@@ -55,6 +55,8 @@ DPAD = 1e-6
 UB_TOL = 1e-9
 #: the best point of a sample is searched to this margin (mm) before it is certified
 MAX_EPS = 1e-2
+#: half-width (mm) of the region around the sample's witness searched for the point to certify
+LOCAL_MM = 5.0
 #: initial capacity of the tile and cell stacks (grown when needed)
 STACK = 4096
 
@@ -392,10 +394,15 @@ def make_capability(leg):
         cx, cy, cz = wx, wy, wz
         cells = 0
         first = True
+        # near the capability the sample's positions lie close to its witness: the best
+        # point is searched around it (any certified point will do)
+        near = np.empty(4)
+        near[0], near[1] = max(box[0], wx - LOCAL_MM), min(box[1], wx + LOCAL_MM)
+        near[2], near[3] = max(box[2], wy - LOCAL_MM), min(box[3], wy + LOCAL_MM)
         while chi - clo > tol or first:
             mid = chi if first else 0.5 * (clo + chi)
             sample(U, Bp, e0, mid, n, W)
-            branch_bound(W, M, P, box, h0, min_size, MAX_EPS, False, r)
+            branch_bound(W, M, P, near, 0.5 * LOCAL_MM, min_size, MAX_EPS, False, r)
             calls += 1
             ok = False
             if r[BB_F] >= 0.0:
