@@ -345,8 +345,8 @@ def make_capability(leg):
     the orientation capability in one call (module notes). ``out``: theta_lo (certified),
     theta_hi (sample empty at every position), sampled theta (witness), its x, y, z, the
     certified point x, y, z, flags (1: not bounded below theta_max, 2: nominal empty, 4: an
-    undecided branch and bound, 8: certification undecided), branch-and-bound calls,
-    certification cells."""
+    undecided branch and bound, 8: certification undecided or ``budget`` cells spent; one
+    certification gets a quarter of it), branch-and-bound calls, certification cells."""
     core = _core(leg)
     sample, branch_bound, certify = core["sample"], core["branch_bound"], core["certify"]
 
@@ -407,7 +407,7 @@ def make_capability(leg):
             ok = False
             if r[BB_F] >= 0.0:
                 px, py, pz = r[BB_X], r[BB_Y], 0.5 * (r[BB_ZLO] + r[BB_ZHI])
-                st, c = certify(U, Bp, P, e0, mid, px, py, pz, min_half, budget)
+                st, c = certify(U, Bp, P, e0, mid, px, py, pz, min_half, budget // 4)
                 cells += c
                 if st == 1:
                     ok = True
@@ -417,6 +417,9 @@ def make_capability(leg):
             if not ok:
                 chi = mid
             first = False
+            if cells > budget:            # the whole certification's budget is spent
+                flags |= 8
+                break
         out[0], out[6], out[7], out[8] = clo, cx, cy, cz
         out[9], out[10], out[11] = flags, calls, cells
 

@@ -66,9 +66,11 @@ STROKE_TOL_MM = 0.01
 MIN_TILE_MM = 1e-4
 #: first tiles of the branch and bound (mm)
 FIRST_TILE_MM = 40.0
-#: smallest orientation cell half-width of the certification (rad) and cell budget
+#: smallest orientation cell half-width of the certification (rad); cell budget of one
+#: certification (stroke) and of all the capability's certifications together
 MIN_HALF_RAD = 1e-7
 CELL_BUDGET = 300_000
+CAPABILITY_CELL_BUDGET = 600_000
 
 
 @dataclass(frozen=True)
@@ -135,7 +137,7 @@ def orientation_capability(mech, samples: int = 7, tol_deg: float = CAPABILITY_T
     cap = _search.make_capability(type(mech).column_leg)
     out = np.empty(12)
     cap(U, B, P, e0, int(samples), box, FIRST_TILE_MM, math.radians(max_deg),
-        math.radians(tol_deg), MIN_TILE_MM, MIN_HALF_RAD, CELL_BUDGET, out)
+        math.radians(tol_deg), MIN_TILE_MM, MIN_HALF_RAD, CAPABILITY_CELL_BUDGET, out)
     flags = int(out[9])
     notes = []
     if flags & 2:
@@ -147,7 +149,8 @@ def orientation_capability(mech, samples: int = 7, tol_deg: float = CAPABILITY_T
         notes.append("a branch and bound was undecided (margin within 1e-9 mm of zero on a "
                      f"{MIN_TILE_MM:g} mm tile); the upper end stops there")
     if flags & 8:
-        notes.append("certification undecided above the lower end (cell budget)")
+        notes.append(f"certification stopped by its budget ({CAPABILITY_CELL_BUDGET:,} "
+                     "orientation cells): the lower end is certified, the truth may lie higher")
     lower, upper, sampled = (math.degrees(v) for v in out[:3])
     if flags & 1:
         upper = math.inf
