@@ -57,6 +57,10 @@ UB_TOL = 1e-9
 MAX_EPS = 1e-2
 #: half-width (mm) of the region around the sample's witness searched for the point to certify
 LOCAL_MM = 5.0
+#: orientations that refuted a point, kept for choosing the next (at most), and the attempts
+#: per level
+CUTS = 64
+CUTS_PER_LEVEL = 6
 #: initial capacity of the tile and cell stacks (grown when needed)
 STACK = 4096
 
@@ -200,10 +204,10 @@ def _core(leg):
         out[BB_STATUS], out[BB_F], out[BB_X], out[BB_Y] = status, best, bx, by
         out[BB_ZLO], out[BB_ZHI], out[BB_UB], out[BB_TILES] = bzl, bzh, max(gub, best), tiles
 
-    def certify(U, Bp, P, e0, theta, x, y, z, min_half, budget):
+    def certify(U, Bp, P, e0, theta, x, y, z, min_half, budget, bad):
         """1: ``(x, y, z)`` holds for every orientation of the box e0 ± theta; 0: refuted (an
-        orientation of the box fails it); -1: undecided (cells below ``min_half`` rad or more
-        than ``budget`` cells). Returns ``(status, cells)``."""
+        orientation of the box fails it, written to ``bad``); -1: undecided (cells below
+        ``min_half`` rad or more than ``budget`` cells). Returns ``(status, cells)``."""
         ulen = np.empty(6)
         for s in range(6):
             ulen[s] = math.sqrt(U[s, 0] ** 2 + U[s, 1] ** 2 + U[s, 2] ** 2)
@@ -228,6 +232,7 @@ def _core(leg):
                 wx, wy, wz = vx - Bp[s, 0], vy - Bp[s, 1], vz - Bp[s, 2]
                 a, b, ok = leg(x, y, wx, wy, wz, P[s, 0], P[s, 1], P[s, 2])
                 if not ok or z < a or z > b:
+                    bad[0], bad[1], bad[2] = tx, ty, tz
                     return 0, cells          # the cell's centre orientation fails
                 if not good:
                     continue
@@ -331,7 +336,7 @@ def make_certify(leg):
     certify = core["certify"]
 
     def cert(U, Bp, P, e0, theta, x, y, z, min_half, budget, out):
-        s, c = certify(U, Bp, P, e0, theta, x, y, z, min_half, budget)
+        s, c = certify(U, Bp, P, e0, theta, x, y, z, min_half, budget, np.empty(3))
         out[0], out[1] = s, c
 
     f8 = nt.float64
@@ -399,21 +404,61 @@ def make_capability(leg):
         near = np.empty(4)
         near[0], near[1] = max(box[0], wx - LOCAL_MM), min(box[1], wx + LOCAL_MM)
         near[2], near[3] = max(box[2], wy - LOCAL_MM), min(box[3], wy + LOCAL_MM)
+        # orientations that refuted a point join the sample (as unit-box coordinates, scaled
+        # to each level): the next point is chosen against them too
+        X = np.empty((M + CUTS, 6, 3))
+        extra = np.empty((CUTS, 3))
+        ne = 0
+        bad = np.empty(3)
+        # levels from the sampled one downwards in doubling steps until one is certified,
+        # then bisection (an uncertifiable level near the capability costs many cells; one
+        # well below it few)
+        step = 10.0 * tol
+        found = False
         while chi - clo > tol or first:
-            mid = chi if first else 0.5 * (clo + chi)
-            sample(U, Bp, e0, mid, n, W)
-            branch_bound(W, M, P, near, 0.5 * LOCAL_MM, min_size, MAX_EPS, False, r)
-            calls += 1
+            if first:
+                mid = chi
+            elif found:
+                mid = 0.5 * (clo + chi)
+            else:
+                mid = max(chi - step, 0.5 * (clo + chi) if clo > 0.0 else 0.0, 0.0)
+                step *= 2.0
             ok = False
-            if r[BB_F] >= 0.0:
+            for _ in range(CUTS_PER_LEVEL):
+                sample(U, Bp, e0, mid, n, X)
+                for k in range(ne):
+                    tx = e0[0] + extra[k, 0] * mid
+                    ty = e0[1] + extra[k, 1] * mid
+                    tz = e0[2] + extra[k, 2] * mid
+                    rr = _kernels._euler_matrix(math.sin(tx), math.cos(tx), math.sin(ty),
+                                                math.cos(ty), math.sin(tz), math.cos(tz))
+                    for s in range(6):
+                        ux, uy, uz = U[s, 0], U[s, 1], U[s, 2]
+                        X[M + k, s, 0] = rr[0] * ux + rr[1] * uy + rr[2] * uz - Bp[s, 0]
+                        X[M + k, s, 1] = rr[3] * ux + rr[4] * uy + rr[5] * uz - Bp[s, 1]
+                        X[M + k, s, 2] = rr[6] * ux + rr[7] * uy + rr[8] * uz - Bp[s, 2]
+                branch_bound(X, M + ne, P, near, 0.5 * LOCAL_MM, min_size, MAX_EPS, False, r)
+                calls += 1
+                if not r[BB_F] >= 0.0:
+                    break
                 px, py, pz = r[BB_X], r[BB_Y], 0.5 * (r[BB_ZLO] + r[BB_ZHI])
-                st, c = certify(U, Bp, P, e0, mid, px, py, pz, min_half, budget // 4)
+                st, c = certify(U, Bp, P, e0, mid, px, py, pz, min_half, budget // 8, bad)
                 cells += c
                 if st == 1:
                     ok = True
+                    found = True
                     clo, cx, cy, cz = mid, px, py, pz
-                elif st == -1:
+                    break
+                if st == -1:
                     flags |= 8
+                    break
+                if ne == CUTS or mid == 0.0:
+                    break
+                for k in range(3):
+                    extra[ne, k] = (bad[k] - e0[k]) / mid
+                ne += 1
+                if cells > budget:
+                    break
             if not ok:
                 chi = mid
             first = False
