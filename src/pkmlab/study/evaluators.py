@@ -173,8 +173,12 @@ def _capability(mech, ctx: Context) -> dict:
                                        "family or these constraints)"]))
     if note:
         ctx.notes["orientation_capability"] = note
-    return {"orientation_capability": a, "orientation_capability_upper": _finite(upper),
-            "orientation_capability_bracket": _finite(upper - a)}
+    out = {"orientation_capability": a, "orientation_capability_upper": _finite(upper),
+           "orientation_capability_bracket": _finite(upper - a)}
+    for name in ("orientation_capability_upper", "orientation_capability_bracket"):
+        if out[name] is None:
+            ctx.notes[name] = "no upper end: the search's largest box has a dexterous position"
+    return out
 
 
 @_evaluator("dexterity")
