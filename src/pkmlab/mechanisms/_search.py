@@ -33,7 +33,9 @@ the method; in short:
   eight otherwise.
 * :func:`make_capability`: the whole orientation-capability search in one call — bisection on
   ``θ`` with the branch and bound (upper end: the sample of the ±θ box found empty at every
-  continuous position), then a bisection for the certified lower end.
+  continuous position), then the certified lower end: levels from the sampled one down in
+  doubling steps, then bisection; at each level the best point near the witness is certified,
+  and an orientation that refutes it joins the sample for the next point (cutting planes).
 """
 
 from __future__ import annotations

@@ -20,13 +20,16 @@ dexterous workspace of the continuous box is non-empty). One compiled call
   cells, and on a cell each leg's offset ``w = R·u - b`` stays within ``|u|·3δ`` of its value
   at the cell's centre (δ the cell's half-width), so the leg's interval is bounded from the
   interval at the ball's extreme distances and heights; cells are split until every cell is
-  certified (or one's centre orientation fails ``p``). The point is the best one of the
-  sample at that ``θ`` (largest margin, to 0.01 mm); ``θ`` is bisected to ``tol``.
+  certified (or one's centre orientation fails ``p``). The point is the best one (largest
+  margin, to 0.01 mm) within 5 mm of the sample's witness, against the sample at that ``θ``
+  plus the orientations that refuted earlier points. ``θ`` steps down from the sampled level
+  in doubling steps until a level is certified, then is bisected to ``tol``, within a budget
+  of orientation cells (the note says when it ran out; the lower end is certified anyway).
 * ``sampled``: the largest ``θ`` whose sample has a position (a witness), to ``tol``.
 
-``upper`` and ``sampled`` are bisected to ``tol`` (0.01°), so the bracket is ``upper - lower``
-wide; it is wider than ``tol`` only when the sample misses orientations that matter
-(certification then fails above ``lower``).
+``upper`` and ``sampled`` are bisected to ``tol`` (0.01°). The bracket ``upper - lower`` is
+wider than ``tol`` when the sample misses orientations that bind or the cell bounds are loose
+(links near horizontal): certification then fails or runs out of budget above ``lower``.
 
 **Needed stroke** (:func:`stroke_needed`) — for an orientation set (a simultaneous box with
 equal half-ranges), the smallest upper actuator limit ``q_max`` (the lower limit kept) for which
