@@ -21,9 +21,12 @@ The kept pairs give each column the same maximum and minimum as all pairs (a max
 subset that contains the extreme element is that element, bit for bit), so the intervals are
 identical to :func:`._kernels.make_column_kernel`'s ``columns_all`` (tested on the 6-PSU and the
 6-UPS). The distances are padded by :data:`DPAD` and the comparisons by :data:`SLACK`, so that
-rounding in the distance of a column cannot make a pruned pair the extreme one. Tiles are
-visited in parallel; inside a tile the kept pairs run over the tile's columns in a vectorised
-loop, the hardest (most tilted) orientations first as in ``columns_all``.
+rounding in the distance of a column cannot make a pruned pair the extreme one (the leg
+functions are monotone in the computed distance under rounding, too: squares, differences and
+``sqrt`` are). Top-level tiles of :data:`TILE` × :data:`TILE` columns are visited in parallel;
+each is split in four, depth first, down to :data:`LEAF` × :data:`LEAF`, every level bounding
+only the pairs its parent kept; at a leaf the kept pairs run over its columns, the hardest
+(most tilted) orientations first as in ``columns_all``.
 """
 
 from __future__ import annotations
