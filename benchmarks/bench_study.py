@@ -1,9 +1,10 @@
 """Candidates per second for the demo study's evaluation (studies/hopkins-6psu-redesign.yaml).
 
 Evaluates Sobol samples of the demo study's design space with its full evaluation (±15°
-dexterous workspace, orientation capability by bisection, Monte-Carlo GCI, the paper's motion)
-on 2 joblib workers, after one warm-up batch per worker (numba compilation), and prints the
-rate and the time 5,000 candidates take at that rate. ``--full`` evaluates all 5,000.
+dexterous workspace, orientation capability over continuous positions, Monte-Carlo GCI, the
+paper's motion) on 2 joblib workers, after one warm-up batch per worker (numba
+compilation), and prints the rate and the time 5,000 candidates take at that rate.
+``--full`` evaluates all 5,000.
 Target on 2 cores: 5,000 candidates in ≤ 5 minutes.
 """
 

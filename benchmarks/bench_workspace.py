@@ -99,6 +99,88 @@ def peak_memory_1mm() -> float:
     return float(out.stdout.strip().splitlines()[-1])
 
 
+def load() -> str:
+    """The machine's load averages (``uptime``), quoted with every timing."""
+    return subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
+
+
+def ups_pruning(columns: int = 300, seed: int = 0) -> None:
+    """The shipped 6-UPS (legs 390-950 mm), ±10° simultaneous dexterous, 7³ orientations,
+    2.5 mm: the public call (tile pruning, :mod:`pkmlab.mechanisms._tiles`), the plain column
+    kernel without pruning, and a plain NumPy brute force (every voxel × orientation × leg)
+    run on ``columns`` random columns of the same grid and extrapolated to all of them."""
+    from pkmlab.mechanisms import _kernels
+
+    big = load_mechanism(ROOT / "studies/mechanisms/gough-stewart-6ups.yaml")
+    box = OrientationSet.box(np.radians([10.0] * 3), "simultaneous", samples=7)
+    print(f"6-UPS pruning, load: {load()}")
+    t_fast, res = timed(lambda: workspace(big, "dexterous", box, H), 5)
+    R = res.orientations.rotations()
+    xs, ys, zb = _grid_xy(big, R, "all", H)
+    zs = np.arange(math.ceil(zb[0] / H), math.floor(zb[1] / H) + 1) * H
+    W = big.leg_offsets(R)
+    W = _kernels.carray(W[np.argsort(-np.linalg.norm(R - np.eye(3), axis=(1, 2)),
+                                     kind="stable")])
+    lo, hi = np.empty((len(xs), len(ys), 1)), np.empty((len(xs), len(ys), 1))
+    plain = _kernels.make_column_kernel(type(big).column_leg, "all")
+    t_plain, _ = timed(lambda: plain(_kernels.carray(xs), _kernels.carray(ys), W,
+                                     _kernels.carray(big.column_params()), lo, hi), 3)
+    tlo, thi, _ = big.column_intervals(xs, ys, R, "all")
+    same = np.array_equal(lo, tlo) and np.array_equal(hi, thi)
+    rng = np.random.default_rng(seed)
+    ix, iy = rng.integers(0, len(xs), columns), rng.integers(0, len(ys), columns)
+    t0 = time.perf_counter()
+    brute = brute_force_columns(big, R, xs[ix], ys[iy], zs)
+    t_sub = time.perf_counter() - t0
+    t_brute = t_sub * len(xs) * len(ys) / columns
+    # the brute force agrees with the exact intervals on the sampled columns (voxel centres)
+    inside = (zs[None] >= lo[ix, iy, 0][:, None]) & (zs[None] <= hi[ix, iy, 0][:, None])
+    print(f"  grid {len(xs)} x {len(ys)} columns x {len(zs)} z, {len(R)} orientations")
+    print(f"  public call (tile pruning)  : {t_fast * 1e3:8.1f} ms (median of 5)")
+    print(f"  plain column kernel         : {t_plain * 1e3:8.1f} ms  -> pruning "
+          f"{t_plain / t_fast:.1f}x")
+    print(f"  NumPy brute force           : {t_sub:.2f} s on {columns} random columns, "
+          f"extrapolated {t_brute:.0f} s")
+    print(f"  ratio vs brute force        : {t_brute / t_fast:8.0f}x   (target >= 1000x)")
+    print(f"  pruned == plain intervals   : {'yes' if same else 'NO'}; brute force agrees on "
+          f"the sampled columns: {'yes' if np.array_equal(inside, brute) else 'NO'}")
+    print(f"  load after: {load()}")
+
+
+def brute_force_columns(mech, R, x, y, zs):
+    """Plain NumPy on the columns ``(x[k], y[k])``: ``(k, nz)`` inside flags (6-UPS legs within
+    stroke on their working-mode side)."""
+    p = np.stack(np.broadcast_arrays(x[:, None], y[:, None], zs[None]), -1).reshape(-1, 3)
+    u, B = mech.tool_points, mech.base_points
+    lo, hi = mech.stroke
+    ok = np.ones(len(p), dtype=bool)
+    for Rm in R:
+        W = p[:, None, :] + (u @ Rm.T)[None] - B[None]
+        q = np.linalg.norm(W, axis=-1)
+        ok &= ((q >= lo) & (q <= hi) & (W[..., 2] > 0)).all(axis=1)
+    return ok.reshape(len(x), len(zs))
+
+
+def capability_cost(repeats: int = 3) -> None:
+    """Orientation capability per candidate, Hopkins & Williams 6-PSU, 5 samples per angle:
+    before (bisection over full 2.5 mm workspaces, ``study.evaluators.capability``) and after
+    (one compiled search over continuous positions, ``workspaces.optima``)."""
+    from pkmlab.study.evaluators import capability
+    from pkmlab.workspaces.optima import orientation_capability
+
+    psu = load_mechanism(ROOT / "studies/mechanisms/hopkins-williams-6psu.yaml")
+    req = {"orientations": OrientationSet.box(np.radians([5.0] * 3), samples=5),
+           "resolution": H, "constraints": Constraints()}
+    print(f"capability per candidate, load: {load()}")
+    t_old, old = timed(lambda: capability(psu, req), repeats)
+    t_new, new = timed(lambda: orientation_capability(psu, 5), repeats)
+    print(f"  before (grid bisection)     : {t_old * 1e3:8.1f} ms  -> {old[0]:.3f}° "
+          f"(+{old[1]:.3f}° bracket, grid columns)")
+    print(f"  after (continuous, 1 call)  : {t_new * 1e3:8.1f} ms  -> [{new.lower:.4f}°, "
+          f"{new.upper:.4f}°] certified bracket")
+    print(f"  load after: {load()}")
+
+
 def main() -> None:
     psu = load_mechanism(ROOT / "studies/mechanisms/hopkins-williams-6psu.yaml")
     compare("6-PSU Hopkins & Williams, ±15° simultaneous dexterous, 2.5 mm, 7x7x7", psu,
@@ -116,6 +198,8 @@ def main() -> None:
               f"(exactness: tests/test_workspace.py)")
     print(f"peak memory, 6-PSU case at 1 mm with mesh: {peak_memory_1mm():.0f} MB "
           "(target < 1024 MB)")
+    ups_pruning()
+    capability_cost()
 
 
 if __name__ == "__main__":

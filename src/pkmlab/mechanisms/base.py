@@ -51,7 +51,7 @@ from scipy.spatial.transform import Rotation
 from ..errors import ParameterError
 from ..poses import as_frames, log_so3
 from ..tolerances import TOL
-from . import _kernels
+from . import _kernels, _tiles
 from .results import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult
 from .solvers import forward_newton, multistart_modes
 
@@ -186,7 +186,11 @@ class Mechanism:
             # Most tilted orientations first: dead columns then die after a few of them.
             W = W[np.argsort(-np.linalg.norm(R - np.eye(3), axis=(1, 2)), kind="stable")]
             lo, hi = np.empty((nx, ny, 1)), np.empty((nx, ny, 1))
-            columns_all = _kernels.make_column_kernel(type(self).column_leg, "all")
+            # large footprints of radial families: tiles of columns bounded first, most
+            # leg × orientation pairs pruned (exact, :mod:`._tiles`)
+            tiled = self.column_radial and nx * ny >= _tiles.MIN_COLUMNS
+            columns_all = (_tiles.make_tiled_all(type(self).column_leg) if tiled
+                           else _kernels.make_column_kernel(type(self).column_leg, "all"))
             columns_all(xs, ys, _kernels.carray(W), P, lo, hi)
             return lo, hi, 0
         if allowed is None:

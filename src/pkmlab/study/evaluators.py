@@ -37,6 +37,7 @@ from ..requirements.task import task_margins
 from ..trajectory import check_trajectory, paper_motion
 from ..workspaces import OrientationSet, workspace
 from ..workspaces.engine import SINGULAR_NOTE
+from ..workspaces.optima import orientation_capability, supports_continuous
 from .metrics import metrics_of
 
 log = logging.getLogger(__name__)
@@ -124,7 +125,9 @@ def _inscribed(mech, ctx: Context) -> dict:
 
 def capability(mech, request: dict, iterations: int = 8) -> tuple[float, float, str]:
     """Largest ``a`` (deg) whose ±a simultaneous Euler box has a non-empty dexterous workspace
-    on ``request``'s grid, by bisection → ``(a, bracket, note)``.
+    on ``request``'s grid, by bisection → ``(a, bracket, note)``: the fallback for families
+    without radial column intervals or with constraints beyond the stroke (radial families
+    use :func:`pkmlab.workspaces.optima.orientation_capability`, continuous positions).
 
     The verified level ``a`` is non-empty and ``a + bracket`` was found empty (so the value is
     a lower bound of the grid's capability to within ``bracket``); ``note`` is non-empty when
@@ -156,10 +159,26 @@ def capability(mech, request: dict, iterations: int = 8) -> tuple[float, float, 
 
 @_evaluator("orientation_capability")
 def _capability(mech, ctx: Context) -> dict:
-    a, bracket, note = capability(mech, ctx.evaluation.request)
+    req = ctx.evaluation.request
+    oset = req["orientations"]
+    samples = oset.samples if oset.kind == "box" else 7
+    if supports_continuous(mech, req["constraints"]):
+        # continuous positions, one compiled search, certified bracket (workspaces.optima)
+        b = orientation_capability(mech, samples)
+        a, upper, note = b.lower, b.upper, b.note
+    else:
+        a, bracket, note = capability(mech, req)
+        upper = a + bracket
+        note = "; ".join(filter(None, [note, "grid bisection (no continuous search for this "
+                                       "family or these constraints)"]))
     if note:
         ctx.notes["orientation_capability"] = note
-    return {"orientation_capability": a, "orientation_capability_bracket": bracket}
+    out = {"orientation_capability": a, "orientation_capability_upper": _finite(upper),
+           "orientation_capability_bracket": _finite(upper - a)}
+    for name in ("orientation_capability_upper", "orientation_capability_bracket"):
+        if out[name] is None:
+            ctx.notes[name] = "no upper end: the search's largest box has a dexterous position"
+    return out
 
 
 @_evaluator("dexterity")

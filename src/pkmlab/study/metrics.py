@@ -12,8 +12,8 @@ Kinds of number (``statistic``):
 * ``worst-case`` — the extreme over *every* voxel of the workspace grid and *every* sample of
   its orientation set (never a random sample's extreme), or over every sample of every
   required motion and every actuator;
-* ``bound`` — a bracketed optimum: the value is the largest verified level, the bracket the
-  search resolution (``<name>_bracket``);
+* ``bound`` — a bracketed optimum: the value is the largest verified level, the bracket
+  (``<name>_bracket``, and ``<name>_upper`` where given) how far above it the truth can be;
 * ``sampled`` — a Monte-Carlo statistic over random poses (its name says so, or it carries a
   standard error);
 * ``flag`` — 1 or 0.
@@ -80,10 +80,16 @@ _ALL = [
     # orientation capability
     Metric("orientation_capability", "orientation_capability", "deg", "bound",
            "largest a such that the ±a simultaneous Euler box has a non-empty dexterous "
-           "workspace on the study's grid: the largest level verified by bisection"),
+           "workspace: lower end of the bracket, a position certified for the continuous "
+           "box (psu6, ups6, stroke only; other families: the largest grid level verified "
+           "by bisection)"),
+    Metric("orientation_capability_upper", "orientation_capability", "deg", "bound",
+           "upper end of the bracket: the box's orientation sample admits no position, "
+           "proved by branch and bound over continuous positions (other families: the "
+           "first grid level found empty)"),
     Metric("orientation_capability_bracket", "orientation_capability", "deg", "bound",
-           "width of the bisection bracket above orientation_capability (the first level "
-           "found empty lies this much higher)"),
+           "orientation_capability_upper - orientation_capability (the bisections run to "
+           "0.01°)"),
     # dexterity
     Metric("nominal_kappa", "dexterity", "", "exact",
            "κ of the homogenised Jacobian at the nominal pose"),

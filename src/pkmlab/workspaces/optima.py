@@ -1,0 +1,249 @@
+"""Continuous optima with a bracket: orientation capability and the stroke a set needs.
+
+Both are found over *continuous* positions, not over the grid columns of a workspace, for
+families with radial column intervals (``Mechanism.column_radial``: ``psu6``, ``ups6``) and the
+stroke constraint alone. The kernels are in :mod:`pkmlab.mechanisms._search`; this module
+states what their numbers mean.
+
+**Orientation capability** — the largest ``θ`` such that some position keeps every leg within
+its stroke at *every* orientation of the simultaneous Euler box ``nominal ± θ`` (the
+dexterous workspace of the continuous box is non-empty). One compiled call
+(:func:`orientation_capability`) returns a bracket ``[lower, upper]`` that contains it:
+
+* ``upper``: the box's sample (``samples`` angles per axis, corners included) admits *no*
+  position. The search is a branch and bound over continuous ``(x, y)``: a tile of positions
+  is discarded when an upper bound of the column margin ``min b - max a`` over the whole tile
+  (from the monotone radial leg intervals at the tile's nearest and farthest distance from
+  each leg's axis) is negative; tiles are split down to 1e-4 mm. z is exact per column.
+  Every larger box contains this sample, so no larger box has a dexterous position either.
+* ``lower``: a point ``p`` (reported) certified for the continuous box: the box is split into
+  cells, and on a cell each leg's offset ``w = R·u - b`` stays within ``|u|·3δ`` of its value
+  at the cell's centre (δ the cell's half-width), so the leg's interval is bounded from the
+  interval at the ball's extreme distances and heights; cells are split until every cell is
+  certified (or one's centre orientation fails ``p``). The point is the best one (largest
+  margin, to 0.01 mm) within 5 mm of the sample's witness, against the sample at that ``θ``
+  plus the orientations that refuted earlier points. ``θ`` steps down from the sampled level
+  in doubling steps until a level is certified, then is bisected to ``tol``, within a budget
+  of orientation cells (the note says when it ran out; the lower end is certified anyway).
+* ``sampled``: the largest ``θ`` whose sample has a position (a witness), to ``tol``.
+
+``upper`` and ``sampled`` are bisected to ``tol`` (0.01°). The bracket ``upper - lower`` is
+wider than ``tol`` when the sample misses orientations that bind or the cell bounds are loose
+(links near horizontal): certification then fails or runs out of budget above ``lower``.
+
+**Needed stroke** (:func:`stroke_needed`) — for an orientation set (a simultaneous box with
+equal half-ranges), the smallest upper actuator limit ``q_max`` (the lower limit kept) for which
+the dexterous workspace is non-empty: ``lower`` the largest ``q_max`` at which the sample admits
+no continuous position (branch and bound), ``upper`` the smallest at which a point is
+certified for the continuous box; both bisected to ``tol`` (0.01 mm).
+
+The grid engine's answers lie below these: a grid column is one continuous position.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..limits import CAPABILITY_MAX_DEG
+from ..mechanisms import _kernels, _search
+from ..poses import as_frames, matrix_to_euler
+from .orientations import OrientationSet
+
+log = logging.getLogger(__name__)
+
+__all__ = ["OptimumBracket", "orientation_capability", "stroke_needed", "supports_continuous",
+           "CAPABILITY_TOL_DEG", "STROKE_TOL_MM"]
+
+#: bisection tolerance of the capability (deg)
+CAPABILITY_TOL_DEG = 0.01
+#: bisection tolerance of the needed stroke (mm)
+STROKE_TOL_MM = 0.01
+#: smallest tile of the branch and bound (mm)
+MIN_TILE_MM = 1e-4
+#: first tiles of the branch and bound (mm)
+FIRST_TILE_MM = 40.0
+#: smallest orientation cell half-width of the certification (rad); cell budget of one
+#: certification (stroke) and of all the capability's certifications together
+MIN_HALF_RAD = 1e-7
+CELL_BUDGET = 300_000
+CAPABILITY_CELL_BUDGET = 600_000
+
+
+@dataclass(frozen=True)
+class OptimumBracket:
+    """A continuous optimum and the bracket that contains it.
+
+    ``lower`` and ``upper`` bound the true value (method in the module notes), ``sampled``
+    is the value for the orientation sample, ``point`` the certified position (mm, base
+    frame) at ``lower``; ``note`` says why a bracket is wider or open."""
+
+    name: str
+    unit: str
+    lower: float
+    upper: float
+    sampled: float
+    point: tuple
+    samples: int
+    method: str
+    note: str = ""
+    seconds: float = 0.0
+
+    @property
+    def width(self) -> float:
+        return self.upper - self.lower
+
+    def as_dict(self) -> dict:
+        return dataclasses.asdict(self) | {"width": self.width}
+
+
+def supports_continuous(mech, constraints=None) -> bool:
+    """True when the continuous search applies: radial column intervals, stroke only."""
+    extra = bool(constraints is not None and constraints.extra)
+    return bool(type(mech).column_radial) and mech.column_method is not None and not extra
+
+
+def _inputs(mech):
+    _, Rn = as_frames(mech.nominal_pose)
+    e0 = _kernels.carray(np.array(matrix_to_euler(Rn[0]), dtype=float))
+    U = _kernels.carray(np.array(mech.tool_points, dtype=float))
+    B = _kernels.carray(np.array(mech.base_points, dtype=float))
+    # every orientation's position bounds lie within the nominal one's grown by 2·max|u|
+    b = mech.position_bounds(Rn)[0]
+    g = 2.0 * float(np.max(np.linalg.norm(U, axis=1))) + 1.0
+    box = _kernels.carray(np.array([b[0, 0] - g, b[1, 0] + g, b[0, 1] - g, b[1, 1] + g]))
+    return e0, U, B, box
+
+
+def _require(mech, constraints=None):
+    if not supports_continuous(mech, constraints):
+        raise ParameterError("family", "a family with radial column intervals (psu6, ups6) "
+                             "and the stroke constraint only", mech.family)
+
+
+def orientation_capability(mech, samples: int = 7, tol_deg: float = CAPABILITY_TOL_DEG,
+                           max_deg: float = CAPABILITY_MAX_DEG) -> OptimumBracket:
+    """The orientation capability over continuous positions, bracketed (module notes), in one
+    compiled search."""
+    _require(mech)
+    if not (isinstance(samples, int) and samples >= 2):
+        raise ParameterError("samples", "an integer >= 2 (angles per axis)", samples)
+    t0 = time.perf_counter()
+    e0, U, B, box = _inputs(mech)
+    P = _kernels.carray(mech.column_params())
+    cap = _search.make_capability(type(mech).column_leg)
+    out = np.empty(12)
+    cap(U, B, P, e0, int(samples), box, FIRST_TILE_MM, math.radians(max_deg),
+        math.radians(tol_deg), MIN_TILE_MM, MIN_HALF_RAD, CAPABILITY_CELL_BUDGET, out)
+    flags = int(out[9])
+    notes = []
+    if flags & 2:
+        notes.append("no workspace at the nominal orientation")
+    if flags & 1:
+        notes.append(f"not bounded by the search: the ±{max_deg:g}° box has a dexterous "
+                     "position")
+    if flags & 4:
+        notes.append("a branch and bound was undecided (margin within 1e-9 mm of zero on a "
+                     f"{MIN_TILE_MM:g} mm tile); the upper end stops there")
+    if flags & 8:
+        notes.append(f"certification stopped by its budget ({CAPABILITY_CELL_BUDGET:,} "
+                     "orientation cells): the lower end is certified, the truth may lie higher")
+    lower, upper, sampled = (math.degrees(v) for v in out[:3])
+    if flags & 1:
+        upper = math.inf
+    return OptimumBracket(
+        "orientation_capability", "deg", lower, upper, sampled, tuple(out[6:9]), samples,
+        f"branch and bound over continuous positions ({samples}^3 orientation samples, "
+        f"upper end) and a point certified for the continuous box (lower end), bisected to "
+        f"{tol_deg:g}°; {int(out[10])} searches, {int(out[11])} orientation cells",
+        "; ".join(notes), time.perf_counter() - t0)
+
+
+def stroke_needed(mech, orientations: OrientationSet, tol_mm: float = STROKE_TOL_MM,
+                  q_max_limit: float | None = None) -> OptimumBracket:
+    """The smallest upper actuator limit giving a non-empty dexterous workspace over the
+    simultaneous box ``orientations`` (equal half-ranges), the lower limit kept, bracketed
+    (module notes). ``q_max_limit`` caps the search (default: lower limit + 4 × scale)."""
+    _require(mech)
+    if orientations.kind != "box" or orientations.semantics != "simultaneous" or \
+            len(set(orientations.angles)) != 1:
+        raise ParameterError("orientations", "a simultaneous box with equal half-ranges",
+                             orientations.describe())
+    t0 = time.perf_counter()
+    theta = float(orientations.angles[0])
+    n = int(orientations.samples)
+    e0, U, B, box = _inputs(mech)
+    if orientations.centre is not None:
+        e0 = _kernels.carray(np.array(orientations.centre, dtype=float))
+    qmin = float(mech.stroke[0])
+    bb = _search.make_branch_bound(type(mech).column_leg)
+    cert = _search.make_certify(type(mech).column_leg)
+    r, c = np.empty(8), np.empty(2)
+
+    def params(qmax):
+        return _kernels.carray(dataclasses.replace(mech, stroke_window=(qmin, qmax))
+                               .column_params())
+
+    def empty(qmax):           # True: proved empty at every position; False: a witness
+        bb(U, B, params(qmax), e0, theta, n, box, FIRST_TILE_MM, MIN_TILE_MM, 0.0, True, r)
+        return {1.0: False, 0.0: True}.get(float(r[0]))
+
+    def certified(qmax, xy=None):
+        """A point certified at qmax: the sample's best column (searched over the whole box,
+        or the column ``xy``), at the middle of its z interval; None if none."""
+        P = params(qmax)
+        where = box if xy is None else _kernels.carray(np.array(
+            [xy[0] - 1e-9, xy[0] + 1e-9, xy[1] - 1e-9, xy[1] + 1e-9]))
+        bb(U, B, P, e0, theta, n, where, FIRST_TILE_MM, MIN_TILE_MM, _search.MAX_EPS, False, r)
+        if not r[1] >= 0.0:
+            return None
+        p = (float(r[2]), float(r[3]), 0.5 * float(r[4] + r[5]))
+        cert(U, B, P, e0, theta, *p, MIN_HALF_RAD, CELL_BUDGET, c)
+        return p if c[0] == 1 else None
+
+    hi = q_max_limit if q_max_limit is not None else qmin + 4.0 * mech.scale
+    lo = float(mech.stroke[1])
+    notes = []
+    if not empty(lo):
+        # already non-empty: the needed limit lies between qmin and the current one
+        lo = qmin + 1e-9
+        if empty(lo) is not True:
+            raise ParameterError("stroke", "a window whose lower limit alone admits no "
+                                 "position", mech.stroke)
+    if empty(hi) is not False:
+        raise ParameterError("q_max_limit", "a limit at which the set is non-empty", hi)
+    s_lo, s_hi = lo, hi                       # s_lo proved empty, s_hi has a witness
+    while s_hi - s_lo > tol_mm:
+        mid = 0.5 * (s_lo + s_hi)
+        e = empty(mid)
+        if e is None:
+            notes.append(f"branch and bound undecided at {mid:.4f} mm")
+            break
+        s_lo, s_hi = (mid, s_hi) if e else (s_lo, mid)
+    sampled = s_hi
+    # the column kept from here on: the sample's best one at its own needed limit
+    bb(U, B, params(s_hi), e0, theta, n, box, FIRST_TILE_MM, MIN_TILE_MM, _search.MAX_EPS,
+       False, r)
+    xy = (float(r[2]), float(r[3]))
+    c_lo, c_hi, point = s_lo, hi, certified(hi, xy)
+    if point is None:
+        raise ParameterError("q_max_limit", "a limit at which a point is certified", hi)
+    while c_hi - c_lo > tol_mm:
+        mid = 0.5 * (c_lo + c_hi)
+        p = certified(mid, xy)
+        if p is None:
+            c_lo = mid
+        else:
+            c_hi, point = mid, p
+    return OptimumBracket(
+        "stroke_needed", "mm", s_lo, c_hi, sampled, point, n,
+        f"upper actuator limit, lower limit {qmin:g} mm kept: branch and bound over "
+        f"continuous positions ({n}^3 orientation samples, lower end), a point certified "
+        f"for the continuous ±{math.degrees(theta):g}° box (upper end), bisected to "
+        f"{tol_mm:g} mm", "; ".join(notes), time.perf_counter() - t0)

@@ -1,0 +1,150 @@
+"""Continuous optima (capability, needed stroke) and the exact tile pruning of the engine.
+
+Independent checks: the plain column kernel (no pruning) for the tiles; the inverse
+kinematics (not the column kernels) with dense orientation sampling and local optimisation for
+the certified points; local optimisation over continuous positions for the empty samples.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from conftest import MECH_DIR as STUDIES
+from scipy.optimize import minimize
+
+from pkmlab import UPS6, load_mechanism
+from pkmlab.mechanisms import NO_STROKE, _kernels, _tiles
+from pkmlab.poses import euler_to_matrix
+from pkmlab.workspaces import OrientationSet
+from pkmlab.workspaces.engine import _grid_xy
+from pkmlab.workspaces.optima import orientation_capability, stroke_needed
+
+
+@pytest.fixture(scope="module")
+def hopkins():
+    return load_mechanism(STUDIES / "hopkins-williams-6psu.yaml")
+
+
+def _plain_and_tiled(mech, R, h):
+    xs, ys, _ = _grid_xy(mech, R, "all", h)
+    W = mech.leg_offsets(R)
+    W = _kernels.carray(W[np.argsort(-np.linalg.norm(R - np.eye(3), axis=(1, 2)),
+                                     kind="stable")])
+    P = _kernels.carray(mech.column_params())
+    out = [np.empty((len(xs), len(ys), 1)) for _ in range(4)]
+    _kernels.make_column_kernel(type(mech).column_leg, "all")(
+        _kernels.carray(xs), _kernels.carray(ys), W, P, out[0], out[1])
+    _tiles.make_tiled_all(type(mech).column_leg)(
+        _kernels.carray(xs), _kernels.carray(ys), W, P, out[2], out[3])
+    return out
+
+
+@pytest.mark.parametrize("case", ["psu15", "ups10", "ups20"])
+def test_tile_pruning_gives_identical_intervals(hopkins, case):
+    """The pruned kernel keeps every column's max a / min b bit for bit (6-PSU and 6-UPS)."""
+    if case == "psu15":
+        mech, a, h = hopkins, 15.0, 1.0
+    else:
+        mech = load_mechanism(STUDIES / "gough-stewart-6ups.yaml")
+        a, h = (10.0, 10.0) if case == "ups10" else (20.0, 7.5)
+    R = euler_to_matrix(OrientationSet.box(np.radians([a] * 3), samples=5).parameters())
+    lo, hi, tlo, thi = _plain_and_tiled(mech, R, h)
+    inside = lo <= hi
+    assert inside.sum() > 100 and (~inside).sum() > 100     # both kinds of column exist
+    assert np.array_equal(lo, tlo) and np.array_equal(hi, thi)
+
+
+def _psu_margin_at(mech, x, y, R):
+    """Along the column (x, y) a 6-PSU's slider is q = z + c (slope 1): the z interval of every
+    leg × orientation from the inverse kinematics at z = 0 → (max a, min b)."""
+    n = len(R)
+    ik = mech.inverse((np.tile([x, y, 0.0], (n, 1)), R), stroke=NO_STROKE)
+    q0 = np.where(np.isfinite(ik.q), ik.q, np.nan)
+    if np.isnan(q0).any():
+        return np.inf, -np.inf
+    lo, hi = mech.stroke
+    return float(np.max(lo - q0)), float(np.min(hi - q0))
+
+
+def _point_margin(mech, p, euler):
+    R = euler_to_matrix(np.atleast_2d(euler))
+    ik = mech.inverse((np.tile(p, (len(R), 1)), R), stroke=NO_STROKE)
+    lo, hi = mech.stroke
+    m = np.min(np.minimum(ik.q - lo, hi - ik.q), axis=1)
+    return np.where(np.isfinite(m), m, -1e9)
+
+
+def test_capability_bracket_holds_independently(hopkins):
+    """Lower end: the certified point keeps every leg in stroke at 20,000 random orientations
+    of the continuous box and at local minima of its margin found from the worst of them.
+    Upper end: local maximisation of the column margin over continuous positions finds no
+    position for the sample at the upper end."""
+    b = orientation_capability(hopkins, 5)
+    assert b.note == "" and 0.0 <= b.width <= 0.01 + 1e-9
+    assert 23.1 < b.lower <= b.sampled <= b.upper < 23.25        # measured: 23.170 / 23.176
+    p = np.asarray(b.point)
+    th = math.radians(b.lower)
+    rng = np.random.default_rng(3)
+    E = rng.uniform(-th, th, (20_000, 3))
+    corners = np.array(np.meshgrid(*[[-th, th]] * 3)).reshape(3, -1).T
+    E = np.vstack([E, corners])
+    m = _point_margin(hopkins, p, E)
+    assert m.min() >= -1e-9
+    for e in E[np.argsort(m)[:3]]:
+        res = minimize(lambda v: _point_margin(hopkins, p, v)[0], e, method="L-BFGS-B",
+                       bounds=[(-th, th)] * 3)
+        assert res.fun >= -1e-9
+    # upper end: no continuous position for the sample
+    Rs = euler_to_matrix(OrientationSet.box(np.radians([b.upper] * 3), samples=5)
+                         .parameters())
+
+    def neg(v):
+        lo, hi = _psu_margin_at(hopkins, v[0], v[1], Rs)
+        return -(hi - lo) if np.isfinite(hi - lo) else 1e3
+
+    starts = [p[:2]] + list(p[:2] + rng.normal(0, 5, (2, 2)))
+    best = min(minimize(neg, s, method="Nelder-Mead",
+                        options={"xatol": 1e-7, "fatol": 1e-9}).fun for s in starts)
+    assert -best < 0.0
+
+
+def test_stroke_needed_bracket(hopkins):
+    """The ±30° set of Hopkins & Williams: the stroke (0 to q_max) it needs is bracketed, the
+    certified point holds at dense orientations, and the sample at the lower end admits no
+    position (local search)."""
+    o = OrientationSet.box(np.radians([30.0] * 3), samples=5)
+    b = stroke_needed(hopkins, o)
+    assert b.lower <= b.sampled <= b.upper and 128.0 < b.lower and b.upper < 134.0
+    mech = dataclasses.replace(hopkins, stroke_window=(0.0, b.upper))
+    th = math.radians(30.0)
+    E = np.random.default_rng(5).uniform(-th, th, (20_000, 3))
+    assert _point_margin(mech, np.asarray(b.point), E).min() >= -1e-9
+    low = dataclasses.replace(hopkins, stroke_window=(0.0, b.lower))
+    Rs = euler_to_matrix(o.parameters())
+    res = minimize(lambda v: -np.subtract(*_psu_margin_at(low, v[0], v[1], Rs)[::-1]),
+                   np.asarray(b.point[:2]), method="Nelder-Mead", options={"xatol": 1e-7})
+    assert -res.fun < 0.0
+
+
+def test_continuous_search_refuses_other_families():
+    from pkmlab.errors import ParameterError
+
+    mech = load_mechanism(STUDIES / "luzi-3chain.yaml")
+    with pytest.raises(ParameterError, match="family"):
+        orientation_capability(mech, 5)
+
+
+def test_capability_on_a_6ups_is_bracketed():
+    """A small 6-UPS: the certified lower end is below the upper end and the grid value."""
+    mech = UPS6.from_circles(base_radii=(100.0, 165.0), platform_radii=(50.0, 80.0),
+                             platform_rotation=math.radians(33.7), base_pair_separation=0.0,
+                             platform_pair_separation=0.0, stroke=(250.0, 350.0))
+    b = orientation_capability(mech, 5)
+    assert b.lower <= b.sampled <= b.upper and b.width <= 0.05 and b.lower > 1.0
+    p = np.asarray(b.point)
+    th = math.radians(b.lower)
+    E = np.random.default_rng(1).uniform(-th, th, (20_000, 3))
+    assert _point_margin(mech, p, E).min() >= -1e-9
