@@ -50,6 +50,7 @@ from scipy.spatial.transform import Rotation
 
 from ..errors import ParameterError
 from ..poses import as_frames, log_so3
+from ..threads import threads_for
 from ..tolerances import TOL
 from . import _kernels
 from .results import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult
@@ -187,15 +188,17 @@ class Mechanism:
             W = W[np.argsort(-np.linalg.norm(R - np.eye(3), axis=(1, 2)), kind="stable")]
             lo, hi = np.empty((nx, ny, 1)), np.empty((nx, ny, 1))
             columns_all = _kernels.make_column_kernel(type(self).column_leg, "all")
-            columns_all(xs, ys, _kernels.carray(W), P, lo, hi)
+            with threads_for(nx * ny * len(W)):
+                columns_all(xs, ys, _kernels.carray(W), P, lo, hi)
             return lo, hi, 0
         if allowed is None:
             allowed = np.ones((nx, ny, len(R)), dtype=np.bool_)
         lo, hi = np.empty((nx, ny, K)), np.empty((nx, ny, K))
         count = np.empty((nx, ny), dtype=np.int64)
         columns_any = _kernels.make_column_kernel(type(self).column_leg, "any")
-        columns_any(xs, ys, _kernels.carray(W), P, _kernels.carray(allowed, np.bool_), lo, hi,
-                    count)
+        with threads_for(nx * ny * len(W)):
+            columns_any(xs, ys, _kernels.carray(W), P, _kernels.carray(allowed, np.bool_), lo,
+                        hi, count)
         return lo, hi, int(np.sum(count > K))
 
     def position_bounds(self, R: np.ndarray) -> np.ndarray:
@@ -310,12 +313,13 @@ class Mechanism:
         reason = np.empty(n, dtype=np.int8)
         lo, hi = float(lo), float(hi)
         one, ng = type(self)._ik_one, len(g)
-        if R is None:
-            euler = _kernels.make_driver(one, ng, "euler")
-            euler(_kernels.carray(X_or_p), g, lo, hi, q, st, reason)
-        else:
-            frames = _kernels.make_driver(one, ng, "frames")
-            frames(_kernels.carray(X_or_p), _kernels.carray(R), g, lo, hi, q, st, reason)
+        with threads_for(n):
+            if R is None:
+                euler = _kernels.make_driver(one, ng, "euler")
+                euler(_kernels.carray(X_or_p), g, lo, hi, q, st, reason)
+            else:
+                frames = _kernels.make_driver(one, ng, "frames")
+                frames(_kernels.carray(X_or_p), _kernels.carray(R), g, lo, hi, q, st, reason)
         return IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st)
 
     @cached_property
