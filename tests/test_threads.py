@@ -9,12 +9,11 @@ import sys
 
 import numba
 import numpy as np
+from conftest import MECH_DIR
 
 import pkmlab
 from pkmlab.study import runners
 from pkmlab.threads import SMALL_WORK, threads_for
-
-from conftest import MECH_DIR
 
 _PROBE = ("import os, pkmlab, numpy as np; "
           "m = pkmlab.load_mechanism({f!r}); m.inverse(np.tile(m.nominal_pose, (50000, 1))); "

@@ -125,7 +125,8 @@ class DaskRunner:
         from distributed import as_completed
 
         tasks = list(tasks)
-        futures = [self.client.submit(_call, fn, tid, args, None, True, pure=False) for tid, args in tasks]
+        futures = [self.client.submit(_call, fn, tid, args, None, True, pure=False)
+                   for tid, args in tasks]
         for fut in as_completed(futures):
             yield fut.result()
 
