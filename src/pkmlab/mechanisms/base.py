@@ -45,7 +45,6 @@ from functools import cached_property
 from typing import Any, ClassVar
 
 import numpy as np
-from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
 from ..errors import ParameterError
@@ -54,7 +53,7 @@ from ..threads import threads_for
 from ..tolerances import TOL
 from . import _kernels
 from .results import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult
-from .solvers import forward_newton, multistart_modes
+from .solvers import bracketed_root, forward_newton, multistart_modes
 
 log = logging.getLogger(__name__)
 
@@ -395,7 +394,7 @@ class Mechanism:
         for k in range(len(zs) - 1):
             a, b = vals[k], vals[k + 1]
             if np.isfinite(a) and np.isfinite(b) and a * b <= 0:
-                z = brentq(mean_q, zs[k + 1], zs[k], xtol=TOL.nominal_z_mm)
+                z = bracketed_root(mean_q, zs[k + 1], zs[k], xtol=TOL.nominal_z_mm)
                 return np.array([0.0, 0.0, z, 0.0, 0.0, yaw])
         raise ParameterError("stroke", "a window whose mid-point is reachable by a level, "
                              "centred platform (the nominal pose: give 'nominal' or change the "
