@@ -74,3 +74,17 @@ def test_worker_tasks_run_on_one_numba_thread():
     finally:
         r.close()
     assert out == {0: 1, 1: 1}
+
+
+_HEAVY = ("pkmlab.study", "scipy.optimize", "scipy.signal", "matplotlib", "trimesh",
+          "distributed", "plotly", "pymoo", "pandas", "joblib")
+
+
+def test_cli_import_leaves_heavy_modules_for_the_commands_that_use_them():
+    """Cold start (issue 14): the CLI's import stays light; scipy.optimize alone took 0.28 s
+    and the study package (evaluators → requirements → scipy.signal) more."""
+    code = ("import sys, pkmlab.cli; "
+            f"print(' '.join(m for m in {_HEAVY!r} if m in sys.modules))")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       timeout=120, check=True)
+    assert r.stdout.split() == []
