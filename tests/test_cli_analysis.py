@@ -74,6 +74,25 @@ def test_metric_maps_are_worst_cases_over_the_set():
     assert np.isnan(km.grid[~res.occupancy]).all() and np.isfinite(km.grid[res.occupancy]).all()
 
 
+def test_maps_computed_only_where_drawn_give_the_same_picture_and_mesh_colours():
+    """Issue 14 (cheap exports): the export evaluates κ only on the slice layers and the
+    surface voxels; the drawn values and the mesh vertex values equal the full map's."""
+    from pkmlab.dexterity.maps import drawn_voxels, vertex_values
+    from pkmlab.workspaces.slicing import slice_layout
+
+    mech = load_mechanism(HOPKINS)
+    res = workspace(mech, "dexterous", OrientationSet.box(np.radians([10] * 3), samples=3), 4.0)
+    levels = slice_layout(res, "auto", None, None, None, 12).levels
+    where = drawn_voxels(res, levels)
+    full = metric_map(mech, res, "kappa", L=60.0)
+    part = metric_map(mech, res, "kappa", L=60.0, where=where)
+    assert 0 < where.sum() < res.occupancy.sum() and not (where & ~res.occupancy).any()
+    k = np.rint((np.asarray(levels) - res.zs[0]) / res.resolution).astype(int)
+    np.testing.assert_array_equal(part.grid[:, :, k], full.grid[:, :, k])
+    mesh = res.mesh()
+    np.testing.assert_array_equal(vertex_values(mesh, part), vertex_values(mesh, full))
+
+
 def test_trajectory_cli_reports_the_first_violation(tmp_path):
     mech = load_mechanism(HOPKINS)
     t = np.linspace(0, 2, 41)

@@ -71,6 +71,8 @@ from numba.core.bytecode import FunctionIdentity
 from numba.core.compiler_lock import global_compiler_lock
 from numba.extending import register_jitable
 
+from .threads import DEFAULTS as _OPENMP_DEFAULTS  # noqa: F401  (set before any kernel runs)
+
 log = logging.getLogger(__name__)
 #: seconds after which a kernel compile is announced (the progress rule: no silent step > 2 s)
 COMPILE_NOTICE_S = 1.5

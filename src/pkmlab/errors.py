@@ -14,8 +14,8 @@ import sys
 import types
 from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
-__all__ = ["ParameterError", "NumericalError", "Shown", "format_value", "format_field",
-           "parse_field", "from_validation_error"]
+__all__ = ["ParameterError", "NumericalError", "CandidateError", "Shown", "format_value",
+           "format_field", "parse_field", "from_validation_error"]
 
 _REPR_LIMIT = 200
 _REPR_DEPTH = 8
@@ -331,3 +331,14 @@ class NumericalError(RuntimeError):
         self.what = what
         self.reason = reason
         super().__init__(f"{what}: {reason}")
+
+
+class CandidateError(RuntimeError):
+    """A candidate's evaluation raised an undeclared exception (a programming error): the run
+    stops after recording it. ``params`` is the design, ``details`` the worker's traceback."""
+
+    def __init__(self, params: dict, details: str):
+        self.params = params
+        self.details = details
+        super().__init__(f"evaluation of candidate {params} raised an error (recorded in the "
+                         f"store); the run stops:\n{details}")

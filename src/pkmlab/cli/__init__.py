@@ -53,8 +53,7 @@ def main() -> None:
     other unexpected error exits 1 with one line (``--debug``: the traceback)."""
     import sqlite3
 
-    from ..errors import NumericalError, ParameterError
-    from ..study.run import CandidateError
+    from ..errors import CandidateError, NumericalError, ParameterError
     from ..yamlio import locate_error
 
     try:

@@ -21,7 +21,8 @@ from .force import max_force_all_directions
 from .metrics import CharacteristicLength, condition_number, resolve_length
 from .stiffness import stiffness
 
-__all__ = ["METRICS", "MetricMap", "metric_map", "mesh_colours", "vertex_values"]
+__all__ = ["METRICS", "MetricMap", "metric_map", "drawn_voxels", "mesh_colours",
+           "vertex_values"]
 
 #: metric → (label, unit, worse is larger)
 METRICS = {
@@ -59,9 +60,25 @@ class MetricMap:
         return f"{name} ({unit})" if unit else name
 
 
+def drawn_voxels(result, levels) -> np.ndarray:
+    """``(nx, ny, nz)`` bool: the occupied voxels a picture shows, those of the voxel layers
+    nearest to the slice heights ``levels`` (mm; the layers :func:`.slice_figure` colours)
+    and those on the workspace's surface (occupied voxels with an empty face neighbour, the
+    ones nearest to a boundary mesh's vertices). A map needs no other voxel to be drawn."""
+    from scipy import ndimage
+
+    occ = np.asarray(result.occupancy, dtype=bool)
+    mask = occ & ~ndimage.binary_erosion(occ, border_value=0)
+    if len(result.zs):
+        k = np.clip(np.rint((np.asarray(levels, dtype=float) - result.zs[0])
+                            / result.resolution).astype(int), 0, len(result.zs) - 1)
+        mask[:, :, k] |= occ[:, :, k]
+    return mask
+
+
 def metric_map(mech, result, metric: str = "kappa",
                L: float | CharacteristicLength | None = None, f_max=150.0,
-               k=1.0e4, progress=None) -> MetricMap:
+               k=1.0e4, progress=None, where: np.ndarray | None = None) -> MetricMap:
     """Worst-case ``metric`` over ``result``'s orientation set at every occupied voxel.
 
     Args:
@@ -73,12 +90,17 @@ def metric_map(mech, result, metric: str = "kappa",
         k: actuator stiffness(es) in N/mm for ``"stiffness"``.
         progress: optional ``progress(fraction_done)``, called after each batch of
             orientations (a map over a large workspace takes tens of seconds).
+        where: optional ``(nx, ny, nz)`` bool: evaluate only these occupied voxels (e.g.
+            :func:`drawn_voxels`); the others stay NaN in ``grid`` and out of ``values``.
     """
     if metric not in METRICS:
         raise ParameterError("metric", f"one of {list(METRICS)}", metric)
     length = resolve_length(mech, L)
     L = length.length
     idx, pos = _voxels(result)
+    if where is not None:
+        keep = np.asarray(where, dtype=bool)[idx[:, 0], idx[:, 1], idx[:, 2]]
+        idx, pos = idx[keep], pos[keep]
     R = result.orientations.rotations()
     V = len(pos)
     worse_is_larger = METRICS[metric][2]

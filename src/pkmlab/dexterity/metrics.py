@@ -42,7 +42,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from ..errors import ParameterError
 from ..poses import as_frames
@@ -324,6 +323,8 @@ def characteristic_length(mech, pose=None) -> CharacteristicLength:
         return float(_kappa_from_sv(singular_values(Jh)))
 
     a, b = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
+    from scipy.optimize import minimize_scalar  # lazy: 0.3 s at import
+
     res = minimize_scalar(f, bounds=(a, b), method="bounded",
                           options={"xatol": 1e-10, "maxiter": 200})
     x, val = (float(res.x), float(res.fun)) if res.fun <= kap[k] else (float(grid[k]),

@@ -45,15 +45,15 @@ from functools import cached_property
 from typing import Any, ClassVar
 
 import numpy as np
-from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
 from ..errors import ParameterError
 from ..poses import as_frames, log_so3
+from ..threads import threads_for
 from ..tolerances import TOL
 from . import _kernels, _tiles
 from .results import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult
-from .solvers import forward_newton, multistart_modes
+from .solvers import bracketed_root, forward_newton, multistart_modes
 
 log = logging.getLogger(__name__)
 
@@ -191,15 +191,17 @@ class Mechanism:
             tiled = self.column_radial and nx * ny >= _tiles.MIN_COLUMNS
             columns_all = (_tiles.make_tiled_all(type(self).column_leg) if tiled
                            else _kernels.make_column_kernel(type(self).column_leg, "all"))
-            columns_all(xs, ys, _kernels.carray(W), P, lo, hi)
+            with threads_for(nx * ny * len(W)):
+                columns_all(xs, ys, _kernels.carray(W), P, lo, hi)
             return lo, hi, 0
         if allowed is None:
             allowed = np.ones((nx, ny, len(R)), dtype=np.bool_)
         lo, hi = np.empty((nx, ny, K)), np.empty((nx, ny, K))
         count = np.empty((nx, ny), dtype=np.int64)
         columns_any = _kernels.make_column_kernel(type(self).column_leg, "any")
-        columns_any(xs, ys, _kernels.carray(W), P, _kernels.carray(allowed, np.bool_), lo, hi,
-                    count)
+        with threads_for(nx * ny * len(W)):
+            columns_any(xs, ys, _kernels.carray(W), P, _kernels.carray(allowed, np.bool_), lo,
+                        hi, count)
         return lo, hi, int(np.sum(count > K))
 
     def position_bounds(self, R: np.ndarray) -> np.ndarray:
@@ -314,12 +316,13 @@ class Mechanism:
         reason = np.empty(n, dtype=np.int8)
         lo, hi = float(lo), float(hi)
         one, ng = type(self)._ik_one, len(g)
-        if R is None:
-            euler = _kernels.make_driver(one, ng, "euler")
-            euler(_kernels.carray(X_or_p), g, lo, hi, q, st, reason)
-        else:
-            frames = _kernels.make_driver(one, ng, "frames")
-            frames(_kernels.carray(X_or_p), _kernels.carray(R), g, lo, hi, q, st, reason)
+        with threads_for(n):
+            if R is None:
+                euler = _kernels.make_driver(one, ng, "euler")
+                euler(_kernels.carray(X_or_p), g, lo, hi, q, st, reason)
+            else:
+                frames = _kernels.make_driver(one, ng, "frames")
+                frames(_kernels.carray(X_or_p), _kernels.carray(R), g, lo, hi, q, st, reason)
         return IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st)
 
     @cached_property
@@ -395,7 +398,7 @@ class Mechanism:
         for k in range(len(zs) - 1):
             a, b = vals[k], vals[k + 1]
             if np.isfinite(a) and np.isfinite(b) and a * b <= 0:
-                z = brentq(mean_q, zs[k + 1], zs[k], xtol=TOL.nominal_z_mm)
+                z = bracketed_root(mean_q, zs[k + 1], zs[k], xtol=TOL.nominal_z_mm)
                 return np.array([0.0, 0.0, z, 0.0, 0.0, yaw])
         raise ParameterError("stroke", "a window whose mid-point is reachable by a level, "
                              "centred platform (the nominal pose: give 'nominal' or change the "

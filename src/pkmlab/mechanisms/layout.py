@@ -18,9 +18,9 @@ ParaDex / classic Gough–Stewart layout.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..errors import ParameterError
+from .solvers import bracketed_root
 
 __all__ = ["paired_layout", "equal_leg_base_angle", "build_paired"]
 
@@ -80,7 +80,7 @@ def equal_leg_base_angle(base_radii, platform_radii, platform_rotation, base_pai
 
     grid = np.linspace(-np.pi, np.pi, 1441)
     vals = gap(grid)
-    roots = [brentq(gap, grid[i], grid[i + 1], xtol=1e-14)
+    roots = [bracketed_root(gap, grid[i], grid[i + 1], xtol=1e-14)
              for i in range(len(grid) - 1) if vals[i] == 0 or vals[i] * vals[i + 1] < 0]
     if not roots:
         raise ParameterError("base_pair_angle",

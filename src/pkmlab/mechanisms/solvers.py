@@ -16,6 +16,26 @@ from ..tolerances import TOL
 from .results import NO_STROKE, AssemblyModes, FKResult, step_frames
 
 
+def bracketed_root(f, a: float, b: float, xtol: float) -> float:
+    """A root of the scalar function ``f`` in ``[a, b]``, where ``f(a)`` and ``f(b)`` differ in
+    sign (or one is zero), to within ``xtol``, by bisection: ``ceil(log2(|b - a| / xtol))``
+    evaluations, guaranteed. (``scipy.optimize.brentq`` needs fewer evaluations but importing
+    scipy.optimize costs about 0.3 s, more than the whole root search in a fresh process.)"""
+    fa = f(a)
+    if fa == 0:
+        return float(a)
+    for _ in range(max(1, int(np.ceil(np.log2(max(abs(b - a), xtol) / xtol))) + 1)):
+        m = 0.5 * (a + b)
+        fm = f(m)
+        if fm == 0:
+            return float(m)
+        if (fm < 0) == (fa < 0):
+            a, fa = m, fm
+        else:
+            b = m
+    return float(0.5 * (a + b))
+
+
 def _solve(G: np.ndarray, f: np.ndarray) -> np.ndarray:
     """Batched ``G⁻¹ f`` with a pseudo-inverse fallback when a matrix is singular."""
     try:

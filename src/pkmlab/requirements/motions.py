@@ -30,7 +30,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.signal import savgol_filter
 
 from ..errors import ParameterError
 from ..trajectory import motions as _paper
@@ -134,6 +133,8 @@ def differentiate(t, x, window: float, polyorder: int, field: str = "smoothing"
     if n > len(t):
         raise ParameterError(f"{field}.window", f"at most the recording's {len(t)} samples "
                              f"({(len(t) - 1) * step:g} s)", f"{window:g} s = {n} samples")
+    from scipy.signal import savgol_filter  # lazy: scipy.signal costs 0.5 s at import
+
     d1 = savgol_filter(x, n, polyorder, deriv=1, delta=step, axis=0, mode="interp")
     d2 = savgol_filter(x, n, polyorder, deriv=2, delta=step, axis=0, mode="interp")
     return d1, d2, n

@@ -129,7 +129,7 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
                 step) -> dict:
     from .. import dexterity as dx
     from ..dexterity.maps import METRICS as MAPS
-    from ..dexterity.maps import mesh_colours, metric_map, vertex_values
+    from ..dexterity.maps import drawn_voxels, mesh_colours, metric_map, vertex_values
     from ..workspaces import workspace
     from ..workspaces.plots import slice_figure
     from ..workspaces.slicing import slice_layout
@@ -170,10 +170,12 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
             L = length.length if length.status != "fallback" else None
             mesh = res.mesh()
             values, first = {}, None
+            drawn = drawn_voxels(res, lay.levels) if maps and L else None
             for name in maps if L else ():
-                step(f"{name} map over {int(res.occupancy.sum())} voxels × "
-                     f"{len(res.orientations.rotations())} orientations")
-                mm = metric_map(mech, res, name, L, f_max=force_limit,
+                step(f"{name} map over the {int(drawn.sum())} drawn voxels (of "
+                     f"{int(res.occupancy.sum())}) × {len(res.orientations.rotations())} "
+                     "orientations")
+                mm = metric_map(mech, res, name, L, f_max=force_limit, where=drawn,
                                 progress=_every(2.0, lambda f, name=name: step(
                                     f"{name} map {100 * f:.0f} %")))
                 values[name] = vertex_values(mesh, mm)

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from ..errors import ParameterError
+from ..errors import CandidateError, ParameterError
 from .definition import PENALTY, Study
 from .evaluators import evaluate_design
 from .optimisers import OPTIMISERS
@@ -30,17 +30,6 @@ __all__ = ["run_study", "objective_matrix", "feasible", "CandidateError", "BASEL
            "OutputLock", "provenance"]
 
 BASELINE = {"__baseline__": True}
-
-
-class CandidateError(RuntimeError):
-    """A candidate's evaluation raised an undeclared exception (a programming error): the run
-    stops after recording it. ``params`` is the design, ``details`` the worker's traceback."""
-
-    def __init__(self, params: dict, details: str):
-        self.params = params
-        self.details = details
-        super().__init__(f"evaluation of candidate {params} raised an error (recorded in the "
-                         f"store); the run stops:\n{details}")
 
 
 def provenance() -> dict:

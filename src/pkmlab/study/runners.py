@@ -10,6 +10,8 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable, Iterable, Iterator
 
+from ..threads import single_thread_worker
+
 __all__ = ["SerialRunner", "JoblibRunner", "DaskRunner", "make_runner"]
 
 log = logging.getLogger(__name__)
@@ -47,9 +49,11 @@ def _watch_parent(parent: int, period: float = 0.5) -> None:
     threading.Thread(target=watch, name="pkmlab-parent-watchdog", daemon=True).start()
 
 
-def _call(fn, task_id, args, parent=None):
+def _call(fn, task_id, args, parent=None, worker=False):
     if parent is not None:
         _watch_parent(parent)
+    if worker:
+        single_thread_worker()      # the workers fill the cores; one numba thread each
     return task_id, fn(*args)
 
 
@@ -83,7 +87,7 @@ class JoblibRunner:
         from joblib import delayed
 
         parent = os.getpid()
-        yield from self.pool(delayed(_call)(fn, tid, args, parent) for tid, args in tasks)
+        yield from self.pool(delayed(_call)(fn, tid, args, parent, True) for tid, args in tasks)
 
     def close(self) -> None:
         pass
@@ -121,7 +125,8 @@ class DaskRunner:
         from distributed import as_completed
 
         tasks = list(tasks)
-        futures = [self.client.submit(_call, fn, tid, args, pure=False) for tid, args in tasks]
+        futures = [self.client.submit(_call, fn, tid, args, None, True, pure=False)
+                   for tid, args in tasks]
         for fut in as_completed(futures):
             yield fut.result()
 

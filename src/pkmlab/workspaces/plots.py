@@ -30,7 +30,6 @@ def slice_figure(result, window: float | None = None, spacing: float | None = No
     ``layout`` (``"auto"`` or ``"paper"``), ``window``, ``spacing``, ``centre`` and
     ``max_panels`` choose the sections (:func:`.slicing.slice_layout`; ``None``: the
     layout's)."""
-    from matplotlib.figure import Figure
 
     lay = slice_layout(result, layout, window, spacing, centre, max_panels)
     levels, window, spacing = lay.levels, lay.window, lay.spacing
@@ -40,8 +39,7 @@ def slice_figure(result, window: float | None = None, spacing: float | None = No
     cx, cy = lay.centre
     half = window / 2
     h = result.resolution
-    fig = Figure(figsize=(2.2 * cols, 2.2 * rows + 0.6), layout="constrained")
-    axes = fig.subplots(rows, cols, squeeze=False)
+    fig, axes = _panel_grid(rows, cols, 2.2, 0.8)
     extent = (result.xs[0] - h / 2, result.xs[-1] + h / 2, result.ys[0] - h / 2,
               result.ys[-1] + h / 2) if len(result.xs) else (0, 1, 0, 1)
     im = None
@@ -69,6 +67,7 @@ def slice_figure(result, window: float | None = None, spacing: float | None = No
             im = ax.imshow(img, origin="lower", extent=extent, cmap=cmap, vmin=vmin, vmax=vmax,
                            interpolation="nearest")
         ax.set_title(f"z = {z:.1f} mm", fontsize=7)
+    _outer_labels(axes, len(levels))
     if im is not None:
         note = {"neither": "", "max": "\n(colours capped at the 99th percentile)",
                 "min": "\n(colours floored at the 1st percentile)",
@@ -82,6 +81,31 @@ def slice_figure(result, window: float | None = None, spacing: float | None = No
     empty = " (empty)" if result.empty else ""
     fig.suptitle(f"{name}: {result.kind} workspace{empty}\n{lay.describe()}", fontsize=9)
     return fig
+
+
+def _panel_grid(rows: int, cols: int, size: float, top: float, bottom: float = 0.0):
+    """A figure of ``rows × cols`` square panels of ``size`` inches sharing their axes (tick
+    labels on the outer panels only), with fixed margins: ``top`` inches of height for the
+    title and ``bottom`` for a legend. Fixed margins and shared ticks draw about four times
+    faster than a constrained layout with every panel's own tick labels, which dominated the
+    time of a ``pkmlab workspace`` run."""
+    from matplotlib.figure import Figure
+
+    W, H = size * cols, size * rows + top + bottom
+    fig = Figure(figsize=(W, H))
+    axes = fig.subplots(rows, cols, squeeze=False, sharex=True, sharey=True)
+    fig.subplots_adjust(left=0.45 / W, right=1 - 0.15 / W, bottom=(0.3 + bottom) / H,
+                        top=1 - top / H, wspace=0.12, hspace=0.25)
+    return fig, axes
+
+
+def _outer_labels(axes, used: int) -> None:
+    """Tick labels on the outside of the used panels only: y labels in the first column, x
+    labels under every used panel that has no used panel below it."""
+    rows, cols = axes.shape
+    for a in range(min(used, rows * cols)):
+        axes[a // cols, a % cols].tick_params(labelbottom=a + cols >= used,
+                                              labelleft=a % cols == 0)
 
 
 def _colour_range(values: np.ndarray) -> tuple[float, float, str]:
@@ -117,7 +141,6 @@ def overlay_figure(results: list, labels: list[str], layout: str = "auto",
                    max_panels: int = MAX_PANELS, title: str = ""):
     """Outlines of several workspaces' sections, one colour each, on one common layout
     (:func:`.slicing.slice_layout` over all of them: nothing is clipped by default)."""
-    from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
     lay = slice_layout(list(results), layout, window, spacing, None, max_panels)
@@ -126,8 +149,7 @@ def overlay_figure(results: list, labels: list[str], layout: str = "auto",
     rows = int(math.ceil(n / cols))
     colours = ["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#D55E00", "#56B4E9", "#F0E442",
                "#000000"]
-    fig = Figure(figsize=(2.4 * cols, 2.4 * rows + 1.0), layout="constrained")
-    axes = fig.subplots(rows, cols, squeeze=False)
+    fig, axes = _panel_grid(rows, cols, 2.4, 0.95, 0.4)
     cx, cy = lay.centre
     half = lay.window / 2
     for a, ax in enumerate(axes.ravel()):
@@ -149,7 +171,8 @@ def overlay_figure(results: list, labels: list[str], layout: str = "auto",
         ax.set_title(f"z = {z:.1f} mm", fontsize=7)
     handles = [Line2D([], [], color=colours[k % len(colours)], label=lab)
                for k, lab in enumerate(labels)]
-    fig.legend(handles=handles, loc="outside lower center", ncol=min(len(labels), 4),
-               fontsize=8)
+    _outer_labels(axes, len(lay.levels))
+    fig.legend(handles=handles, loc="lower center", ncol=min(len(labels), 4), fontsize=8,
+               frameon=False)
     fig.suptitle((title + "\n" if title else "") + lay.describe(), fontsize=9)
     return fig
