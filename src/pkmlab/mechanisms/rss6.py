@@ -46,6 +46,8 @@ from numba.extending import register_jitable
 
 from ..errors import ParameterError
 from . import _kernels
+from ._crank import crank_column_leg, crank_params
+from ._set_columns import set_column_intervals
 from .base import NO_STROKE, Mechanism, as_points, as_positive, as_vector3
 from .layout import build_paired
 from .psu6 import _radii
@@ -347,6 +349,22 @@ class RSS6(Mechanism):
         return d
 
     # ---- workspace hooks -------------------------------------------------------------------
+    column_method = "crank"
+    #: set-valued column leg (:mod:`._set_columns`): the exact crank z set (:mod:`._crank`)
+    column_set_leg = crank_column_leg
+
+    def column_params(self) -> np.ndarray:
+        """``(6, 11)`` rows of :func:`._crank.crank_column_leg`."""
+        return crank_params(self.zero_directions, self.v_directions, self.crank_length,
+                            self.rod_length, self.branch, self.stroke)
+
+    def column_intervals(self, xs, ys, R, mode, allowed=None, K=8):
+        """Exact feasible z sets of the columns (see :mod:`._crank`), same contract as
+        :meth:`.base.Mechanism.column_intervals`; each leg's set may have several pieces, so
+        the dexterous (``"all"``) sets have up to ``K`` pieces too."""
+        return set_column_intervals(crank_column_leg, self.leg_offsets(R),
+                                    self.column_params(), xs, ys, R, mode, allowed, K)
+
     def position_bounds(self, R):
         """Each platform joint within ``a_i + s_i`` of its pivot: ``(M, 2, 3)``."""
         W = self.leg_offsets(R)
