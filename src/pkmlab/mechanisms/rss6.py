@@ -45,6 +45,7 @@ from numba import njit
 from numba.extending import register_jitable
 
 from ..errors import ParameterError
+from ..poses import as_frames
 from . import _kernels
 from ._crank import crank_column_leg, crank_params
 from ._set_columns import set_column_intervals
@@ -376,3 +377,25 @@ class RSS6(Mechanism):
         W = p[:, None, :] + np.einsum("nij,kj->nki", R, self.tool_points)
         q = self.inverse((p, R), stroke=NO_STROKE).q
         return self.crank_ends(q), W
+
+    def link_segments(self, p, R):
+        """Cranks (pivot → crank end, segments 0-5) and rods (crank end → platform joint,
+        6-11), with their legs ``[0..5, 0..5]``: interference covers crank/crank, crank/rod
+        and rod/rod of different legs."""
+        C, W = self.leg_segments(p, R)
+        B = np.broadcast_to(self.base_points, C.shape)
+        leg = np.arange(6)
+        return np.concatenate([B, C], axis=1), np.concatenate([C, W], axis=1), \
+            np.concatenate([leg, leg])
+
+    def base_joint_axes(self, p, R, axes):
+        """The crank-end ball joints ride on the cranks: their mounting axes, given at the
+        nominal pose, turn with each crank about its servo axis by ``α − α_nominal``."""
+        q = self.inverse((p, R), stroke=NO_STROKE).q                      # (N, 6)
+        pn, Rn = as_frames(self.nominal_pose)
+        d = q - self.inverse((pn, Rn), stroke=NO_STROKE).q                  # (N, 6)
+        n = self.servo_axes
+        a = np.broadcast_to(np.asarray(axes, dtype=float), (len(p), 6, 3))
+        c, s = np.cos(d)[..., None], np.sin(d)[..., None]
+        return (a * c + np.cross(n, a) * s
+                + n * np.sum(n * a, axis=-1, keepdims=True) * (1.0 - c))   # Rodrigues

@@ -94,7 +94,7 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
                              f"{RESOLUTION_MM[1]:g}] mm", resolution)
     if method not in ("auto", "columns", "sampled"):
         raise ParameterError("method", "one of ['auto', 'columns', 'sampled']", method)
-    cons = constraints or Constraints()
+    cons = (constraints or Constraints()).resolved(mech)
     if cons.stroke is not True:
         # the same geometry with another actuator window (the family re-validates it)
         mech = dataclasses.replace(mech, stroke_window=cons.stroke)
