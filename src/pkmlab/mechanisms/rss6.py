@@ -30,9 +30,12 @@ singular (serial singularity) when the rod is perpendicular to the crank's veloc
 With actuator values in rad, ``Jᵀ τ = w`` relates servo torques ``τ`` (N·mm) and the tool
 wrench ``w = [f (N); m (N·mm)]``: ``τ = J⁻ᵀ w`` (see :meth:`RSS6.servo_torques`).
 
-Workspace: the feasible z set of a column is a union of intervals (the crank equation is not
-monotone in z), so this family has no exact column hooks and the workspace engine samples
-voxels; :meth:`RSS6.position_bounds` bounds the sampled box.
+Workspace: exact column method (``column_method = "crank"``): on a column the feasible z set
+of a leg is a union of intervals whose ends are roots of a quartic (the real solution appears)
+and of two quadratics (the servo-window edges), see :mod:`._crank`; the set-valued column
+drivers of :mod:`._set_columns` intersect / unite them. :meth:`RSS6.position_bounds` bounds the
+search box. Interference covers the cranks too (:meth:`RSS6.link_segments`), and the
+crank-end ball joints' cones turn with the cranks (:meth:`RSS6.base_joint_axes`).
 """
 
 from __future__ import annotations

@@ -79,10 +79,11 @@ def _geometry(mech, ctx: Context) -> dict:
     fp = mech.footprint()
     travel = float(mech.stroke[1] - mech.stroke[0])
     rotary = mech.actuator_unit == "rad"
+    notes = {} if ctx is None else ctx.notes          # the geometry needs no context
     if rotary:
-        ctx.notes["stroke_length"] = "rotary actuators: their travel is servo_range (deg)"
+        notes["stroke_length"] = "rotary actuators: their travel is servo_range (deg)"
     else:
-        ctx.notes["servo_range"] = "prismatic actuators: their travel is stroke_length (mm)"
+        notes["servo_range"] = "prismatic actuators: their travel is stroke_length (mm)"
     return {"base_outer_radius": fp["base_radius"],
             "platform_outer_radius": fp["platform_radius"],
             "stroke_length": None if rotary else travel,
