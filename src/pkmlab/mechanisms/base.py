@@ -146,7 +146,8 @@ class Mechanism:
     # ---- family hooks ----------------------------------------------------------------------
     _ik_one: ClassVar[Any] = None
     #: ``"linear"`` / ``"quadratic"`` when the family supplies exact column kernels
-    #: (:meth:`_columns`) for the workspace engine, ``None`` for sampled evaluation.
+    #: (``column_leg``) for the workspace engine, ``"crank"`` for rss6's set-valued legs (it
+    #: overrides ``column_intervals``, :mod:`._set_columns`), ``None`` for sampled evaluation.
     column_method: ClassVar[str | None] = None
     #: True when, at fixed (x, y, orientation), the leg geometry (link vectors, joint angles,
     #: Jacobian) does not depend on z, so non-stroke constraints act on whole columns.
