@@ -9,10 +9,16 @@ Prints, in one run:
 * the time of the same request on two 6-UPS: one sized like the 6-PSU (radii 165/100 mm
   base, 80/50 mm platform, legs 250-350 mm) and the Kotlarski et al. Gough–Stewart of the
   shipped studies (their exactness is tested in ``tests/test_workspace.py``);
-* peak memory (max RSS of a fresh process) of the 6-PSU case at 1 mm including its mesh.
+* peak memory (max RSS of a fresh process) of the 6-PSU case at 1 mm including its mesh;
+* the 6-RSS servo hexapod (``python benchmarks/bench_workspace.py rss6`` runs only this): the
+  ±10° simultaneous dexterous workspace at 2 mm with 7×7×7 orientations by the exact crank
+  column method, against a plain NumPy brute force (the closed-form crank angle of every voxel
+  × orientation × leg) timed on every ``RSS_STRIDE``-th x slab of the same grid and
+  extrapolated by the slab count; the two agree voxel for voxel on those slabs.
 
-Targets on 2 cores: ≤ 10 ms (6-PSU), ≤ 50 ms (6-UPS), ratio ≥ 1000×, < 1 GB at 1 mm.
-Run: ``.venv/bin/python benchmarks/bench_workspace.py``.
+Targets on 2 cores: ≤ 10 ms (6-PSU), ≤ 50 ms (6-UPS), ratio ≥ 1000×, < 1 GB at 1 mm;
+6-RSS ratio ≥ 500×.
+Run: ``.venv/bin/python benchmarks/bench_workspace.py [rss6]``.
 """
 
 from __future__ import annotations
@@ -26,13 +32,16 @@ from pathlib import Path
 import numpy as np
 from _timing import timed  # noqa: E402 - the benchmarks folder is on sys.path
 
-from pkmlab import UPS6, load_mechanism
+from pkmlab import RSS6, UPS6, load_mechanism
 from pkmlab.workspaces import Constraints, OrientationSet, workspace
 from pkmlab.workspaces.engine import _grid_xy
 
 ROOT = Path(__file__).resolve().parents[1]
 BOX = OrientationSet.box(np.radians([15.0, 15.0, 15.0]), "simultaneous", samples=7)
 H = 2.5
+RSS_BOX = OrientationSet.box(np.radians([10.0, 10.0, 10.0]), "simultaneous", samples=7)
+RSS_H = 2.0
+RSS_STRIDE = 16
 
 
 
@@ -56,6 +65,73 @@ def brute_force(mech, R, xs, ys, zs):
             good = (q >= lo) & (q <= hi)
         ok &= good.all(axis=1)
     return ok.reshape(X.shape)
+
+
+def brute_force_rss(mech, R, xs, ys, zs):
+    """Plain NumPy for the 6-RSS: the branch's crank angle (atan2(F, E) + b·acos(G/ρ), wrapped)
+    of every voxel at every orientation; all real and within the servo range."""
+    X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
+    p = np.stack([X, Y, Z], axis=-1).reshape(-1, 3)
+    a, s, b = mech.crank_length, mech.rod_length, mech.branch
+    lo, hi = mech.stroke
+    ok = np.ones(len(p), dtype=bool)
+    for Rm in R:
+        W = p[:, None, :] + (mech.tool_points @ Rm.T)[None] - mech.base_points[None]
+        E = 2 * a * np.einsum("nki,ki->nk", W, mech.zero_directions)
+        F = 2 * a * np.einsum("nki,ki->nk", W, mech.v_directions)
+        G = np.einsum("nki,nki->nk", W, W) + a * a - s * s
+        rho = np.hypot(E, F)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            alpha = np.arctan2(F, E) + b * np.arccos(G / rho)
+        alpha = np.where(alpha > np.pi, alpha - 2 * np.pi,
+                         np.where(alpha <= -np.pi, alpha + 2 * np.pi, alpha))
+        ok &= np.all((np.abs(G) <= rho) & (alpha >= lo) & (alpha <= hi), axis=1)
+    return ok.reshape(X.shape)
+
+
+def compare_rss(name, mech, repeats=3):
+    """The 6-RSS case: exact columns vs the brute force on every RSS_STRIDE-th x slab."""
+    t_fast, res = timed(lambda: workspace(mech, "dexterous", RSS_BOX, RSS_H), repeats)
+    R = res.orientations.rotations()
+    xs, ys, zb = _grid_xy(mech, R, "all", RSS_H)
+    zs = np.arange(math.ceil(zb[0] / RSS_H), math.floor(zb[1] / RSS_H) + 1) * RSS_H
+    fast_all = workspace(mech, "dexterous", RSS_BOX, RSS_H, Constraints(connected=False))
+    sub = np.arange(0, len(xs), RSS_STRIDE)
+    t0 = time.perf_counter()
+    brute = brute_force_rss(mech, R, xs[sub], ys, zs)
+    t_brute = (time.perf_counter() - t0) * len(xs) / len(sub)
+    # the engine crops to the occupied footprint: put its columns back on the full grid
+    K = fast_all.lo.shape[-1]
+    lo = np.full((len(xs), len(ys), K), np.inf)
+    hi = np.full((len(xs), len(ys), K), -np.inf)
+    cx, cy = np.searchsorted(xs, fast_all.xs), np.searchsorted(ys, fast_all.ys)
+    assert np.array_equal(xs[cx], fast_all.xs) and np.array_equal(ys[cy], fast_all.ys)
+    lo[np.ix_(cx, cy)], hi[np.ix_(cx, cy)] = fast_all.lo, fast_all.hi
+    lo, hi = lo[sub][:, :, None, :], hi[sub][:, :, None, :]
+    fast = np.any((lo <= zs[:, None]) & (zs[:, None] <= hi), axis=-1)
+    diff = int(np.sum(fast != brute))
+    print(f"{name}:")
+    print(f"  exact columns (public call): {t_fast * 1e3:8.1f} ms, volume "
+          f"{res.volume / 1e3:.1f} cm3 on {len(res.xs)} x {len(res.ys)} columns")
+    print(f"  plain NumPy brute force    : {t_brute:8.1f} s (measured on {len(sub)} of "
+          f"{len(xs)} x slabs, extrapolated) on {len(xs) * len(ys) * len(zs):,} voxels x "
+          f"{len(R)} orientations")
+    print(f"  ratio                      : {t_brute / t_fast:8.0f}x   (target >= 500x)")
+    print(f"  grids agree on those slabs : {'yes' if diff == 0 else 'NO'} ({diff} of "
+          f"{int(brute.sum()):,} inside voxels differ)")
+    return t_fast, t_brute, diff
+
+
+def rss_main() -> None:
+    sized = RSS6.from_circles(base_radii=(102.0, 102.0), platform_radii=(80.0, 80.0),
+                              crank_length=46.0, rod_length=183.0, crank_plane="tangential",
+                              name="6-RSS a = 46 mm, s = 183 mm, radii 102 / 80 mm")
+    compare_rss("6-RSS (a = 46, s = 183 mm, radii 102/80 mm), ±10° simultaneous dexterous, "
+                "2 mm, 7x7x7", sized)
+    hobby = load_mechanism(ROOT / "studies/mechanisms/instructables-servo-6rss.yaml")
+    t, res = timed(lambda: workspace(hobby, "dexterous", RSS_BOX, RSS_H), 3)
+    print(f"6-RSS instructables file, same request: {t * 1e3:.0f} ms; volume "
+          f"{res.volume / 1e3:.1f} cm3 (it has no ±10° dexterous workspace)")
 
 
 def compare(name, mech, repeats=7, target_ms=None):
@@ -182,6 +258,9 @@ def capability_cost(repeats: int = 3) -> None:
 
 
 def main() -> None:
+    if sys.argv[1:] == ["rss6"]:
+        rss_main()
+        return
     psu = load_mechanism(ROOT / "studies/mechanisms/hopkins-williams-6psu.yaml")
     compare("6-PSU Hopkins & Williams, ±15° simultaneous dexterous, 2.5 mm, 7x7x7", psu,
             repeats=21, target_ms=10)
@@ -200,6 +279,7 @@ def main() -> None:
           "(target < 1024 MB)")
     ups_pruning()
     capability_cost()
+    rss_main()
 
 
 if __name__ == "__main__":

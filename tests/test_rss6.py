@@ -170,11 +170,12 @@ def test_cli_reports_servo_angles_in_degrees():
 
 
 def test_sampled_workspace_matches_independent_voxel_count():
-    """No column hooks: the engine samples voxels. Its count equals an independent numpy
-    evaluation of the closed form (|G| <= ρ and the angle in range) on the same grid."""
+    """The engine's sampled method: its count equals an independent numpy evaluation of the
+    closed form (|G| <= ρ and the angle in range) on the same grid (the exact column method
+    is checked in ``test_rss6_columns.py``)."""
     m = RSS6.from_circles(stroke=(-1.0, 1.0))
     cons = pkmlab.Constraints(connected=False)
-    ws = pkmlab.workspace(m, "constant", resolution=4.0, constraints=cons)
+    ws = pkmlab.workspace(m, "constant", resolution=4.0, constraints=cons, method="sampled")
     assert ws.method == "sampled voxels"
     X, Y, Z = np.meshgrid(ws.xs, ws.ys, ws.zs, indexing="ij")
     p = np.stack([X.ravel(), Y.ravel(), Z.ravel()], axis=1)

@@ -57,7 +57,8 @@ from .quantities import (  # noqa: F401 (re-exported for plugins' spec models)
     _stroke,
 )
 from .specbase import FamilySpec, PairedCircles, _Common, _Model  # noqa: F401
-from .units import ANGLE_UNITS, LENGTH_UNITS
+from .units import ANGLE_UNITS, LENGTH_UNITS, parse_angle, parse_length
+from .workspaces.constraints import ActuatorWindow
 from .yamlio import load_yaml, remember, where
 
 __all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec", "FamilySpec", "mechanism_specs",
@@ -217,23 +218,59 @@ class JointLimitsSpec(_Model):
     platform_axes: Points | None = Field(None, description="6 mounting axes, platform frame")
 
 
-def _stroke_choice(v: Any) -> bool | list[float]:
+def _stroke_item(x: Any) -> tuple[float, str]:
+    """One actuator value as written: ``(value, unit)`` with unit "bare" (a plain number),
+    "mm" (a length with units, in mm) or "rad" (an angle with units, in rad)."""
+    if isinstance(x, int | float) and not isinstance(x, bool):
+        return float(x), "bare"
+    if isinstance(x, str):
+        try:
+            return float(x), "bare"
+        except ValueError:
+            pass
+        for parse, unit in ((parse_length, "mm"), (parse_angle, "rad")):
+            try:
+                return parse(x, ""), unit
+            except ParameterError:
+                pass
+    raise _Invalid("must be a window [min, max] of actuator values: lengths (mm or with "
+                   "units) or, for rotary actuators, servo angles (deg or with units); got "
+                   f"{format_value(x)}")
+
+
+def _stroke_choice(v: Any) -> bool | ActuatorWindow:
     if v is True:
         return True
     if v is False:
         raise _Invalid("must be true or a window [min, max] (without a stroke limit the "
                        "workspace is unbounded); got False")
-    return _stroke(v)
+    if isinstance(v, ActuatorWindow):
+        return v
+    if not isinstance(v, list | tuple) or len(v) != 2:
+        raise _Invalid(f"must be true or a window [min, max]; got {format_value(v)}")
+    (lo, u0), (hi, u1) = _stroke_item(v[0]), _stroke_item(v[1])
+    if {u0, u1} == {"mm", "rad"}:
+        raise _Invalid(f"must be two lengths or two angles, not one of each; got "
+                       f"{format_value(v)}")
+    unit = u0 if u0 != "bare" else u1
+    if unit != "bare":   # a bare number beside a quantity takes the quantity's default unit
+        lo = lo if u0 != "bare" else (lo if unit == "mm" else float(np.radians(lo)))
+        hi = hi if u1 != "bare" else (hi if unit == "mm" else float(np.radians(hi)))
+    if not lo < hi:
+        raise _Invalid(f"must be [min, max] with min < max; got {format_value(v)}")
+    return ActuatorWindow(lo, hi, unit)
 
 
-StrokeChoice = Annotated[bool | list[float], BeforeValidator(_stroke_choice),
+StrokeChoice = Annotated[Any, BeforeValidator(_stroke_choice),
                          WithJsonSchema({"anyOf": [{"type": "boolean"},
-                                                   {"type": "array", "items": _NUMBER_OR_UNIT}]})]
+                                                   {"type": "array", "items": _NUMBER_OR_UNIT,
+                                                    "minItems": 2, "maxItems": 2}]})]
 
 
 class ConstraintsSpec(_Model):
     stroke: StrokeChoice = Field(
-        True, description="true (the mechanism's window) or [min, max] to try another")
+        True, description="true (the mechanism's window) or [min, max] to try another: "
+        "lengths (mm or with units), or servo angles (deg or with units) for rotary actuators")
     joint_limits: JointLimitsSpec | None = None
     link_diameter: PositiveLength | None = Field(None, description="leg diameter (mm)")
     kappa_max: float | None = Field(None, ge=1, description="largest condition number")
@@ -304,7 +341,7 @@ class WorkspaceSpec(_Model):
         if c.joint_limits is not None:
             j = c.joint_limits
             jl = JointLimits(j.base, j.platform, j.base_axes, j.platform_axes)
-        cons = Constraints(stroke=c.stroke if c.stroke is True else tuple(c.stroke),
+        cons = Constraints(stroke=c.stroke,
                            joint_limits=jl, link_diameter=c.link_diameter,
                            kappa_max=c.kappa_max, characteristic_length=c.characteristic_length,
                            connected=c.connected)
@@ -433,7 +470,7 @@ def _display_of(validator):
              _auto_positive_length: lambda v: "auto" if v is None else _fmt_length(v),
              _link_lengths: lambda v: ([_fmt_length(x) for x in v] if isinstance(v, list)
                                        else _fmt_length(v)),
-             _stroke_choice: lambda v: v if v is True else [_fmt_length(x) for x in v]}
+             _stroke_choice: lambda v: v if v is True else v.shown()}
     if validator in table:
         return table[validator]
     if getattr(validator, "__qualname__", "").startswith("_length_list"):

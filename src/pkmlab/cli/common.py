@@ -143,7 +143,8 @@ KappaMaxOpt = Annotated[float | None, typer.Option(help="largest condition numbe
 AllComponentsOpt = Annotated[bool, typer.Option(
     "--all-components", help="keep regions not connected to the nominal pose")]
 StrokeOpt = Annotated[str | None, typer.Option(
-    help='evaluate with another actuator window "min,max" (mm or with units)')]
+    help='evaluate with another actuator window "min,max": lengths (mm or with units), or '
+    'servo angles (deg or with units) for rotary actuators')]
 
 
 def _request(kind, orientation, box, semantics, tilt, torsion, samples, resolution,

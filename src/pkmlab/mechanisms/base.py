@@ -13,6 +13,10 @@ method whose name starts with ``_``):
 * ``forward(q)``, ``assembly_modes(q)``;
 * ``footprint()`` — base and platform radii measured from their centres;
 * ``leg_segments(p, R)`` — each leg's moving link, for interference and drawing;
+  ``link_segments(p, R)`` — every moving link with the leg it belongs to (default: the
+  ``leg_segments``; 6-RSS: cranks and rods), for interference; ``base_joint_axes(p, R, axes)``
+  — the mounting axes of the base-side passive joints at each pose (default: fixed; 6-RSS:
+  turned with the crank that carries the joint), for joint cones;
 * workspace hooks: ``position_bounds(R)``, and for families with exact column intervals
   ``column_method``, ``column_leg``, ``column_params()``, ``leg_offsets(R)`` and
   ``column_intervals(xs, ys, R, mode)`` (and ``column_radial`` when the leg intervals are
@@ -142,7 +146,8 @@ class Mechanism:
     # ---- family hooks ----------------------------------------------------------------------
     _ik_one: ClassVar[Any] = None
     #: ``"linear"`` / ``"quadratic"`` when the family supplies exact column kernels
-    #: (:meth:`_columns`) for the workspace engine, ``None`` for sampled evaluation.
+    #: (``column_leg``) for the workspace engine, ``"crank"`` for rss6's set-valued legs (it
+    #: overrides ``column_intervals``, :mod:`._set_columns`), ``None`` for sampled evaluation.
     column_method: ClassVar[str | None] = None
     #: True when, at fixed (x, y, orientation), the leg geometry (link vectors, joint angles,
     #: Jacobian) does not depend on z, so non-stroke constraints act on whole columns.
@@ -216,6 +221,18 @@ class Mechanism:
         ``start`` carries the base-side passive joint and ``end`` the platform-side one.
         """
         raise NotImplementedError
+
+    def link_segments(self, p: np.ndarray, R: np.ndarray):
+        """``(start, end, leg)``: end points ``(N, S, 3)`` of every moving link and the leg
+        ``(S,)`` each belongs to; links of one leg share joints, so interference is checked
+        between links of different legs only. Default: the ``leg_segments``."""
+        start, end = self.leg_segments(p, R)
+        return start, end, np.arange(start.shape[1])
+
+    def base_joint_axes(self, p: np.ndarray, R: np.ndarray, axes: np.ndarray) -> np.ndarray:
+        """``(N, 6, 3)`` base-frame mounting axes of the base-side passive joints at the poses,
+        given ``axes (6, 3)`` at the nominal pose. Default: the joints are fixed to the base."""
+        return np.broadcast_to(np.asarray(axes, dtype=float), (len(p), 6, 3))
 
     def _gparams(self) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError

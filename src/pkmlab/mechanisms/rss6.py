@@ -30,9 +30,12 @@ singular (serial singularity) when the rod is perpendicular to the crank's veloc
 With actuator values in rad, ``Jᵀ τ = w`` relates servo torques ``τ`` (N·mm) and the tool
 wrench ``w = [f (N); m (N·mm)]``: ``τ = J⁻ᵀ w`` (see :meth:`RSS6.servo_torques`).
 
-Workspace: the feasible z set of a column is a union of intervals (the crank equation is not
-monotone in z), so this family has no exact column hooks and the workspace engine samples
-voxels; :meth:`RSS6.position_bounds` bounds the sampled box.
+Workspace: exact column method (``column_method = "crank"``): on a column the feasible z set
+of a leg is a union of intervals whose ends are roots of a quartic (the real solution appears)
+and of two quadratics (the servo-window edges), see :mod:`._crank`; the set-valued column
+drivers of :mod:`._set_columns` intersect / unite them. :meth:`RSS6.position_bounds` bounds the
+search box. Interference covers the cranks too (:meth:`RSS6.link_segments`), and the
+crank-end ball joints' cones turn with the cranks (:meth:`RSS6.base_joint_axes`).
 """
 
 from __future__ import annotations
@@ -45,7 +48,10 @@ from numba import njit
 from numba.extending import register_jitable
 
 from ..errors import ParameterError
+from ..poses import as_frames
 from . import _kernels
+from ._crank import crank_column_leg, crank_params
+from ._set_columns import set_column_intervals
 from .base import NO_STROKE, Mechanism, as_points, as_positive, as_vector3
 from .layout import build_paired
 from .psu6 import _radii
@@ -347,6 +353,22 @@ class RSS6(Mechanism):
         return d
 
     # ---- workspace hooks -------------------------------------------------------------------
+    column_method = "crank"
+    #: set-valued column leg (:mod:`._set_columns`): the exact crank z set (:mod:`._crank`)
+    column_set_leg = crank_column_leg
+
+    def column_params(self) -> np.ndarray:
+        """``(6, 11)`` rows of :func:`._crank.crank_column_leg`."""
+        return crank_params(self.zero_directions, self.v_directions, self.crank_length,
+                            self.rod_length, self.branch, self.stroke)
+
+    def column_intervals(self, xs, ys, R, mode, allowed=None, K=8):
+        """Exact feasible z sets of the columns (see :mod:`._crank`), same contract as
+        :meth:`.base.Mechanism.column_intervals`; each leg's set may have several pieces, so
+        the dexterous (``"all"``) sets have up to ``K`` pieces too."""
+        return set_column_intervals(crank_column_leg, self.leg_offsets(R),
+                                    self.column_params(), xs, ys, R, mode, allowed, K)
+
     def position_bounds(self, R):
         """Each platform joint within ``a_i + s_i`` of its pivot: ``(M, 2, 3)``."""
         W = self.leg_offsets(R)
@@ -358,3 +380,25 @@ class RSS6(Mechanism):
         W = p[:, None, :] + np.einsum("nij,kj->nki", R, self.tool_points)
         q = self.inverse((p, R), stroke=NO_STROKE).q
         return self.crank_ends(q), W
+
+    def link_segments(self, p, R):
+        """Cranks (pivot → crank end, segments 0-5) and rods (crank end → platform joint,
+        6-11), with their legs ``[0..5, 0..5]``: interference covers crank/crank, crank/rod
+        and rod/rod of different legs."""
+        C, W = self.leg_segments(p, R)
+        B = np.broadcast_to(self.base_points, C.shape)
+        leg = np.arange(6)
+        return np.concatenate([B, C], axis=1), np.concatenate([C, W], axis=1), \
+            np.concatenate([leg, leg])
+
+    def base_joint_axes(self, p, R, axes):
+        """The crank-end ball joints ride on the cranks: their mounting axes, given at the
+        nominal pose, turn with each crank about its servo axis by ``α − α_nominal``."""
+        q = self.inverse((p, R), stroke=NO_STROKE).q                      # (N, 6)
+        pn, Rn = as_frames(self.nominal_pose)
+        d = q - self.inverse((pn, Rn), stroke=NO_STROKE).q                  # (N, 6)
+        n = self.servo_axes
+        a = np.broadcast_to(np.asarray(axes, dtype=float), (len(p), 6, 3))
+        c, s = np.cos(d)[..., None], np.sin(d)[..., None]
+        return (a * c + np.cross(n, a) * s
+                + n * np.sum(n * a, axis=-1, keepdims=True) * (1.0 - c))   # Rodrigues

@@ -254,7 +254,7 @@ def _sampled_fail(mech, R, task, h, cons, grow=0.0, surface=False) -> int:
 
 
 def _prepare(mech, orientations: OrientationSet | None, constraints: Constraints | None):
-    cons = constraints or Constraints()
+    cons = (constraints or Constraints()).resolved(mech)
     if cons.stroke is not True:
         mech = dataclasses.replace(mech, stroke_window=cons.stroke)
     oset = orientations or OrientationSet.fixed()

@@ -61,6 +61,8 @@ class Evaluation:
                       if getattr(self, n)]
             if self.dexterity is not None:
                 names.append("dexterity")
+            if self.payload is not None:
+                names.append("payload")
         if self.trajectory is not None:
             names.append("trajectory")
         names += [n for n in ("task", "motions", "actuators") if getattr(self, n) is not None]

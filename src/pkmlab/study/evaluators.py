@@ -33,6 +33,7 @@ from ..errors import NumericalError, ParameterError
 from ..limits import CAPABILITY_MAX_DEG
 from ..requirements.actuators import fit as actuator_fit
 from ..requirements.dynamics import inverse_dynamics
+from ..requirements.static import static_loads
 from ..requirements.task import task_margins
 from ..trajectory import check_trajectory, paper_motion
 from ..workspaces import OrientationSet, workspace
@@ -77,9 +78,17 @@ def _finite(x) -> float | None:
 @_evaluator("geometry")
 def _geometry(mech, ctx: Context) -> dict:
     fp = mech.footprint()
+    travel = float(mech.stroke[1] - mech.stroke[0])
+    rotary = mech.actuator_unit == "rad"
+    notes = {} if ctx is None else ctx.notes          # the geometry needs no context
+    if rotary:
+        notes["stroke_length"] = "rotary actuators: their travel is servo_range (deg)"
+    else:
+        notes["servo_range"] = "prismatic actuators: their travel is stroke_length (mm)"
     return {"base_outer_radius": fp["base_radius"],
             "platform_outer_radius": fp["platform_radius"],
-            "stroke_length": float(mech.stroke[1] - mech.stroke[0])}
+            "stroke_length": None if rotary else travel,
+            "servo_range": math.degrees(travel) if rotary else None}
 
 
 @_evaluator("workspace")
@@ -269,6 +278,27 @@ def _motions(mech, ctx: Context) -> dict:
         if not sums:
             ctx.notes[name] = "no feasible sample in any motion"
     return out
+
+
+@_evaluator("payload")
+def _payload(mech, ctx: Context) -> dict:
+    """Peak static servo torque over the workspace (:mod:`pkmlab.requirements.static`)."""
+    res = ctx.result
+    if mech.actuator_unit != "rad":
+        ctx.notes["peak_servo_torque"] = ("prismatic actuators: no servo torque (forces: "
+                                          "peak_actuator_force with evaluate.motions)")
+        return {"peak_servo_torque": None}
+    if res.empty:
+        ctx.notes["peak_servo_torque"] = "workspace empty"
+        return {"peak_servo_torque": None}
+    loads = static_loads(res.mechanism, res, ctx.evaluation.payload.for_mechanism(mech))
+    if loads.singular:
+        ctx.notes["peak_servo_torque"] = "singular pose inside the workspace: unbounded torque"
+        return {"peak_servo_torque": None}
+    if loads.poses == 0:
+        ctx.notes["peak_servo_torque"] = "no valid pose on the workspace grid"
+        return {"peak_servo_torque": None}
+    return {"peak_servo_torque": loads.peak}
 
 
 @_evaluator("actuators")

@@ -55,7 +55,11 @@ _ALL = [
            "footprint: largest horizontal distance of a base joint from the base z axis"),
     Metric("platform_outer_radius", "geometry", "mm", "exact",
            "largest distance of a platform joint from the platform joints' centroid"),
-    Metric("stroke_length", "geometry", "mm", "exact", "actuator travel (max - min)"),
+    Metric("stroke_length", "geometry", "mm", "exact",
+           "prismatic actuator travel (max - min); null for rotary actuators (servo_range)"),
+    Metric("servo_range", "geometry", "deg", "exact",
+           "rotary actuator travel (max - min of the servo angle); null for prismatic "
+           "actuators (stroke_length)"),
     # workspace
     Metric("workspace_volume", "workspace", "cm³", "grid",
            "volume of the requested workspace (exact in z, x-y grid and sampled orientation "
@@ -137,6 +141,11 @@ _ALL = [
            "largest |actuator speed| over every sample of every required motion"),
     Metric("peak_actuator_power", "motions", "W", "worst-case",
            "largest |actuator force × speed| over every sample of every required motion"),
+    # requirements: the payload held at rest over the workspace
+    Metric("peak_servo_torque", "payload", "N·mm", "worst-case",
+           "largest |servo torque| holding the payload at rest (τ = J⁻ᵀ·w, w the gravity "
+           "wrench of payload + platform + leg-end masses) over every voxel × orientation "
+           "sample of the workspace; rotary actuators only (null for prismatic)"),
     # requirements: actuators
     Metric("actuators_fit", "actuators", "", "flag",
            "1 if the chosen actuator meets force, speed, torque–speed and stroke along every "

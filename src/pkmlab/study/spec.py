@@ -292,7 +292,8 @@ def _metric(name: Any, where: str, evaluation: Evaluation) -> str:
         need = METRICS[name].evaluator
         raise ParameterError(where, f"a metric the evaluation computes (add evaluate.{need}"
                              + (" and evaluate.workspace" if need in ("inscribed",
-                                "orientation_capability", "dexterity") else "") + ")", name)
+                                "orientation_capability", "dexterity", "payload") else "")
+                             + ")", name)
     return name
 
 

@@ -6,6 +6,7 @@ Each check takes tool positions ``p (N, 3)`` and rotations ``R (N, 3, 3)`` and r
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -15,7 +16,52 @@ from ..dexterity.metrics import condition_number, resolve_length
 from ..errors import ParameterError
 from ..poses import as_frames
 
-__all__ = ["Constraints", "JointLimits", "check", "segment_distances", "joint_angles"]
+__all__ = ["ActuatorWindow", "Constraints", "JointLimits", "check", "segment_distances",
+           "joint_angles"]
+
+
+@dataclass(frozen=True)
+class ActuatorWindow:
+    """An actuator window as the user wrote it (YAML ``constraints.stroke``, ``--stroke``),
+    resolved against a mechanism by :meth:`Constraints.resolved`.
+
+    Attributes:
+        lo, hi: the two values, in ``unit``.
+        unit: ``"mm"`` (lengths given with units, converted to mm), ``"rad"`` (angles given
+            with units, converted to rad) or ``"bare"`` (plain numbers: mm for prismatic
+            actuators, deg for rotary ones, the YAML conventions).
+    """
+
+    lo: float
+    hi: float
+    unit: str
+
+    def __post_init__(self):
+        if self.unit not in ("mm", "rad", "bare"):
+            raise ValueError(f"unit must be 'mm', 'rad' or 'bare', got {self.unit!r}")
+
+    def shown(self) -> list[str]:
+        if self.unit == "rad":
+            return [f"{math.degrees(v):.12g} deg" for v in (self.lo, self.hi)]
+        return [f"{v:.12g}" + (" mm" if self.unit == "mm" else "") for v in (self.lo, self.hi)]
+
+    def window(self, mech) -> tuple[float, float]:
+        """``(lo, hi)`` in the internal unit of ``mech``'s actuators (mm, or rad for rotary
+        ones); a length for a rotary actuator (or an angle for a prismatic one) is refused."""
+        rotary = mech.actuator_unit == "rad"
+        if self.unit == ("mm" if rotary else "rad"):
+            want = ("servo angles (deg or with units)" if rotary else
+                    "lengths (mm or with units)")
+            kind = "rotary" if rotary else "prismatic"
+            raise ParameterError("constraints.stroke", f"{want} for family {mech.family!r}, "
+                                 f"whose actuators are {kind}", self.shown())
+        lo, hi = self.lo, self.hi
+        if rotary and self.unit == "bare":
+            lo, hi = math.radians(lo), math.radians(hi)
+        if rotary and not -math.pi <= lo < hi <= math.pi:
+            raise ParameterError("constraints.stroke", "[min, max] servo angles with -180 deg "
+                                 "<= min < max <= 180 deg", self.shown())
+        return lo, hi
 
 
 @dataclass(frozen=True)
@@ -57,9 +103,11 @@ class Constraints:
     """Which constraints a workspace request applies.
 
     Attributes:
-        stroke: ``True`` = the mechanism's actuator window, or ``(min, max)`` in mm to
-            evaluate the same geometry with another window (what-if strokes). It cannot be
-            switched off: without it a workspace is unbounded.
+        stroke: ``True`` = the mechanism's actuator window, or ``(min, max)`` in the
+            actuators' internal unit (mm, or rad for rotary actuators) to evaluate the same
+            geometry with another window (what-if strokes), or an :class:`ActuatorWindow` as
+            the user wrote it (resolved against the mechanism by :meth:`resolved`). It cannot
+            be switched off: without it a workspace is unbounded.
         joint_limits: passive joint cones, or ``None``.
         link_diameter: legs are cylinders of this diameter (mm); two legs interfere when
             their axes come closer than it. ``None`` = not checked.
@@ -73,22 +121,28 @@ class Constraints:
             regions that the stroke alone admits).
     """
 
-    stroke: bool | tuple[float, float] = True
+    stroke: bool | tuple[float, float] | ActuatorWindow = True
     joint_limits: JointLimits | None = None
     link_diameter: float | None = None
     kappa_max: float | None = None
     characteristic_length: float | None = None
     connected: bool = True
+    #: unit of a ``(min, max)`` stroke (``"mm"`` or ``"rad"``), set by :meth:`resolved`
+    stroke_unit: str | None = None
 
     def __post_init__(self):
         if self.stroke is not True:
-            win = np.asarray(self.stroke, dtype=float) if self.stroke is not False else None
+            w = self.stroke
+            win = (np.asarray([w.lo, w.hi] if isinstance(w, ActuatorWindow) else w,
+                              dtype=float) if w is not False else None)
             if win is None or win.shape != (2,) or not np.all(np.isfinite(win)) \
                     or win[0] >= win[1]:
-                raise ParameterError("constraints.stroke", "true or a window [min, max] in mm "
-                                     "with min < max (without a stroke limit the workspace "
-                                     "is unbounded)", self.stroke)
-            object.__setattr__(self, "stroke", (float(win[0]), float(win[1])))
+                raise ParameterError("constraints.stroke", "true or a window [min, max] "
+                                     "(mm, or servo angles for rotary actuators) with min < "
+                                     "max (without a stroke limit the workspace is "
+                                     "unbounded)", self.stroke)
+            if not isinstance(w, ActuatorWindow):
+                object.__setattr__(self, "stroke", (float(win[0]), float(win[1])))
         if self.link_diameter is not None and not (self.link_diameter > 0):
             raise ParameterError("constraints.link_diameter", "a length > 0 mm",
                                  self.link_diameter)
@@ -97,6 +151,16 @@ class Constraints:
         if self.characteristic_length is not None and not (self.characteristic_length > 0):
             raise ParameterError("constraints.characteristic_length", "a length > 0 mm",
                                  self.characteristic_length)
+
+    def resolved(self, mech) -> Constraints:
+        """These constraints with the stroke in ``mech``'s internal actuator unit (an
+        :class:`ActuatorWindow` converted, refused when its dimension does not fit)."""
+        if isinstance(self.stroke, ActuatorWindow):
+            return dataclasses.replace(self, stroke=self.stroke.window(mech),
+                                       stroke_unit=mech.actuator_unit)
+        if self.stroke is not True and self.stroke_unit is None:
+            return dataclasses.replace(self, stroke_unit=mech.actuator_unit)
+        return self
 
     @property
     def extra(self) -> bool:
@@ -107,7 +171,10 @@ class Constraints:
     def describe(self) -> dict:
         jl = self.joint_limits
         return {
-            "stroke": self.stroke if self.stroke is True else list(self.stroke),
+            "stroke": (self.stroke if self.stroke is True else self.stroke.shown()
+                       if isinstance(self.stroke, ActuatorWindow) else
+                       [f"{math.degrees(v):.12g} deg" for v in self.stroke]
+                       if self.stroke_unit == "rad" else list(self.stroke)),
             "joint_limits_deg": None if jl is None else {
                 "base": None if jl.base is None else math.degrees(jl.base),
                 "platform": None if jl.platform is None else math.degrees(jl.platform)},
@@ -125,7 +192,8 @@ def joint_angles(mech, p, R, limits: JointLimits) -> tuple[np.ndarray, np.ndarra
     with np.errstate(invalid="ignore", divide="ignore"):
         d = d / np.linalg.norm(d, axis=-1, keepdims=True)
     nb, npl = _mounting_axes(mech, limits)
-    cb = np.einsum("nki,ki->nk", d, nb)
+    nb = mech.base_joint_axes(p, R, nb)       # joints riding on a crank turn with it
+    cb = np.einsum("nki,nki->nk", d, nb)
     cp = np.einsum("nki,nij,kj->nk", d, R, npl)
     return np.arccos(np.clip(cb, -1, 1)), np.arccos(np.clip(cp, -1, 1))
 
@@ -142,9 +210,13 @@ def _mounting_axes(mech, limits: JointLimits):
     return nb, npl
 
 
-def segment_distances(start: np.ndarray, end: np.ndarray) -> np.ndarray:
-    """Smallest distance ``(N, 15)`` between every pair of the six segments ``(N, 6, 3)``."""
-    i, j = np.triu_indices(6, 1)
+def segment_distances(start: np.ndarray, end: np.ndarray, leg=None) -> np.ndarray:
+    """Smallest distance between every pair of the segments ``(N, S, 3)``: ``(N, 15)`` for
+    six; with ``leg (S,)`` only pairs of segments of different legs."""
+    i, j = np.triu_indices(start.shape[1], 1)
+    if leg is not None:
+        keep = np.asarray(leg)[i] != np.asarray(leg)[j]
+        i, j = i[keep], j[keep]
     p1, q1, p2, q2 = start[:, i], end[:, i], start[:, j], end[:, j]
     d1, d2, r = q1 - p1, q2 - p2, p1 - p2
     a = np.einsum("...i,...i", d1, d1)
@@ -179,8 +251,8 @@ def check(mech, p: np.ndarray, R: np.ndarray, cons: Constraints) -> np.ndarray:
         if jl.platform is not None:
             ok &= np.all(ap <= jl.platform, axis=1)
     if cons.link_diameter is not None:
-        start, end = mech.leg_segments(p, R)
-        d = segment_distances(start, end)
+        start, end, leg = mech.link_segments(p, R)
+        d = segment_distances(start, end, leg)
         ok &= np.all(d >= cons.link_diameter, axis=1)
     if cons.kappa_max is not None:
         L = resolve_length(mech, cons.characteristic_length).length

@@ -94,7 +94,7 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
                              f"{RESOLUTION_MM[1]:g}] mm", resolution)
     if method not in ("auto", "columns", "sampled"):
         raise ParameterError("method", "one of ['auto', 'columns', 'sampled']", method)
-    cons = constraints or Constraints()
+    cons = (constraints or Constraints()).resolved(mech)
     if cons.stroke is not True:
         # the same geometry with another actuator window (the family re-validates it)
         mech = dataclasses.replace(mech, stroke_window=cons.stroke)
@@ -136,7 +136,10 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
         t = time.perf_counter()
         lo, hi, overflow = mech.column_intervals(xs, ys, R, mode)
         timings["columns_s"] = time.perf_counter() - t
-        if refine and mode == "all" and oset.kind != "fixed":
+        if refine and mode == "all" and oset.kind != "fixed" and mech.column_leg is None:
+            notes.append(f"refine: not available for family {mech.family!r} (set-valued "
+                         "column legs); sampled orientations only")
+        elif refine and mode == "all" and oset.kind != "fixed":
             t = time.perf_counter()
             before = _column_volume(lo, hi, h)
             lo, hi, changed = refine_columns(mech, xs, ys, oset, lo, hi)
@@ -230,7 +233,7 @@ def orientation_convergence(mech, kind: str, orientations: OrientationSet,
         r = workspace(mech, kind, o, resolution, constraints)
         row = {"samples": int(n), "orientations": int(len(o.parameters())),
                "volume_mm3": r.volume, "seconds": r.timings["total_s"]}
-        if kind == "dexterous" and mech.column_method is not None:
+        if kind == "dexterous" and mech.column_leg is not None:
             rr = workspace(mech, kind, o, resolution, constraints, refine=True)
             row["refined_volume_mm3"] = rr.volume
         rows.append(row)
