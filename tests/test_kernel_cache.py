@@ -79,8 +79,11 @@ for task in args["tasks"]:
     if kind == "ik":
         X = np.array(poses[f])
         R = euler_to_matrix(X[:, 3:]).reshape(-1, 3, 3)
+        ik, J = m.inverse_and_jacobian((X[:, :3].copy(), R))
         out[task] = {"euler": m.inverse(X).q.tolist(),
                      "frames": m.inverse((X[:, :3].copy(), R)).q.tolist(),
+                     "fused": ik.q.tolist(), "jac": m.jacobian(X).tolist(),
+                     "fused_jac": J.tolist(),
                      "base": m.base_points.tolist(), "tool": m.tool_points.tolist(),
                      "length": m.link_length.tolist() if f == "psu6" else None}
     elif kind == "ws":
@@ -131,6 +134,19 @@ def ik_reference(family, X, base, tool, length):
     return np.linalg.norm(Wj - B, axis=-1)                              # ups6
 
 
+def jacobian_reference(family, X, base, tool, length):
+    """Rows ``[a, r × a] / a_z`` (psu6, ``a`` the link) or ``[n, r × n]`` (ups6)."""
+    p, R = X[:, :3], euler_to_matrix(X[:, 3:]).reshape(-1, 3, 3)
+    r = np.einsum("nij,kj->nki", R, np.array(tool))
+    a = p[:, None, :] + r - np.array(base)
+    if family == "psu6":
+        with np.errstate(invalid="ignore"):
+            a[..., 2] = np.sqrt(np.array(length) ** 2 - a[..., 0] ** 2 - a[..., 1] ** 2)
+        return np.concatenate([a, np.cross(r, a)], axis=-1) / a[..., 2:3]
+    n = a / np.linalg.norm(a, axis=-1)[..., None]
+    return np.concatenate([n, np.cross(r, n)], axis=-1)
+
+
 def leg_reference(family, x, y, W, P):
     """Each leg's stroke interval on the column (x, y), as in the family docstrings."""
     wx, wy, wz = W[..., 0], W[..., 1], W[..., 2]
@@ -178,10 +194,14 @@ def union_length(lo, hi):
 def check_ik(family, r):
     X = POSES[family]
     ref = ik_reference(family, X, r["base"], r["tool"], r["length"])
-    for path in ("euler", "frames"):
+    for path in ("euler", "frames", "fused"):
         q = np.array(r[path], dtype=float)
         np.testing.assert_allclose(q, ref, rtol=1e-11, atol=1e-9,
                                    err_msg=f"{family} IK, {path} path")
+    Jref = jacobian_reference(family, X, r["base"], r["tool"], r["length"])
+    for path in ("jac", "fused_jac"):
+        np.testing.assert_allclose(np.array(r[path], dtype=float), Jref, rtol=1e-11,
+                                   atol=1e-11, err_msg=f"{family} Jacobian, {path} path")
 
 
 def check_columns(family, r):
@@ -284,7 +304,8 @@ def test_kernels_compiled_by_different_processes_do_not_alias(tmp_path):
         assert r["volume"] == pytest.approx(h * h * length.sum(), rel=1e-9), family
     # everything came from the cache: nothing compiled and saved in the third process
     assert "data saved" not in log, [s for s in log.splitlines() if "data saved" in s][:5]
-    for name in ("drive_euler", "drive_frames", "columns_all", "columns_any", "leg_eval"):
+    for name in ("drive_euler", "drive_frames", "columns_all", "columns_any", "leg_eval",
+                 "drive_jacobian", "drive_kinematics"):
         assert re.search(rf"data loaded from .*{name}", log), f"{name} not loaded from cache"
 
 

@@ -392,3 +392,29 @@ def test_actuator_choices_must_be_catalogue_entries(tmp_path):
     data["design"]["actuator"]["choices"] = ["EC-S-1k", "nope"]
     with pytest.raises(ParameterError, match=r"design\.actuator\.choices"):
         study_from_mapping(data, path.parent)
+
+
+@pytest.mark.parametrize("name", ["hopkins-williams-6psu", "gough-stewart-6ups",
+                                  "instructables-servo-6rss", "luzi-3chain"])
+def test_actuator_power_equals_energy_rate_on_every_family(name):
+    """Σ f_i·q̇_i = dE/dt with q̇ from finite differences of the inverse kinematics (not the
+    Jacobian): checks ``f = J⁻ᵀ w`` for prismatic forces and for rss6's crank torques."""
+    mech = load_mechanism(MECH_DIR / f"{name}.yaml")
+    S = mech.scale / 400
+    A = np.array([6 * S, 4 * S, 5 * S, 0.03, 0.04, 0.05])
+    f, ph = np.array([0.8, 1.1, 1.5, 0.7, 1.3, 0.9]), np.array([0.3, 1.0, 0.0, 2.0, 0.5, 1.2])
+    m = sinusoid_motion(mech, A, f, ph, duration=1.0, rate=50)
+    body = MassProperties(20.0, mech.tool_offset + [3.0, -2.0, 40.0], [4e5, 3e5, 2e5])
+    res = inverse_dynamics(mech, m, body)
+    assert np.all(res.ok)
+    h = 1e-4
+    w2 = 2 * np.pi * f
+
+    def q_at(t):
+        return mech.inverse(mech.nominal_pose + A * np.sin(np.outer(t, w2) + ph)).q
+
+    qd = (q_at(m.t - 2 * h) - 8 * q_at(m.t - h) + 8 * q_at(m.t + h) - q_at(m.t + 2 * h)) / (12 * h)
+    np.testing.assert_allclose(res.qdot, qd, atol=1e-6 * np.max(np.abs(qd)))
+    P = np.sum(res.force * qd, axis=1) * 1e-3
+    ref = np.einsum("ni,ni->n", res.wrench, m.twist) * 1e-3      # w·[v; ω], W
+    assert np.max(np.abs(P - ref)) < 1e-6 * np.max(np.abs(ref))

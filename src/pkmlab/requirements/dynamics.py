@@ -229,7 +229,7 @@ def _one(k, J, R, tw, ac, mass, rc, Ic, g0, w, f, qd, pw, piv, r, IA, IW, b, A):
         pw[k, i] = f[k, i] * qd[k, i] * 1e-3
 
 
-_CHUNK = 32768
+_CHUNK = 65536
 
 
 def inverse_dynamics(mech, motion: Motion, body: MassProperties,
@@ -248,12 +248,12 @@ def inverse_dynamics(mech, motion: Motion, body: MassProperties,
     for s in range(0, n, _CHUNK):
         e = min(n, s + _CHUNK)
         p, R = as_frames(motion.poses[s:e])
-        ik = mech.inverse((p, R))
+        ik, J = mech.inverse_and_jacobian((p, R))
         q[s:e], valid[s:e] = ik.q, ik.valid
         if not np.all(ik.valid):
             idx = np.flatnonzero(~ik.valid)
             reasons.update(zip((s + idx).tolist(), np.asarray(ik.reason_text)[idx].tolist()))
-        J = np.ascontiguousarray(mech.jacobian((p, R)))
+        J = np.ascontiguousarray(J)
         _solver()(J, np.ascontiguousarray(R), tw[s:e], ac[s:e], float(body.mass), rc, Ic,
                   float(gravity), w[s:e], f[s:e], qd[s:e], pw[s:e], piv[s:e])
         sus = np.flatnonzero(ik.valid & ~(piv[s:e] > _SUSPECT))
