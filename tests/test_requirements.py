@@ -418,3 +418,115 @@ def test_actuator_power_equals_energy_rate_on_every_family(name):
     P = np.sum(res.force * qd, axis=1) * 1e-3
     ref = np.einsum("ni,ni->n", res.wrench, m.twist) * 1e-3      # w·[v; ω], W
     assert np.max(np.abs(P - ref)) < 1e-6 * np.max(np.abs(ref))
+
+
+# ---- exported outputs per design -------------------------------------------------------------
+
+
+def _output_study(tmp_path):
+    data = {
+        "study": "req-outputs", "description": "outputs of a requirement study",
+        "mechanism": {"file": str(MECH_DIR / "hopkins-williams-6psu.yaml")},
+        "design": {"link_length": {"low": "200 mm", "high": "260 mm", "levels": 2}},
+        "evaluate": {
+            "task": {"shape": "cylinder", "radius": "20 mm", "height": "16 mm",
+                     "frame": "nominal", "box": ["5 deg", "5 deg", "5 deg"], "samples": 2,
+                     "resolution": "4 mm"},
+            "motions": [{"name": "heave", "sinusoid": {"amplitude": {"z": "8 mm"},
+                                                       "frequency": {"z": "2 Hz"}},
+                         "duration": "0.5 s", "rate": "100 Hz"}],
+            "payload": {"mass": "2 kg", "com": ["0 mm", "0 mm", "30 mm"]},
+            "actuators": {"spec": {"name": "small", "force": "40 N", "speed": "150 mm/s",
+                                   "stroke": "101.6 mm", "lead": "4 mm/rev",
+                                   "efficiency": 0.9,
+                                   "torque_speed": [["0 rpm", "30 N*mm"], ["3000 rpm",
+                                                                         "30 N*mm"],
+                                                    ["4000 rpm", "0 N*mm"]]}}},
+        "objectives": [{"minimize": "peak_actuator_force"}],
+        "optimizer": {"method": "grid"}, "seed": 1, "top": 1}
+    return study_from_mapping(data, tmp_path)
+
+
+def test_exported_design_draws_task_and_actuator_limits(tmp_path):
+    import json
+
+    import trimesh
+
+    from pkmlab.requirements.plots import actuator_figure
+    from pkmlab.study.export import export_designs
+    from pkmlab.study.report import write_report
+
+    s = _output_study(tmp_path)
+    params = {"link_length": 230.0}
+    rec = evaluate_design(s.space, params, s.evaluation, 0)
+    assert rec["status"] == "ok", rec["reason"]
+    front = [{"key": "0123456789abcdef", "seq": 1, "params": params, "metrics": rec["metrics"],
+              "notes": rec["notes"], "role": "candidate", "status": "ok", "reason": "",
+              "seconds": 0.0}]
+    folders, problems = export_designs(tmp_path, s, front)
+    assert not problems and len(folders) == 1
+    d = folders[0]
+    for f in ("slices.png", "task.stl", "workspace_task.glb", "actuators-heave.png",
+              "actuators.json"):
+        assert (d / f).is_file(), f
+    # the task mesh is the task region: a 20 mm radius, 16 mm high cylinder about the
+    # nominal position
+    mech = s.space.decode(params)
+    c = mech.nominal_pose[:3]
+    b = trimesh.load(d / "task.stl").bounds
+    np.testing.assert_allclose(b, [c - [20, 20, 8], c + [20, 20, 8]], atol=1e-4)
+    scene = trimesh.load(d / "workspace_task.glb")
+    assert set(scene.geometry) == {"workspace", "task"}
+    # the limit lines drawn are the actuator's limits
+    data = json.loads((d / "actuators.json").read_text())
+    m = data["motions"][0]
+    assert m["force_limit"] == 40.0 and m["speed_limit"] == 150.0
+    assert data["actuator"]["name"] == "small"
+    res = inverse_dynamics(mech, s.evaluation.motions.motions(mech)[0],
+                           s.evaluation.payload.for_mechanism(mech))
+    np.testing.assert_allclose(m["peak_force"], np.max(np.abs(res.force), axis=0))
+    spec = s.evaluation.actuators.catalogue["small"]
+    fig = actuator_figure(res, spec)
+    limits = sorted({float(ln.get_ydata()[0]) for ln in fig.axes[0].lines
+                     if ln.get_linestyle() == "--"})
+    assert limits == [-40.0, 40.0]
+    curve = [ln for ln in fig.axes[2].lines if ln.get_linestyle() == "--"][0]
+    np.testing.assert_allclose(curve.get_ydata(), [0.03, 0.03, 0.0, 0.0])   # N·m
+    # the task region is drawn on the slices at its heights (red lines on those panels)
+    from pkmlab.requirements.task import task_outline
+    assert len(task_outline(mech, s.evaluation.task.region, c[2])) == 1
+    assert task_outline(mech, s.evaluation.task.region, c[2] + 9) == []
+    # the margins in summary.md
+    write_report(tmp_path, s, front)
+    text = (tmp_path / "summary.md").read_text()
+    assert "Requirement margins" in text
+    row = next(ln for ln in text.splitlines() if ln.startswith("| Pareto 1") and
+               "task_margin" not in ln and ln.count("|") > 8)
+    assert f"{rec['metrics']['task_margin']:.4g}" in row
+    assert f"{rec['metrics']['actuator_force_margin']:.4g}" in row
+
+
+def test_editing_an_input_file_changes_the_study_fingerprint(tmp_path):
+    """The recordings and the catalogue are part of what a resume must match."""
+    import shutil
+
+    src = ROOT / "studies"
+    for sub in ("inputs", "actuators", "mechanisms"):
+        shutil.copytree(src / sub, tmp_path / sub)
+    path = tmp_path / "study.yaml"
+    shutil.copy(src / "motion-simulator-6ups-requirements.yaml", path)
+    fp = load_study(path).fingerprint()
+    assert load_study(path).fingerprint() == fp
+    csv_path = tmp_path / "inputs" / "road-bumps.csv"
+    text = csv_path.read_text()
+    lines = text.splitlines()
+    k = next(i for i, ln in enumerate(lines) if ln and ln[0].isdigit() and i > 5)
+    cells = lines[k].split(",")
+    cells[3] = f"{float(cells[3]) + 0.5:.6g}"            # z of one sample, +0.5 mm
+    lines[k] = ",".join(cells)
+    csv_path.write_text("\n".join(lines) + "\n")
+    fp2 = load_study(path).fingerprint()
+    assert fp2 != fp
+    cat = tmp_path / "actuators" / "electric-cylinders.yaml"
+    cat.write_text(cat.read_text() + "\n# a comment changes the bytes\n")
+    assert load_study(path).fingerprint() not in (fp, fp2)

@@ -13,10 +13,12 @@ with tool pose ``(p, R)``, twist ``[v; ω]`` and its derivative ``[a; α]`` (bas
 point, in the base frame (mass × mm/s² is 10⁻³ N: the code applies the factor). The actuator
 forces follow from virtual work, ``w = Jᵀ·f`` with ``q̇ = J·[v; ω]``
 (:mod:`pkmlab.dexterity.force`): ``f = J⁻ᵀ·w``, solved per sample by LU with partial
-pivoting. The actuator speeds are ``q̇ = J·[v; ω]`` and the powers ``f·q̇`` (W). Every
-family here has prismatic actuators: ``f`` is a force in N along +q (positive pushes
-towards larger q); a rotary drive behind it (a screw of lead ``ℓ``) is handled by
-:mod:`.actuators`.
+pivoting. The actuator speeds are ``q̇ = J·[v; ω]`` and the powers ``f·q̇`` (W). For
+prismatic families ``f`` is a force in N along +q (positive pushes towards larger q; a rotary
+drive behind it, a screw of lead ``ℓ``, is handled by :mod:`.actuators`); for rotary families
+(``actuator_unit`` rad, ``rss6``) ``f`` is the crank torque in N·mm about the servo axis and
+``q̇`` in rad/s (``DynamicsResult.unit``). The Jacobians come from
+``mech.inverse_and_jacobian`` (numba per pose for psu6, ups6 and rss6).
 
 Failures are data: a sample whose pose has no inverse kinematics within the stroke, or whose
 Jacobian is singular (pkmlab's one rule, :func:`pkmlab.dexterity.is_singular`, with ``J`` as
@@ -67,6 +69,7 @@ class DynamicsResult:
     reasons: dict
     actuator_names: tuple[str, ...]
     stroke: tuple[float, float]
+    unit: str = "mm"            # the mechanism's actuator_unit: "rad" → torques N·mm, rad/s
 
     @property
     def ok(self) -> np.ndarray:
@@ -269,4 +272,5 @@ def inverse_dynamics(mech, motion: Motion, body: MassProperties,
         f[idx] = np.nan
         pw[idx] = np.nan
     return DynamicsResult(motion.name, motion.t, q, qd, f, pw, w, code, reasons,
-                          tuple(mech.actuator_names), tuple(mech.stroke))
+                          tuple(mech.actuator_names), tuple(mech.stroke),
+                          mech.actuator_unit)

@@ -364,10 +364,20 @@ def build_payload(data: Any) -> PayloadPlan:
 # ---- actuators ----------------------------------------------------------------------------------
 
 
+PositiveTorque = _quantity(TORQUE_UNITS, "N*mm", 0.0, strict=True)
+PositiveAngularSpeed = _quantity(ANGULAR_SPEED_UNITS, "rad/s", 0.0, strict=True)
+
+
 class ActuatorItem(_Model):
     name: str = Field(pattern=r"^[A-Za-z0-9._-]+$")
-    force: PositiveForce = Field(description="force limit (N)")
-    speed: PositiveSpeed = Field(description="speed limit (mm/s)")
+    kind: Literal["linear", "rotary"] = Field("linear", description="linear (prismatic "
+                                              "families) or rotary (servo on a crank, rss6)")
+    force: PositiveForce | None = Field(None, description="linear: force limit (N)")
+    speed: PositiveSpeed | None = Field(None, description="linear: speed limit (mm/s)")
+    torque: PositiveTorque | None = Field(None, description="rotary: torque limit (N·mm)")
+    angular_speed: PositiveAngularSpeed | None = Field(None, description="rotary: speed "
+                                                       "limit (rad/s, or '60 rpm')")
+    range: Angle | None = Field(None, description="rotary: angle range used (deg)")
     stroke: PositiveLength | None = Field(None, description="travel (mm)")
     lead: Lead | None = Field(None, description="screw lead (mm/rev), with torque_speed")
     efficiency: float = Field(1.0, gt=0, le=1)
@@ -398,6 +408,27 @@ class ActuatorsPlan:
 
 def _actuator(a: ActuatorItem, field: str) -> ActuatorSpec:
     curve = tuple((float(w), float(T)) for w, T in (a.torque_speed or ()))
+    need = ("force", "speed") if a.kind == "linear" else ("torque", "angular_speed")
+    wrong = ("torque", "angular_speed", "range") if a.kind == "linear" else \
+        ("force", "speed", "stroke", "lead")
+    for k in need:
+        if getattr(a, k) is None:
+            raise ParameterError(f"{field}.{k}", f"given for a {a.kind} actuator", None)
+    for k in wrong:
+        if getattr(a, k) is not None:
+            raise ParameterError(f"{field}.{k}", f"not given for a {a.kind} actuator (use "
+                                 f"{' and '.join(need)})", getattr(a, k))
+    if a.kind == "rotary":
+        if a.range is not None and not (0 < a.range <= 2 * math.pi):
+            raise ParameterError(f"{field}.range", "an angle range in (0, 360] deg",
+                                 math.degrees(a.range))
+        if curve:
+            ws = [w for w, _ in curve]
+            if ws[0] != 0 or any(b <= c for c, b in zip(ws, ws[1:])):
+                raise ParameterError(f"{field}.torque_speed", "speeds increasing from 0",
+                                     [round(w * 60 / (2 * math.pi), 6) for w in ws])
+        return ActuatorSpec(a.name, a.torque, a.angular_speed, a.range, None, a.efficiency,
+                            curve, "rotary")
     if curve:
         ws = [w for w, _ in curve]
         if ws[0] != 0 or any(b <= c for c, b in zip(ws, ws[1:])):
