@@ -339,6 +339,18 @@ def _one_line(tmp_path, data, expect):
     ({"motions": [{"name": "a", "paper": True}], "payload": {"mass": 1, "inertia": [1, 1, 5]}},
      "evaluate.payload.inertia"),
     ({"motions": [{"name": "a", "paper": True}]}, "evaluate.payload"),
+    ({"motions": [{"name": "a", "paper": True}],
+      "payload": {"mass": 1, "legs": {"mass": 2, "model": "rod", "platform_share": 0.4}}},
+     "evaluate.payload.legs.platform_share"),
+    ({"motions": [{"name": "a", "paper": True}], "payload": {"mass": 1},
+      "actuators": {"spec": {"name": "s", "kind": "rotary", "torque": "2 N*m"}}},
+     "evaluate.actuators.spec.angular_speed"),
+    ({"motions": [{"name": "a", "paper": True}], "payload": {"mass": 1},
+      "actuators": {"spec": {"name": "s", "force": "2 kN", "speed": "300 mm/s",
+                             "torque": "2 N*m"}}}, "evaluate.actuators.spec.torque"),
+    ({"motions": [{"name": "a", "paper": True}], "payload": {"mass": 1},
+      "actuators": {"spec": {"name": "s", "force": "2 parsec", "speed": "300 mm/s"}}},
+     "evaluate.actuators.spec.force"),
 ])
 def test_validate_rejects_bad_requirements(tmp_path, evaluate, expect):
     _one_line(tmp_path, _study(tmp_path, **evaluate), expect)
@@ -530,3 +542,86 @@ def test_editing_an_input_file_changes_the_study_fingerprint(tmp_path):
     cat = tmp_path / "actuators" / "electric-cylinders.yaml"
     cat.write_text(cat.read_text() + "\n# a comment changes the bytes\n")
     assert load_study(path).fingerprint() not in (fp, fp2)
+
+
+def test_slender_rod_legs_in_the_power_balance():
+    """6-UPS with uniform slender-rod legs (8 kg each): Σ f·q̇ (q̇ from the IK by finite
+    differences) = d/dt of the platform's energy plus each rod's (m/6)|Ḃ|² + m·g·(A_z + B_z)/2,
+    the rods' end points taken from ``leg_segments``; to 1e-6 relative."""
+    from pkmlab.poses import as_frames
+    from pkmlab.requirements.payload import combine, leg_end_masses, leg_rod_masses
+
+    mech = _ups()
+    mleg = 8.0
+    A, f, ph = (np.array(v) for v in SIN)
+    m = sinusoid_motion(mech, A, f, ph, duration=1.3, rate=300)
+    res = inverse_dynamics(mech, m, combine(BODY, leg_rod_masses(mech, mleg)))
+    assert np.all(res.ok)
+    _, _, _, energy, d1 = _independent_newton_euler(mech, A, f, ph, m.t)
+    w2 = 2 * np.pi * f
+
+    def pose(tt):
+        return mech.nominal_pose + A * np.sin(np.outer(np.atleast_1d(tt), w2) + ph)
+
+    def ends(tt):
+        return mech.leg_segments(*as_frames(pose(tt)))
+
+    def leg_energy(tt):
+        a, b = ends(tt)
+        bd = d1(lambda s: ends(s)[1], tt)
+        kin = mleg / 6 * np.sum(bd * bd, axis=(1, 2))
+        pot = mleg * GRAVITY * np.sum(a[..., 2] + b[..., 2], axis=1) / 2
+        return (kin + pot) * 1e-6
+
+    h = 1e-4
+    qd = (mech.inverse(pose(m.t - 2 * h)).q - 8 * mech.inverse(pose(m.t - h)).q
+          + 8 * mech.inverse(pose(m.t + h)).q - mech.inverse(pose(m.t + 2 * h)).q) / (12 * h)
+    P = np.sum(res.force * qd, axis=1) * 1e-3
+    dE = d1(energy, m.t) + d1(leg_energy, m.t)
+    assert np.max(np.abs(P - dE)) < 1e-6 * np.max(np.abs(P))
+    # the 'ends' model with half of each leg at its platform joint fails this balance (its
+    # inertia share is m/2, the rod's m/3)
+    ends_model = inverse_dynamics(mech, m, combine(BODY, leg_end_masses(mech, mleg / 2)))
+    Pe = np.sum(ends_model.force * qd, axis=1) * 1e-3
+    assert np.max(np.abs(Pe - dE)) > 1e-4 * np.max(np.abs(P))
+
+
+def test_rod_legs_need_fixed_base_joints():
+    mech = load_mechanism(MECH_DIR / "hopkins-williams-6psu.yaml")
+    from pkmlab.requirements.payload import leg_rod_masses
+
+    with pytest.raises(ParameterError, match=r"legs\.model"):
+        leg_rod_masses(mech, 1.0)
+
+
+def test_rotary_servo_fit_on_rss6_and_kind_mismatch_is_invalid(tmp_path):
+    mech = load_mechanism(MECH_DIR / "instructables-servo-6rss.yaml")
+    m = sinusoid_motion(mech, [0, 0, 5, 0.05, 0, 0], [0, 0, 1.0, 0.7, 0, 0], duration=1.5,
+                        rate=200)
+    res = inverse_dynamics(mech, m, MassProperties(0.5, [0, 0, 10.0], [500, 500, 800]))
+    assert res.unit == "rad" and np.all(res.ok)
+    tmax, wmax = np.max(np.abs(res.force)), np.max(np.abs(res.qdot))    # N·mm, rad/s
+    curve = ((0.0, 4 * tmax), (2 * wmax, 4 * tmax), (4 * wmax, 0.0))
+    servo = ActuatorSpec("servo", 2 * tmax, 4 * wmax, math.pi, None, 1.0, curve, "rotary")
+    out = fit(servo, [res])
+    assert out.fits
+    assert out.force_margin == pytest.approx(50.0) and out.speed_margin == pytest.approx(75.0)
+    T = np.abs(res.force)
+    avail = np.interp(np.abs(res.qdot), [0, 2 * wmax, 4 * wmax], [4 * tmax, 4 * tmax, 0])
+    assert out.torque_speed_margin == pytest.approx(100 * np.min(avail - T) / (4 * tmax))
+    used = np.max(res.q.max(0) - res.q.min(0))
+    assert out.stroke_margin == pytest.approx(math.degrees(math.pi - used))
+    # a linear actuator on a rotary family: the design is invalid, and says why
+    data = {"study": "servo", "mechanism": {"file": str(MECH_DIR /
+                                                        "instructables-servo-6rss.yaml")},
+            "design": {"crank_length": {"low": "20 mm", "high": "30 mm"}},
+            "evaluate": {"motions": [{"name": "s", "sinusoid": {"amplitude": {"z": "3 mm"},
+                                                                "frequency": {"z": "1 Hz"}},
+                                      "duration": "0.2 s", "rate": "50 Hz"}],
+                         "payload": {"mass": "0.2 kg"},
+                         "actuators": {"spec": {"name": "lin", "force": "10 N",
+                                                "speed": "10 mm/s"}}},
+            "objectives": [{"minimize": "peak_actuator_force"}], "optimizer": {"method": "grid"}}
+    s = study_from_mapping(data, tmp_path)
+    rec = evaluate_design(s.space, None, s.evaluation, 0)
+    assert rec["status"] == "invalid" and "rotary actuator" in rec["reason"], rec["reason"]

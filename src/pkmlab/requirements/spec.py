@@ -39,7 +39,7 @@ from ..units import (
 from ..workspaces.orientations import OrientationSet
 from . import motions as mo
 from .actuators import ActuatorSpec
-from .payload import MassProperties, combine, leg_end_masses
+from .payload import MassProperties, combine, leg_end_masses, leg_rod_masses
 from .task import TaskRegion
 
 __all__ = ["TaskSpec", "MotionSpec", "PayloadSpec", "ActuatorsSpec", "TaskPlan",
@@ -311,8 +311,12 @@ class BodySpec(_Model):
 
 class LegsSpec(_Model):
     mass: Mass = Field(description="mass of one leg (kg)")
-    platform_share: float = Field(0.5, ge=0, le=1, description="share lumped at the "
-                                  "platform joint (the rest stays at the base end)")
+    model: Literal["ends", "rod"] = Field("ends", description="'ends': a share at the "
+                                          "platform joint; 'rod': a uniform slender rod from "
+                                          "a fixed base joint (ups6)")
+    platform_share: float | None = Field(None, ge=0, le=1, description="ends: share lumped "
+                                         "at the platform joint (default 0.5; the rest stays "
+                                         "at the base end)")
 
 
 class PayloadSpec(BodySpec):
@@ -323,12 +327,15 @@ class PayloadSpec(BodySpec):
 @dataclass(frozen=True)
 class PayloadPlan:
     body: MassProperties                       # payload + platform
-    leg_mass: float                            # kg lumped at each platform joint
-    source: dict
+    leg_mass: float                            # kg: lumped at each platform joint (ends),
+    source: dict                               # or each rod's mass (rod)
+    leg_model: str = "ends"
 
     def for_mechanism(self, mech) -> MassProperties:
         if self.leg_mass <= 0:
             return self.body
+        if self.leg_model == "rod":
+            return combine(self.body, leg_rod_masses(mech, self.leg_mass))
         return combine(self.body, leg_end_masses(mech, self.leg_mass))
 
 
@@ -357,8 +364,16 @@ def build_payload(data: Any) -> PayloadPlan:
     body = _body(p, f)
     if p.platform is not None:
         body = combine(body, _body(p.platform, f"{f}.platform"))
-    leg = 0.0 if p.legs is None else p.legs.mass * p.legs.platform_share
-    return PayloadPlan(body, leg, dict(data))
+    if p.legs is not None and p.legs.model == "rod" and p.legs.platform_share is not None:
+        raise ParameterError(f"{f}.legs.platform_share", "not given with model 'rod' (the "
+                             "rod's inertia and weight shares follow from the model)",
+                             p.legs.platform_share)
+    if p.legs is None:
+        return PayloadPlan(body, 0.0, dict(data))
+    if p.legs.model == "rod":
+        return PayloadPlan(body, p.legs.mass, dict(data), "rod")
+    share = 0.5 if p.legs.platform_share is None else p.legs.platform_share
+    return PayloadPlan(body, p.legs.mass * share, dict(data))
 
 
 # ---- actuators ----------------------------------------------------------------------------------
