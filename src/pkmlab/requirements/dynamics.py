@@ -31,6 +31,7 @@ given), has NaN forces and a status naming why (``DynamicsResult.status``).
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,7 +40,6 @@ from numba import types as nt
 
 from .._jit import cached_kernel
 from ..dexterity.metrics import is_singular
-from ..poses import as_frames
 from .motions import Motion
 from .payload import GRAVITY, MassProperties
 
@@ -246,7 +246,28 @@ def _one(k, J, R, tw, ac, mass, rc, Ic, g0, wmass, rw, w, f, qd, pw, piv, r, IA,
         pw[k, i] = f[k, i] * qd[k, i] * 1e-3
 
 
-_CHUNK = 65536
+#: samples per chunk: few parallel regions (each waits for every thread to be scheduled, which
+#: on a loaded machine costs more than the work), the chunk's arrays ~100 MB
+_CHUNK = 262144
+
+
+@njit(cache=True)
+def _euler_frames(X, p, R):
+    """Euler poses ``(n, 6)`` → positions and ``R = Rz·Ry·Rx`` (as :func:`pkmlab.poses.
+    euler_to_matrix`), without NumPy's temporaries."""
+    for k in range(X.shape[0]):
+        p[k, 0], p[k, 1], p[k, 2] = X[k, 0], X[k, 1], X[k, 2]
+        cx, cy, cz = math.cos(X[k, 3]), math.cos(X[k, 4]), math.cos(X[k, 5])
+        sx, sy, sz = math.sin(X[k, 3]), math.sin(X[k, 4]), math.sin(X[k, 5])
+        R[k, 0, 0] = cz * cy
+        R[k, 0, 1] = cz * sy * sx - sz * cx
+        R[k, 0, 2] = cz * sy * cx + sz * sx
+        R[k, 1, 0] = sz * cy
+        R[k, 1, 1] = sz * sy * sx + cz * cx
+        R[k, 1, 2] = sz * sy * cx - cz * sx
+        R[k, 2, 0] = -sy
+        R[k, 2, 1] = cy * sx
+        R[k, 2, 2] = cy * cx
 
 
 def inverse_dynamics(mech, motion: Motion, body: MassProperties,
@@ -261,11 +282,13 @@ def inverse_dynamics(mech, motion: Motion, body: MassProperties,
     rw = np.ascontiguousarray(body.weight_com - np.asarray(mech.tool_offset, dtype=float))
     Ic = np.ascontiguousarray(body.inertia)
     tw, ac = np.ascontiguousarray(motion.twist), np.ascontiguousarray(motion.accel)
+    poses = np.ascontiguousarray(motion.poses, dtype=float)
     reasons: dict = {}
     sing = []
     for s in range(0, n, _CHUNK):
         e = min(n, s + _CHUNK)
-        p, R = as_frames(motion.poses[s:e])
+        p, R = np.empty((e - s, 3)), np.empty((e - s, 3, 3))
+        _euler_frames(poses[s:e], p, R)
         ik, J = mech.inverse_and_jacobian((p, R))
         q[s:e], valid[s:e] = ik.q, ik.valid
         if not np.all(ik.valid):
