@@ -625,3 +625,15 @@ def test_rotary_servo_fit_on_rss6_and_kind_mismatch_is_invalid(tmp_path):
     s = study_from_mapping(data, tmp_path)
     rec = evaluate_design(s.space, None, s.evaluation, 0)
     assert rec["status"] == "invalid" and "rotary actuator" in rec["reason"], rec["reason"]
+
+
+def test_summary_reports_which_catalogue_actuators_fit(tmp_path):
+    from pkmlab.study.report import _catalogue_fits
+
+    s = load_study(ROOT / "studies" / "motion-simulator-6ups-requirements.yaml")
+    recs = [{"status": "ok", "params": {"base_outer_radius": 450.0, "platform_ratio": 0.5,
+                                         "actuator": a}, "metrics": {"actuators_fit": fit_}}
+            for a, fit_ in (("EC-S-1k", 0.0), ("EC-L-5k", 1.0), ("EC-L-5k", 0.0))]
+    text = "\n".join(_catalogue_fits(s, recs))
+    assert "EC-S-1k fits 0 of 1" in text and "EC-L-5k fits 1 of 2" in text
+    assert "EC-XL-10k fits 0 of 0" in text

@@ -209,6 +209,7 @@ def _summary(study: Study, records, front, baseline) -> str:
     for i, r in enumerate(front[:max(study.top, 1) * 2]):
         lines.append(row(f"Pareto {i + 1}", r))
     lines += _requirement_margins(study, baseline, front[:max(study.top, 1) * 2], metrics)
+    lines += _catalogue_fits(study, records)
     if notes:
         lines += ["", "Notes (a value shown as — is undefined for the reason given):", *notes]
     lines += ["", "Lengths in mm, angles in degrees, volumes in cm³, forces in N. Metric "
@@ -241,3 +242,19 @@ def _requirement_margins(study: Study, baseline, front, shown) -> list[str]:
         out.append(f"| {label} | " + " | ".join(_fmt(r["metrics"].get(m)) for m in names)
                    + " |")
     return out
+
+
+def _catalogue_fits(study: Study, records) -> list[str]:
+    """Which catalogue actuators work: for a design variable choosing the actuator, per entry
+    the evaluated designs on which it fits (``actuators_fit``) out of those evaluated with it."""
+    var = next((v for v in study.variables if v.role == "actuator"), None)
+    if var is None:
+        return []
+    parts = []
+    for name in var.choices:
+        with_it = [r for r in records if r["status"] == "ok"
+                   and _params(study, r).get(var.name) == name]
+        fits = sum(r["metrics"].get("actuators_fit") == 1.0 for r in with_it)
+        parts.append(f"{name} fits {fits} of {len(with_it)}")
+    return ["", "Catalogue actuators (designs evaluated with each, on which it meets force, "
+            "speed, torque–speed and stroke along every motion): " + "; ".join(parts) + "."]
