@@ -350,7 +350,8 @@ class Mechanism:
         6))``: one parallel pass for families with a numba Jacobian (inverse dynamics
         calls this per chunk of a trajectory)."""
         jac = type(self)._jac_one
-        if jac is None:
+        if jac is None or type(self)._jacobian is not Mechanism._jacobian:
+            # no kernel, or a subclass's own formula: the two calls, which honour it
             return self.inverse(poses, stroke=stroke), self.jacobian(poses)
         p, R = _frames_tuple(poses) if isinstance(poses, tuple) else as_frames(poses)
         p, R = _kernels.carray(p), _kernels.carray(R)
