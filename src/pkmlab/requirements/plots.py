@@ -22,8 +22,8 @@ _RPM = 60 / (2 * math.pi)
 
 
 def _units(result: DynamicsResult) -> tuple[str, str, float, float]:
-    """(force label, speed label, force scale, speed scale) for display: N and mm/s, or
-    N·m and rpm... kept simple: N·mm → N·m, rad/s → deg/s for rotary actuators."""
+    """(force label, speed label, force scale, speed scale) for display: N and mm/s for
+    linear actuators; N·m (from N·mm) and deg/s (from rad/s) for rotary ones."""
     if result.unit == "rad":
         return "torque (N·m)", "speed (deg/s)", 1e-3, 180 / math.pi
     return "force (N)", "speed (mm/s)", 1.0, 1.0
