@@ -66,6 +66,11 @@ def test_checks_can_fail(mech):
                        if f.init})
     with pytest.raises(AssertionError, match="rotation columns"):
         testing.check_jacobian(broken)
+    # the fused IK + Jacobian pass honours a subclass's own Jacobian too
+    X = random_valid_poses(mech, 3, seed=2)
+    np.testing.assert_array_equal(broken.inverse_and_jacobian(X)[1], broken.jacobian(X))
+    np.testing.assert_allclose(mech.inverse_and_jacobian(X)[1], mech.jacobian(X), rtol=1e-14,
+                               atol=1e-14)
 
 
 def test_conftest_poses_are_the_testing_ones(mech):

@@ -83,6 +83,11 @@ for task in args["tasks"]:
                      "frames": m.inverse((X[:, :3].copy(), R)).q.tolist(),
                      "base": m.base_points.tolist(), "tool": m.tool_points.tolist(),
                      "length": m.link_length.tolist() if f == "psu6" else None}
+    elif kind == "jac":
+        X = np.array(poses[f])
+        R = euler_to_matrix(X[:, 3:]).reshape(-1, 3, 3)
+        ik, J = m.inverse_and_jacobian((X[:, :3].copy(), R))
+        out[task] = {"fused": ik.q.tolist(), "fused_jac": J.tolist()}
     elif kind == "ws":
         deg = args["box_deg"]
         oset = pkmlab.OrientationSet.box(np.radians([deg, deg, deg]), samples=args["samples"])
@@ -129,6 +134,19 @@ def ik_reference(family, X, base, tool, length):
         with np.errstate(invalid="ignore"):
             return np.where(h2 >= 0, a[..., 2] - np.sqrt(h2), np.nan)
     return np.linalg.norm(Wj - B, axis=-1)                              # ups6
+
+
+def jacobian_reference(family, X, base, tool, length):
+    """Rows ``[a, r × a] / a_z`` (psu6, ``a`` the link) or ``[n, r × n]`` (ups6)."""
+    p, R = X[:, :3], euler_to_matrix(X[:, 3:]).reshape(-1, 3, 3)
+    r = np.einsum("nij,kj->nki", R, np.array(tool))
+    a = p[:, None, :] + r - np.array(base)
+    if family == "psu6":
+        with np.errstate(invalid="ignore"):
+            a[..., 2] = np.sqrt(np.array(length) ** 2 - a[..., 0] ** 2 - a[..., 1] ** 2)
+        return np.concatenate([a, np.cross(r, a)], axis=-1) / a[..., 2:3]
+    n = a / np.linalg.norm(a, axis=-1)[..., None]
+    return np.concatenate([n, np.cross(r, n)], axis=-1)
 
 
 def leg_reference(family, x, y, W, P):
@@ -182,6 +200,17 @@ def check_ik(family, r):
         q = np.array(r[path], dtype=float)
         np.testing.assert_allclose(q, ref, rtol=1e-11, atol=1e-9,
                                    err_msg=f"{family} IK, {path} path")
+
+
+def check_jac(family, r, ik):
+    """The fused IK + Jacobian driver against the NumPy references."""
+    X = POSES[family]
+    ref = ik_reference(family, X, ik["base"], ik["tool"], ik["length"])
+    np.testing.assert_allclose(np.array(r["fused"], dtype=float), ref, rtol=1e-11, atol=1e-9,
+                               err_msg=f"{family} IK, fused path")
+    Jref = jacobian_reference(family, X, ik["base"], ik["tool"], ik["length"])
+    np.testing.assert_allclose(np.array(r["fused_jac"], dtype=float), Jref, rtol=1e-11,
+                               atol=1e-11, err_msg=f"{family} Jacobian, fused path")
 
 
 def check_columns(family, r):
@@ -267,11 +296,12 @@ def test_kernels_compiled_by_different_processes_do_not_alias(tmp_path):
     _run(cache, script, ["warm:dummy"])
     with ThreadPoolExecutor(2) as pool:
         list(pool.map(lambda tasks: _run(cache, script, tasks),
-                      [["ik:psu6", "ws:ups6"], ["ik:ups6", "ws:psu6"]]))
-    res, log = _run(cache, script, ["ik:psu6", "ws:ups6", "ik:ups6", "ws:psu6"],
-                    {"NUMBA_DEBUG_CACHE": "1"})
+                      [["ik:psu6", "ws:ups6", "jac:ups6"], ["ik:ups6", "ws:psu6", "jac:psu6"]]))
+    res, log = _run(cache, script, ["ik:psu6", "ws:ups6", "ik:ups6", "ws:psu6", "jac:psu6",
+                                    "jac:ups6"], {"NUMBA_DEBUG_CACHE": "1"})
     for family in ("psu6", "ups6"):
         check_ik(family, res[f"ik:{family}"])
+        check_jac(family, res[f"jac:{family}"], res[f"ik:{family}"])
     for family in ("psu6", "ups6"):
         check_columns(family, res[f"ws:{family}"])
     # the small dexterous workspace: the engine's volume from the NumPy columns
@@ -284,7 +314,8 @@ def test_kernels_compiled_by_different_processes_do_not_alias(tmp_path):
         assert r["volume"] == pytest.approx(h * h * length.sum(), rel=1e-9), family
     # everything came from the cache: nothing compiled and saved in the third process
     assert "data saved" not in log, [s for s in log.splitlines() if "data saved" in s][:5]
-    for name in ("drive_euler", "drive_frames", "columns_all", "columns_any", "leg_eval"):
+    for name in ("drive_euler", "drive_frames", "columns_all", "columns_any", "leg_eval",
+                 "drive_kinematics"):
         assert re.search(rf"data loaded from .*{name}", log), f"{name} not loaded from cache"
 
 

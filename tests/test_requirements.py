@@ -339,6 +339,18 @@ def _one_line(tmp_path, data, expect):
     ({"motions": [{"name": "a", "paper": True}], "payload": {"mass": 1, "inertia": [1, 1, 5]}},
      "evaluate.payload.inertia"),
     ({"motions": [{"name": "a", "paper": True}]}, "evaluate.payload"),
+    ({"motions": [{"name": "a", "paper": True}],
+      "payload": {"mass": 1, "legs": {"mass": 2, "model": "rod", "platform_share": 0.4}}},
+     "evaluate.payload.legs.platform_share"),
+    ({"motions": [{"name": "a", "paper": True}], "payload": {"mass": 1},
+      "actuators": {"spec": {"name": "s", "kind": "rotary", "torque": "2 N*m"}}},
+     "evaluate.actuators.spec.angular_speed"),
+    ({"motions": [{"name": "a", "paper": True}], "payload": {"mass": 1},
+      "actuators": {"spec": {"name": "s", "force": "2 kN", "speed": "300 mm/s",
+                             "torque": "2 N*m"}}}, "evaluate.actuators.spec.torque"),
+    ({"motions": [{"name": "a", "paper": True}], "payload": {"mass": 1},
+      "actuators": {"spec": {"name": "s", "force": "2 parsec", "speed": "300 mm/s"}}},
+     "evaluate.actuators.spec.force"),
 ])
 def test_validate_rejects_bad_requirements(tmp_path, evaluate, expect):
     _one_line(tmp_path, _study(tmp_path, **evaluate), expect)
@@ -392,3 +404,236 @@ def test_actuator_choices_must_be_catalogue_entries(tmp_path):
     data["design"]["actuator"]["choices"] = ["EC-S-1k", "nope"]
     with pytest.raises(ParameterError, match=r"design\.actuator\.choices"):
         study_from_mapping(data, path.parent)
+
+
+@pytest.mark.parametrize("name", ["hopkins-williams-6psu", "gough-stewart-6ups",
+                                  "instructables-servo-6rss", "luzi-3chain"])
+def test_actuator_power_equals_energy_rate_on_every_family(name):
+    """Σ f_i·q̇_i = dE/dt with q̇ from finite differences of the inverse kinematics (not the
+    Jacobian): checks ``f = J⁻ᵀ w`` for prismatic forces and for rss6's crank torques."""
+    mech = load_mechanism(MECH_DIR / f"{name}.yaml")
+    S = mech.scale / 400
+    A = np.array([6 * S, 4 * S, 5 * S, 0.03, 0.04, 0.05])
+    f, ph = np.array([0.8, 1.1, 1.5, 0.7, 1.3, 0.9]), np.array([0.3, 1.0, 0.0, 2.0, 0.5, 1.2])
+    m = sinusoid_motion(mech, A, f, ph, duration=1.0, rate=50)
+    body = MassProperties(20.0, mech.tool_offset + [3.0, -2.0, 40.0], [4e5, 3e5, 2e5])
+    res = inverse_dynamics(mech, m, body)
+    assert np.all(res.ok)
+    h = 1e-4
+    w2 = 2 * np.pi * f
+
+    def q_at(t):
+        return mech.inverse(mech.nominal_pose + A * np.sin(np.outer(t, w2) + ph)).q
+
+    qd = (q_at(m.t - 2 * h) - 8 * q_at(m.t - h) + 8 * q_at(m.t + h) - q_at(m.t + 2 * h)) / (12 * h)
+    np.testing.assert_allclose(res.qdot, qd, atol=1e-6 * np.max(np.abs(qd)))
+    P = np.sum(res.force * qd, axis=1) * 1e-3
+    ref = np.einsum("ni,ni->n", res.wrench, m.twist) * 1e-3      # w·[v; ω], W
+    assert np.max(np.abs(P - ref)) < 1e-6 * np.max(np.abs(ref))
+
+
+# ---- exported outputs per design -------------------------------------------------------------
+
+
+def _output_study(tmp_path):
+    data = {
+        "study": "req-outputs", "description": "outputs of a requirement study",
+        "mechanism": {"file": str(MECH_DIR / "hopkins-williams-6psu.yaml")},
+        "design": {"link_length": {"low": "200 mm", "high": "260 mm", "levels": 2}},
+        "evaluate": {
+            "task": {"shape": "cylinder", "radius": "20 mm", "height": "16 mm",
+                     "frame": "nominal", "box": ["5 deg", "5 deg", "5 deg"], "samples": 2,
+                     "resolution": "4 mm"},
+            "motions": [{"name": "heave", "sinusoid": {"amplitude": {"z": "8 mm"},
+                                                       "frequency": {"z": "2 Hz"}},
+                         "duration": "0.5 s", "rate": "100 Hz"}],
+            "payload": {"mass": "2 kg", "com": ["0 mm", "0 mm", "30 mm"]},
+            "actuators": {"spec": {"name": "small", "force": "40 N", "speed": "150 mm/s",
+                                   "stroke": "101.6 mm", "lead": "4 mm/rev",
+                                   "efficiency": 0.9,
+                                   "torque_speed": [["0 rpm", "30 N*mm"], ["3000 rpm",
+                                                                         "30 N*mm"],
+                                                    ["4000 rpm", "0 N*mm"]]}}},
+        "objectives": [{"minimize": "peak_actuator_force"}],
+        "optimizer": {"method": "grid"}, "seed": 1, "top": 1}
+    return study_from_mapping(data, tmp_path)
+
+
+def test_exported_design_draws_task_and_actuator_limits(tmp_path):
+    import json
+
+    import trimesh
+
+    from pkmlab.requirements.plots import actuator_figure
+    from pkmlab.study.export import export_designs
+    from pkmlab.study.report import write_report
+
+    s = _output_study(tmp_path)
+    params = {"link_length": 230.0}
+    rec = evaluate_design(s.space, params, s.evaluation, 0)
+    assert rec["status"] == "ok", rec["reason"]
+    front = [{"key": "0123456789abcdef", "seq": 1, "params": params, "metrics": rec["metrics"],
+              "notes": rec["notes"], "role": "candidate", "status": "ok", "reason": "",
+              "seconds": 0.0}]
+    folders, problems = export_designs(tmp_path, s, front)
+    assert not problems and len(folders) == 1
+    d = folders[0]
+    for f in ("slices.png", "task.stl", "workspace_task.glb", "actuators-heave.png",
+              "actuators.json"):
+        assert (d / f).is_file(), f
+    # the task mesh is the task region: a 20 mm radius, 16 mm high cylinder about the
+    # nominal position
+    mech = s.space.decode(params)
+    c = mech.nominal_pose[:3]
+    b = trimesh.load(d / "task.stl").bounds
+    np.testing.assert_allclose(b, [c - [20, 20, 8], c + [20, 20, 8]], atol=1e-4)
+    scene = trimesh.load(d / "workspace_task.glb")
+    assert set(scene.geometry) == {"workspace", "task"}
+    # the limit lines drawn are the actuator's limits
+    data = json.loads((d / "actuators.json").read_text())
+    m = data["motions"][0]
+    assert m["force_limit"] == 40.0 and m["speed_limit"] == 150.0
+    assert data["actuator"]["name"] == "small"
+    res = inverse_dynamics(mech, s.evaluation.motions.motions(mech)[0],
+                           s.evaluation.payload.for_mechanism(mech))
+    np.testing.assert_allclose(m["peak_force"], np.max(np.abs(res.force), axis=0))
+    spec = s.evaluation.actuators.catalogue["small"]
+    fig = actuator_figure(res, spec)
+    limits = sorted({float(ln.get_ydata()[0]) for ln in fig.axes[0].lines
+                     if ln.get_linestyle() == "--"})
+    assert limits == [-40.0, 40.0]
+    curve = [ln for ln in fig.axes[2].lines if ln.get_linestyle() == "--"][0]
+    np.testing.assert_allclose(curve.get_ydata(), [0.03, 0.03, 0.0, 0.0])   # N·m
+    # the task region is drawn on the slices at its heights (red lines on those panels)
+    from pkmlab.requirements.task import task_outline
+    assert len(task_outline(mech, s.evaluation.task.region, c[2])) == 1
+    assert task_outline(mech, s.evaluation.task.region, c[2] + 9) == []
+    # the margins in summary.md
+    write_report(tmp_path, s, front)
+    text = (tmp_path / "summary.md").read_text()
+    assert "Requirement margins" in text
+    row = next(ln for ln in text.splitlines() if ln.startswith("| Pareto 1") and
+               "task_margin" not in ln and ln.count("|") > 8)
+    assert f"{rec['metrics']['task_margin']:.4g}" in row
+    assert f"{rec['metrics']['actuator_force_margin']:.4g}" in row
+
+
+def test_editing_an_input_file_changes_the_study_fingerprint(tmp_path):
+    """The recordings and the catalogue are part of what a resume must match."""
+    import shutil
+
+    src = ROOT / "studies"
+    for sub in ("inputs", "actuators", "mechanisms"):
+        shutil.copytree(src / sub, tmp_path / sub)
+    path = tmp_path / "study.yaml"
+    shutil.copy(src / "motion-simulator-6ups-requirements.yaml", path)
+    fp = load_study(path).fingerprint()
+    assert load_study(path).fingerprint() == fp
+    csv_path = tmp_path / "inputs" / "road-bumps.csv"
+    text = csv_path.read_text()
+    lines = text.splitlines()
+    k = next(i for i, ln in enumerate(lines) if ln and ln[0].isdigit() and i > 5)
+    cells = lines[k].split(",")
+    cells[3] = f"{float(cells[3]) + 0.5:.6g}"            # z of one sample, +0.5 mm
+    lines[k] = ",".join(cells)
+    csv_path.write_text("\n".join(lines) + "\n")
+    fp2 = load_study(path).fingerprint()
+    assert fp2 != fp
+    cat = tmp_path / "actuators" / "electric-cylinders.yaml"
+    cat.write_text(cat.read_text() + "\n# a comment changes the bytes\n")
+    assert load_study(path).fingerprint() not in (fp, fp2)
+
+
+def test_slender_rod_legs_in_the_power_balance():
+    """6-UPS with uniform slender-rod legs (8 kg each): Σ f·q̇ (q̇ from the IK by finite
+    differences) = d/dt of the platform's energy plus each rod's (m/6)|Ḃ|² + m·g·(A_z + B_z)/2,
+    the rods' end points taken from ``leg_segments``; to 1e-6 relative."""
+    from pkmlab.poses import as_frames
+    from pkmlab.requirements.payload import combine, leg_end_masses, leg_rod_masses
+
+    mech = _ups()
+    mleg = 8.0
+    A, f, ph = (np.array(v) for v in SIN)
+    m = sinusoid_motion(mech, A, f, ph, duration=1.3, rate=300)
+    res = inverse_dynamics(mech, m, combine(BODY, leg_rod_masses(mech, mleg)))
+    assert np.all(res.ok)
+    _, _, _, energy, d1 = _independent_newton_euler(mech, A, f, ph, m.t)
+    w2 = 2 * np.pi * f
+
+    def pose(tt):
+        return mech.nominal_pose + A * np.sin(np.outer(np.atleast_1d(tt), w2) + ph)
+
+    def ends(tt):
+        return mech.leg_segments(*as_frames(pose(tt)))
+
+    def leg_energy(tt):
+        a, b = ends(tt)
+        bd = d1(lambda s: ends(s)[1], tt)
+        kin = mleg / 6 * np.sum(bd * bd, axis=(1, 2))
+        pot = mleg * GRAVITY * np.sum(a[..., 2] + b[..., 2], axis=1) / 2
+        return (kin + pot) * 1e-6
+
+    h = 1e-4
+    qd = (mech.inverse(pose(m.t - 2 * h)).q - 8 * mech.inverse(pose(m.t - h)).q
+          + 8 * mech.inverse(pose(m.t + h)).q - mech.inverse(pose(m.t + 2 * h)).q) / (12 * h)
+    P = np.sum(res.force * qd, axis=1) * 1e-3
+    dE = d1(energy, m.t) + d1(leg_energy, m.t)
+    assert np.max(np.abs(P - dE)) < 1e-6 * np.max(np.abs(P))
+    # the 'ends' model with half of each leg at its platform joint fails this balance (its
+    # inertia share is m/2, the rod's m/3)
+    ends_model = inverse_dynamics(mech, m, combine(BODY, leg_end_masses(mech, mleg / 2)))
+    Pe = np.sum(ends_model.force * qd, axis=1) * 1e-3
+    assert np.max(np.abs(Pe - dE)) > 1e-4 * np.max(np.abs(P))
+
+
+def test_rod_legs_need_fixed_base_joints():
+    mech = load_mechanism(MECH_DIR / "hopkins-williams-6psu.yaml")
+    from pkmlab.requirements.payload import leg_rod_masses
+
+    with pytest.raises(ParameterError, match=r"legs\.model"):
+        leg_rod_masses(mech, 1.0)
+
+
+def test_rotary_servo_fit_on_rss6_and_kind_mismatch_is_invalid(tmp_path):
+    mech = load_mechanism(MECH_DIR / "instructables-servo-6rss.yaml")
+    m = sinusoid_motion(mech, [0, 0, 5, 0.05, 0, 0], [0, 0, 1.0, 0.7, 0, 0], duration=1.5,
+                        rate=200)
+    res = inverse_dynamics(mech, m, MassProperties(0.5, [0, 0, 10.0], [500, 500, 800]))
+    assert res.unit == "rad" and np.all(res.ok)
+    tmax, wmax = np.max(np.abs(res.force)), np.max(np.abs(res.qdot))    # N·mm, rad/s
+    curve = ((0.0, 4 * tmax), (2 * wmax, 4 * tmax), (4 * wmax, 0.0))
+    servo = ActuatorSpec("servo", 2 * tmax, 4 * wmax, math.pi, None, 1.0, curve, "rotary")
+    out = fit(servo, [res])
+    assert out.fits
+    assert out.force_margin == pytest.approx(50.0) and out.speed_margin == pytest.approx(75.0)
+    T = np.abs(res.force)
+    avail = np.interp(np.abs(res.qdot), [0, 2 * wmax, 4 * wmax], [4 * tmax, 4 * tmax, 0])
+    assert out.torque_speed_margin == pytest.approx(100 * np.min(avail - T) / (4 * tmax))
+    used = np.max(res.q.max(0) - res.q.min(0))
+    assert out.stroke_margin == pytest.approx(math.degrees(math.pi - used))
+    # a linear actuator on a rotary family: the design is invalid, and says why
+    data = {"study": "servo", "mechanism": {"file": str(MECH_DIR /
+                                                        "instructables-servo-6rss.yaml")},
+            "design": {"crank_length": {"low": "20 mm", "high": "30 mm"}},
+            "evaluate": {"motions": [{"name": "s", "sinusoid": {"amplitude": {"z": "3 mm"},
+                                                                "frequency": {"z": "1 Hz"}},
+                                      "duration": "0.2 s", "rate": "50 Hz"}],
+                         "payload": {"mass": "0.2 kg"},
+                         "actuators": {"spec": {"name": "lin", "force": "10 N",
+                                                "speed": "10 mm/s"}}},
+            "objectives": [{"minimize": "peak_actuator_force"}], "optimizer": {"method": "grid"}}
+    s = study_from_mapping(data, tmp_path)
+    rec = evaluate_design(s.space, None, s.evaluation, 0)
+    assert rec["status"] == "invalid" and "rotary actuator" in rec["reason"], rec["reason"]
+
+
+def test_summary_reports_which_catalogue_actuators_fit(tmp_path):
+    from pkmlab.study.report import _catalogue_fits
+
+    s = load_study(ROOT / "studies" / "motion-simulator-6ups-requirements.yaml")
+    recs = [{"status": "ok", "params": {"base_outer_radius": 450.0, "platform_ratio": 0.5,
+                                         "actuator": a}, "metrics": {"actuators_fit": fit_}}
+            for a, fit_ in (("EC-S-1k", 0.0), ("EC-L-5k", 1.0), ("EC-L-5k", 0.0))]
+    text = "\n".join(_catalogue_fits(s, recs))
+    assert "EC-S-1k fits 0 of 1" in text and "EC-L-5k fits 1 of 2" in text
+    assert "EC-XL-10k fits 0 of 0" in text

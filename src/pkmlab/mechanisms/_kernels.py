@@ -85,7 +85,7 @@ from .._intervals import union_merge
 from .._jit import cached_kernel, identity, jitable
 
 __all__ = ["BLOCK", "ROW", "carray", "make_driver", "make_column_kernel", "make_leg_eval",
-           "stroke_status"]
+           "make_jacobian_driver", "make_kinematics_driver", "stroke_status"]
 
 # Leg status codes, ordered by severity: a pose's reason is its legs' maximum.
 OK, BELOW_STROKE, ABOVE_STROKE, DEGENERATE, NO_SOLUTION, INVALID_INPUT = 0, 1, 2, 3, 4, 5
@@ -395,6 +395,82 @@ def make_driver(one, ng: int, kind: str):
         return cached_kernel(drive_frames, nt.void(_F2, _F3, g, f8, f8, _F2, _I2, _I1),
                              parallel=True)
     raise ValueError(f"kind must be 'euler' or 'frames', got {kind!r}")
+
+
+# ---- velocity Jacobians -------------------------------------------------------------------------
+# A family may supply ``jac(px, py, pz, r00, ..., r22, g, q, J, k)`` (``register_jitable(inline=
+# "always")``) that writes the ``(6, 6)`` Jacobian of pose ``k`` to ``J[k]`` from the pose, the
+# IK geometry tuple ``g`` and, for families whose Jacobian depends on them, the actuator values
+# ``q[k]``. Rows of legs with no real solution come out NaN (0/0 and sqrt of a negative number
+# under numba's "numpy" error model), as the NumPy formulas give them.
+
+
+@cache
+def _jac_block(jac, ng: int):
+    """The poses ``[k0, k1)`` through ``jac``, a function of its own named after its identity
+    (as :func:`_legs`)."""
+
+    def jac_block(p, R, g, q, J, k0, k1):
+        for k in range(k0, k1):
+            jac(p[k, 0], p[k, 1], p[k, 2], R[k, 0, 0], R[k, 0, 1], R[k, 0, 2],
+                R[k, 1, 0], R[k, 1, 1], R[k, 1, 2], R[k, 2, 0], R[k, 2, 1], R[k, 2, 2],
+                g, q, J, k)
+
+    return jitable(jac_block, identity(jac_block, extra=("jac_block", ng)),
+                   error_model="numpy")
+
+
+@cache
+def make_jacobian_driver(jac, ng: int):
+    """Parallel driver ``jacobian(p (N, 3), R (N, 3, 3), g, q (N, 6), J_out (N, 6, 6))`` for the
+    per-pose Jacobian ``jac`` (above) and geometry tuples of ``ng`` floats, built by
+    :func:`.._jit.cached_kernel` like :func:`make_driver`."""
+    block = _jac_block(jac, ng)
+
+    def drive_jacobian(p, R, g, q, J):
+        n = p.shape[0]
+        for b in prange((n + BLOCK - 1) // BLOCK):
+            block(p, R, g, q, J, b * BLOCK, min(n, b * BLOCK + BLOCK))
+
+    return cached_kernel(drive_jacobian, nt.void(_F2, _F3, nt.UniTuple(nt.float64, ng), _F2,
+                                                 _F3), parallel=True, error_model="numpy")
+
+
+@cache
+def make_kinematics_driver(one, jac, ng: int):
+    """Inverse kinematics and Jacobian of frames in one parallel pass: ``kinematics(p, R, g,
+    qmin, qmax, q_out, st_out, reason_out, J_out)``, the ``frames`` driver of
+    :func:`make_driver` for ``one`` followed, block by block, by ``jac`` (which reads the
+    block's stored actuator values). One parallel region instead of two: on a loaded machine
+    each region waits for every thread to be scheduled."""
+    legs = _legs(one, ng)
+    block_jac = _jac_block(jac, ng)
+
+    def drive_kinematics(p, R, g, qmin, qmax, q_out, st_out, reason_out, J):
+        n = p.shape[0]
+        pf, Rf = p.reshape(-1), R.reshape(-1)
+        q_flat, st_flat = q_out.reshape(-1), st_out.reshape(-1)
+        for b in prange((n + BLOCK - 1) // BLOCK):
+            k0 = b * BLOCK
+            m = min(BLOCK, n - k0)
+            w = _width(m)
+            pb, Rb = pf[3 * k0:3 * (k0 + m)], Rf[9 * k0:9 * (k0 + m)]
+            T = np.empty(12 * ROW)
+            q = np.empty(6 * ROW)
+            st = np.empty(6 * ROW, dtype=np.int8)
+            nbad = _load_frames(pb, Rb, m, w, T)
+            legs(T, w, g, qmin, qmax, q, st)
+            out = slice(6 * k0, 6 * (k0 + m))
+            _store(q, st, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
+            if nbad:
+                bad = np.zeros(BLOCK, dtype=np.bool_)
+                _frames_bad(pb, Rb, m, bad)
+                _store_invalid(bad, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
+            block_jac(p, R, g, q_out, J, k0, k0 + m)
+
+    gt, f8 = nt.UniTuple(nt.float64, ng), nt.float64
+    return cached_kernel(drive_kinematics, nt.void(_F2, _F3, gt, f8, f8, _F2, _I2, _I1, _F3),
+                         parallel=True, error_model="numpy")
 
 
 # ---- column kernels for the workspace engine --------------------------------------------------

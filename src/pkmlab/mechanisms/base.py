@@ -7,7 +7,8 @@ method whose name starts with ``_``):
   ``stroke``, ``actuator_limits``, ``scale``;
 * ``base_points``, ``platform_points``, ``tool_offset`` and ``tool_points`` (mm);
 * ``nominal_pose`` — level, centred, mid-stroke unless given;
-* ``inverse(poses, stroke=None)`` and ``jacobian(poses)``: ``poses`` is ``(N, 6)`` Euler
+* ``inverse(poses, stroke=None)``, ``jacobian(poses)`` and both at once,
+  ``inverse_and_jacobian(poses, stroke=None)``: ``poses`` is ``(N, 6)`` Euler
   (mm, rad, R = Rz·Ry·Rx), ``(N, 4, 4)`` transforms, or a tuple ``(p (N, 3), R (N, 3, 3))``;
   ``stroke`` overrides the actuator window (:data:`NO_STROKE` for geometry only);
 * ``forward(q)``, ``assembly_modes(q)``;
@@ -32,7 +33,10 @@ contract suite in ``tests/test_contract.py`` then runs on it):
   ``platform_points``, ``stroke_window`` and ``tool_offset``, validated in ``__post_init__``;
 * ``_ik_one`` — a numba per-pose inverse kinematics function (see :mod:`._kernels`);
 * ``_gparams()`` — the geometry packed as one float array for that function;
-* ``_jacobian(p, R)`` — the analytic velocity Jacobian ``(N, 6, 6)``;
+* ``_jacobian(p, R)`` — the analytic velocity Jacobian ``(N, 6, 6)``, or instead
+  ``_jac_one``, a numba per-pose Jacobian (see :func:`._kernels.make_jacobian_driver`; with
+  ``_jac_uses_q = True`` when it reads the actuator values), which the base ``_jacobian`` runs
+  in parallel: ``psu6``, ``ups6`` and ``rss6`` do, at tens of M poses/s;
 * ``_closure(p, R, q)`` — loop-closure residuals ``(N, 6)`` in mm and their derivative with
   respect to the tool twist ``(N, 6, 6)``, used by Newton's method;
 * ``scale`` and ``leg_segments``; optionally the column hooks above.
@@ -145,6 +149,11 @@ class Mechanism:
 
     # ---- family hooks ----------------------------------------------------------------------
     _ik_one: ClassVar[Any] = None
+    #: numba per-pose Jacobian ``jac(px, py, pz, r00, ..., r22, g, q, J, k)`` (optional; see
+    #: :func:`._kernels.make_jacobian_driver`), ``g`` the IK geometry; ``q`` (the actuator
+    #: values, from the IK without stroke) is computed only when ``_jac_uses_q``.
+    _jac_one: ClassVar[Any] = None
+    _jac_uses_q: ClassVar[bool] = False
     #: ``"linear"`` / ``"quadratic"`` when the family supplies exact column kernels
     #: (``column_leg``) for the workspace engine, ``"crank"`` for rss6's set-valued legs (it
     #: overrides ``column_intervals``, :mod:`._set_columns`), ``None`` for sampled evaluation.
@@ -237,8 +246,19 @@ class Mechanism:
     def _gparams(self) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError
 
-    def _jacobian(self, p: np.ndarray, R: np.ndarray) -> np.ndarray:  # pragma: no cover
-        raise NotImplementedError
+    def _jacobian(self, p: np.ndarray, R: np.ndarray) -> np.ndarray:
+        """``(N, 6, 6)`` by the family's ``_jac_one`` kernel (families without one override
+        this with their own formula)."""
+        jac = type(self)._jac_one
+        if jac is None:  # pragma: no cover - abstract
+            raise NotImplementedError
+        p, R = _kernels.carray(p), _kernels.carray(R)
+        q = (self._run_ik(p, R, *NO_STROKE).q if self._jac_uses_q
+             else np.empty((len(p), 6)))
+        J = np.empty((len(p), 6, 6))
+        g = self._ik_geometry
+        _kernels.make_jacobian_driver(jac, len(g))(p, R, g, q, J)
+        return J
 
     def _closure(self, p, R, q):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -347,6 +367,25 @@ class Mechanism:
         """``_gparams()`` as a tuple of floats: the IK drivers' loops see its entries as
         constants (see :mod:`._kernels`)."""
         return tuple(self._gparams().tolist())
+
+    def inverse_and_jacobian(self, poses, *, stroke: tuple[float, float] | None = None
+                             ) -> tuple[IKResult, np.ndarray]:
+        """:meth:`inverse` and :meth:`jacobian` of the same poses, ``(IKResult, J (N, 6,
+        6))``: one parallel pass for families with a numba Jacobian (inverse dynamics
+        calls this per chunk of a trajectory)."""
+        jac = type(self)._jac_one
+        if jac is None or type(self)._jacobian is not Mechanism._jacobian:
+            # no kernel, or a subclass's own formula: the two calls, which honour it
+            return self.inverse(poses, stroke=stroke), self.jacobian(poses)
+        p, R = _frames_tuple(poses) if isinstance(poses, tuple) else as_frames(poses)
+        p, R = _kernels.carray(p), _kernels.carray(R)
+        lo, hi = self.stroke if stroke is None else (float(stroke[0]), float(stroke[1]))
+        n, g = len(p), self._ik_geometry
+        q, J = np.empty((n, 6)), np.empty((n, 6, 6))
+        st, reason = np.empty((n, 6), dtype=np.int8), np.empty(n, dtype=np.int8)
+        drive = _kernels.make_kinematics_driver(type(self)._ik_one, jac, len(g))
+        drive(p, R, g, float(lo), float(hi), q, st, reason, J)
+        return IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st), J
 
     def jacobian(self, poses) -> np.ndarray:
         """Analytic velocity Jacobian ``(N, 6, 6)``: ``q̇ = J · [v; ω]``.

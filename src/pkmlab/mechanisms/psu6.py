@@ -48,6 +48,27 @@ def _psu_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, q
         st[k] = _kernels.stroke_status(v, qmin, qmax) if real else _kernels.NO_SOLUTION
 
 
+@register_jitable(inline="always")
+def _psu_jac_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, q, J, k):
+    """Per-pose Jacobian (:func:`._kernels.make_jacobian_driver`): row i is
+    ``[a_iᵀ, (r_i × a_i)ᵀ] / a_iz`` with ``a_iz = sqrt(l_i² - a_ix² - a_iy²)`` (NaN if < 0)."""
+    for i in range(6):
+        ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
+        rx = r00 * ux + r01 * uy + r02 * uz
+        ry = r10 * ux + r11 * uy + r12 * uz
+        rz = r20 * ux + r21 * uy + r22 * uz
+        ax = px + rx - g[3 * i]
+        ay = py + ry - g[3 * i + 1]
+        ll = g[36 + i]
+        az = math.sqrt(ll * ll - ax * ax - ay * ay)
+        J[k, i, 0] = ax / az
+        J[k, i, 1] = ay / az
+        J[k, i, 2] = az / az
+        J[k, i, 3] = (ry * az - rz * ay) / az
+        J[k, i, 4] = (rz * ax - rx * az) / az
+        J[k, i, 5] = (rx * ay - ry * ax) / az
+
+
 @njit(inline="always")
 def _psu_column_leg(x, y, wx, wy, wz, l2, qmin, qmax):
     """Along a column q = z + w_z - sqrt(l² - |a_xy|²) with a_xy = (x, y) + w_xy: the stroke
@@ -82,6 +103,7 @@ class PSU6(Mechanism):
     tool_offset: np.ndarray = (0.0, 0.0, 0.0)  # type: ignore[assignment]
 
     _ik_one = _psu_one
+    _jac_one = _psu_jac_one
 
     def __post_init__(self):
         set_ = object.__setattr__
@@ -135,14 +157,6 @@ class PSU6(Mechanism):
     def _gparams(self) -> np.ndarray:
         return np.concatenate([self.base_points.ravel(), self.tool_points.ravel(),
                                self.link_length])
-
-    def _jacobian(self, p, R):
-        r = np.einsum("nij,kj->nki", R, self.tool_points)          # (N, 6, 3)
-        a = p[:, None, :] + r - self.base_points
-        with np.errstate(invalid="ignore"):
-            a[..., 2] = np.sqrt(self.link_length**2 - a[..., 0] ** 2 - a[..., 1] ** 2)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.concatenate([a, np.cross(r, a)], axis=-1) / a[..., 2:3]
 
     def _closure(self, p, R, q):
         r = np.einsum("nij,kj->nki", R, self.tool_points)

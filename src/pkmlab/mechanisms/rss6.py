@@ -152,6 +152,31 @@ def _rss_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, q
     q[5 * _kernels.ROW + j], st[5 * _kernels.ROW + j] = v, c
 
 
+@register_jitable(inline="always")
+def _rss_jac_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, q, J, k):
+    """Per-pose Jacobian (:func:`._kernels.make_jacobian_driver`): row i is
+    ``[dᵀ, (r × d)ᵀ] / (d · ∂C/∂α)`` (module docstring), from the angles ``q[k]``; ``g``
+    holds 2a·u and 2a·v, so ``C - B = (cos α·2au + sin α·2av)/2``."""
+    for i in range(6):
+        ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
+        rx = r00 * ux + r01 * uy + r02 * uz
+        ry = r10 * ux + r11 * uy + r12 * uz
+        rz = r20 * ux + r21 * uy + r22 * uz
+        c, s = 0.5 * math.cos(q[k, i]), 0.5 * math.sin(q[k, i])
+        e0, e1, e2 = g[36 + 3 * i], g[37 + 3 * i], g[38 + 3 * i]
+        f0, f1, f2 = g[54 + 3 * i], g[55 + 3 * i], g[56 + 3 * i]
+        dx = px + rx - g[3 * i] - (c * e0 + s * f0)
+        dy = py + ry - g[3 * i + 1] - (c * e1 + s * f1)
+        dz = pz + rz - g[3 * i + 2] - (c * e2 + s * f2)
+        den = dx * (c * f0 - s * e0) + dy * (c * f1 - s * e1) + dz * (c * f2 - s * e2)
+        J[k, i, 0] = dx / den
+        J[k, i, 1] = dy / den
+        J[k, i, 2] = dz / den
+        J[k, i, 3] = (ry * dz - rz * dy) / den
+        J[k, i, 4] = (rz * dx - rx * dz) / den
+        J[k, i, 5] = (rx * dy - ry * dx) / den
+
+
 def _unit_rows(value, field: str) -> np.ndarray:
     arr = np.asarray(value, dtype=float)
     if arr.shape != (6, 3) or not np.all(np.isfinite(arr)):
@@ -205,6 +230,8 @@ class RSS6(Mechanism):
     tool_offset: np.ndarray = (0.0, 0.0, 0.0)  # type: ignore[assignment]
 
     _ik_one = _rss_one
+    _jac_one = _rss_jac_one
+    _jac_uses_q = True
 
     def __post_init__(self):
         set_ = object.__setattr__
@@ -310,16 +337,6 @@ class RSS6(Mechanism):
         r = np.einsum("nij,kj->nki", R, self.tool_points)
         d = p[:, None, :] + r - self.crank_ends(q)                     # rod vectors C → P
         return r, d
-
-    def _jacobian(self, p, R):
-        q = self.inverse((p, R), stroke=NO_STROKE).q
-        r, d = self._legs(p, R, q)
-        qq = q[..., None]
-        dC = self.crank_length[:, None] * (-np.sin(qq) * self.zero_directions
-                                           + np.cos(qq) * self.v_directions)
-        den = np.sum(d * dC, axis=-1, keepdims=True)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.concatenate([d, np.cross(r, d)], axis=-1) / den
 
     def _closure(self, p, R, q):
         r, d = self._legs(p, R, np.broadcast_to(q, (len(p), 6)))

@@ -45,6 +45,28 @@ def _ups_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, q
         st[k] = _kernels.DEGENERATE if v < 1e-12 else s
 
 
+@register_jitable(inline="always")
+def _ups_jac_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, q, J, k):
+    """Per-pose Jacobian (:func:`._kernels.make_jacobian_driver`): row i is
+    ``[n_iᵀ, (r_i × n_i)ᵀ]``."""
+    for i in range(6):
+        ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
+        rx = r00 * ux + r01 * uy + r02 * uz
+        ry = r10 * ux + r11 * uy + r12 * uz
+        rz = r20 * ux + r21 * uy + r22 * uz
+        sx = px + rx - g[3 * i]
+        sy = py + ry - g[3 * i + 1]
+        sz = pz + rz - g[3 * i + 2]
+        v = math.sqrt(sx * sx + sy * sy + sz * sz)
+        nx, ny, nz = sx / v, sy / v, sz / v
+        J[k, i, 0] = nx
+        J[k, i, 1] = ny
+        J[k, i, 2] = nz
+        J[k, i, 3] = ry * nz - rz * ny
+        J[k, i, 4] = rz * nx - rx * nz
+        J[k, i, 5] = rx * ny - ry * nx
+
+
 @njit(inline="always")
 def _ups_column_leg(x, y, wx, wy, wz, side, qmin2, qmax2):
     """Along a column q² = d² + (z + w_z)² (d the horizontal leg length): the stroke window
@@ -81,6 +103,7 @@ class UPS6(Mechanism):
     tool_offset: np.ndarray = (0.0, 0.0, 0.0)  # type: ignore[assignment]
 
     _ik_one = _ups_one
+    _jac_one = _ups_jac_one
 
     def __post_init__(self):
         set_ = object.__setattr__
@@ -143,10 +166,6 @@ class UPS6(Mechanism):
         with np.errstate(divide="ignore", invalid="ignore"):
             n = s / length[..., None]
         return r, n, length
-
-    def _jacobian(self, p, R):
-        r, n, _ = self._legs(p, R)
-        return np.concatenate([n, np.cross(r, n)], axis=-1)
 
     def _closure(self, p, R, q):
         r, n, length = self._legs(p, R)

@@ -39,7 +39,7 @@ from ..units import (
 from ..workspaces.orientations import OrientationSet
 from . import motions as mo
 from .actuators import ActuatorSpec
-from .payload import MassProperties, combine, leg_end_masses
+from .payload import MassProperties, combine, leg_end_masses, leg_rod_masses
 from .task import TaskRegion
 
 __all__ = ["TaskSpec", "MotionSpec", "PayloadSpec", "ActuatorsSpec", "TaskPlan",
@@ -311,8 +311,12 @@ class BodySpec(_Model):
 
 class LegsSpec(_Model):
     mass: Mass = Field(description="mass of one leg (kg)")
-    platform_share: float = Field(0.5, ge=0, le=1, description="share lumped at the "
-                                  "platform joint (the rest stays at the base end)")
+    model: Literal["ends", "rod"] = Field("ends", description="'ends': a share at the "
+                                          "platform joint; 'rod': a uniform slender rod from "
+                                          "a fixed base joint (ups6)")
+    platform_share: float | None = Field(None, ge=0, le=1, description="ends: share lumped "
+                                         "at the platform joint (default 0.5; the rest stays "
+                                         "at the base end)")
 
 
 class PayloadSpec(BodySpec):
@@ -323,12 +327,15 @@ class PayloadSpec(BodySpec):
 @dataclass(frozen=True)
 class PayloadPlan:
     body: MassProperties                       # payload + platform
-    leg_mass: float                            # kg lumped at each platform joint
-    source: dict
+    leg_mass: float                            # kg: lumped at each platform joint (ends),
+    source: dict                               # or each rod's mass (rod)
+    leg_model: str = "ends"
 
     def for_mechanism(self, mech) -> MassProperties:
         if self.leg_mass <= 0:
             return self.body
+        if self.leg_model == "rod":
+            return combine(self.body, leg_rod_masses(mech, self.leg_mass))
         return combine(self.body, leg_end_masses(mech, self.leg_mass))
 
 
@@ -357,17 +364,35 @@ def build_payload(data: Any) -> PayloadPlan:
     body = _body(p, f)
     if p.platform is not None:
         body = combine(body, _body(p.platform, f"{f}.platform"))
-    leg = 0.0 if p.legs is None else p.legs.mass * p.legs.platform_share
-    return PayloadPlan(body, leg, dict(data))
+    if p.legs is not None and p.legs.model == "rod" and p.legs.platform_share is not None:
+        raise ParameterError(f"{f}.legs.platform_share", "not given with model 'rod' (the "
+                             "rod's inertia and weight shares follow from the model)",
+                             p.legs.platform_share)
+    if p.legs is None:
+        return PayloadPlan(body, 0.0, dict(data))
+    if p.legs.model == "rod":
+        return PayloadPlan(body, p.legs.mass, dict(data), "rod")
+    share = 0.5 if p.legs.platform_share is None else p.legs.platform_share
+    return PayloadPlan(body, p.legs.mass * share, dict(data))
 
 
 # ---- actuators ----------------------------------------------------------------------------------
 
 
+PositiveTorque = _quantity(TORQUE_UNITS, "N*mm", 0.0, strict=True)
+PositiveAngularSpeed = _quantity(ANGULAR_SPEED_UNITS, "rad/s", 0.0, strict=True)
+
+
 class ActuatorItem(_Model):
     name: str = Field(pattern=r"^[A-Za-z0-9._-]+$")
-    force: PositiveForce = Field(description="force limit (N)")
-    speed: PositiveSpeed = Field(description="speed limit (mm/s)")
+    kind: Literal["linear", "rotary"] = Field("linear", description="linear (prismatic "
+                                              "families) or rotary (servo on a crank, rss6)")
+    force: PositiveForce | None = Field(None, description="linear: force limit (N)")
+    speed: PositiveSpeed | None = Field(None, description="linear: speed limit (mm/s)")
+    torque: PositiveTorque | None = Field(None, description="rotary: torque limit (N·mm)")
+    angular_speed: PositiveAngularSpeed | None = Field(None, description="rotary: speed "
+                                                       "limit (rad/s, or '60 rpm')")
+    range: Angle | None = Field(None, description="rotary: angle range used (deg)")
     stroke: PositiveLength | None = Field(None, description="travel (mm)")
     lead: Lead | None = Field(None, description="screw lead (mm/rev), with torque_speed")
     efficiency: float = Field(1.0, gt=0, le=1)
@@ -398,6 +423,27 @@ class ActuatorsPlan:
 
 def _actuator(a: ActuatorItem, field: str) -> ActuatorSpec:
     curve = tuple((float(w), float(T)) for w, T in (a.torque_speed or ()))
+    need = ("force", "speed") if a.kind == "linear" else ("torque", "angular_speed")
+    wrong = ("torque", "angular_speed", "range") if a.kind == "linear" else \
+        ("force", "speed", "stroke", "lead")
+    for k in need:
+        if getattr(a, k) is None:
+            raise ParameterError(f"{field}.{k}", f"given for a {a.kind} actuator", None)
+    for k in wrong:
+        if getattr(a, k) is not None:
+            raise ParameterError(f"{field}.{k}", f"not given for a {a.kind} actuator (use "
+                                 f"{' and '.join(need)})", getattr(a, k))
+    if a.kind == "rotary":
+        if a.range is not None and not (0 < a.range <= 2 * math.pi):
+            raise ParameterError(f"{field}.range", "an angle range in (0, 360] deg",
+                                 math.degrees(a.range))
+        if curve:
+            ws = [w for w, _ in curve]
+            if ws[0] != 0 or any(b <= c for c, b in zip(ws, ws[1:])):
+                raise ParameterError(f"{field}.torque_speed", "speeds increasing from 0",
+                                     [round(w * 60 / (2 * math.pi), 6) for w in ws])
+        return ActuatorSpec(a.name, a.torque, a.angular_speed, a.range, None, a.efficiency,
+                            curve, "rotary")
     if curve:
         ws = [w for w, _ in curve]
         if ws[0] != 0 or any(b <= c for c, b in zip(ws, ws[1:])):

@@ -171,11 +171,36 @@ class Study:
             "seed": self.seed, "output": str(self.output), "top": self.top,
         }
 
+    def input_files(self) -> list[str]:
+        """The files the requirement blocks read (task point set, motion recordings, actuator
+        catalogue), as resolved paths."""
+        ev = self.evaluation
+        paths = []
+        if ev.task is not None and "file" in ev.task.source:
+            paths.append(ev.task.source["file"])
+        if ev.motions is not None:
+            paths += [m["file"] for m in ev.motions.source if "file" in m]
+        if ev.actuators is not None and "catalogue" in ev.actuators.source:
+            paths.append(ev.actuators.source["catalogue"])
+        return paths
+
+    def input_digests(self) -> dict:
+        """``{path: SHA-256 of its bytes}`` of :meth:`input_files` (part of the fingerprint:
+        editing a recording or the catalogue invalidates a resume)."""
+        out = {}
+        for p in self.input_files():
+            try:
+                out[p] = hashlib.sha256(Path(p).read_bytes()).hexdigest()
+            except OSError as exc:
+                out[p] = f"unreadable: {exc.strerror}"
+        return out
+
     def fingerprint(self) -> str:
         """Hash of what determines the evaluations (mechanism, design space, evaluation,
         seed): the store refuses to resume a study whose fingerprint changed."""
         r = self.resolved()
         keep = {k: r[k] for k in ("mechanism", "design", "derived", "evaluate", "seed")}
+        keep["input_files"] = self.input_digests()
         text = json.dumps(keep, sort_keys=True, separators=(",", ":"), default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 

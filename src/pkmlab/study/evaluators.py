@@ -306,6 +306,10 @@ def _actuators(mech, ctx: Context) -> dict:
     plan = ctx.evaluation.actuators
     name = ctx.choices.get("actuator", plan.default)
     spec = plan.catalogue[name]
+    if (spec.kind == "rotary") != (mech.actuator_unit == "rad"):
+        need = "rotary" if mech.actuator_unit == "rad" else "linear"
+        raise ParameterError("evaluate.actuators", f"a {need} actuator for family "
+                             f"{mech.family!r}", f"{spec.name} ({spec.kind})")
     f = actuator_fit(spec, ctx.dynamics)
     ctx.notes.update(f.notes)
     return {"actuators_fit": float(f.fits), "actuator_force_margin": f.force_margin,

@@ -9,6 +9,14 @@ report and :func:`pkmlab.open_results` need later is written here, so they only 
 rank, values, slice layout, files), ``workspace.stl`` (mm), ``workspace.ply`` (mm, κ per
 vertex as a property), ``workspace.glb`` (m, coloured by κ), ``slices.png`` and
 ``kappa_slices.png``; ``designs/index.json`` lists them and the exports that failed.
+
+With requirements (:mod:`pkmlab.requirements`): the task region is drawn in red into the
+slices and written as ``task.stl`` (mm, base frame) and, with the workspace, as one scene
+``workspace_task.glb``; without a workspace block the dexterous workspace over the task's
+orientation set is computed for the drawing. Each required motion gets
+``actuators-<motion>.png`` (actuator force or torque and speed against time with the chosen
+actuator's limits dashed, and its torque–speed curve with the required points) and
+``actuators.json`` the numbers drawn.
 """
 
 from __future__ import annotations
@@ -148,12 +156,25 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
                   "key": r["key"], "params": params, "metrics": r["metrics"],
                   "notes": r.get("notes", {}), "files": files}
     ev = study.evaluation
-    if ev.workspace is not None:
-        mech = spec.build()
+    mech = spec.build() if (ev.workspace is not None or ev.task is not None
+                            or ev.motions is not None) else None
+    overlay = _task_overlay(mech, ev.task, info)
+    if ev.motions is not None:
+        step("actuator plots over the required motions")
+        _actuator_plots(d, study, mech, r, info, files)
+    if ev.workspace is not None or ev.task is not None:
         force_limit = ev.dexterity.force_limit if ev.dexterity is not None else 150.0
         step("workspace")
-        res = workspace(mech, **ev.request)
-        opts = ev.workspace.slice_options()
+        if ev.workspace is not None:
+            res = workspace(mech, **ev.request)
+            opts = ev.workspace.slice_options()
+        else:       # only a task: draw it in the workspace it must be contained in
+            h = _task_drawing_resolution(mech, ev.task)
+            res = workspace(mech, "dexterous", ev.task.orientations, h)
+            opts = {}
+            info["task_workspace"] = (f"dexterous workspace over the task's orientation set "
+                                      f"({len(ev.task.orientations.rotations())} "
+                                      f"orientations), h = {h:g} mm, drawn for the task")
         lay = slice_layout(res, **opts)
         info["workspace"] = {k: v for k, v in res.metrics().items()
                              if k in ("kind", "volume_cm3", "volume_error_cm3", "bbox_mm",
@@ -161,8 +182,15 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
                                       "method")}
         info["slice_layout"] = lay.as_dict()
         step("slices")
-        res.plot_slices(d / "slices.png", **opts)
+        res.plot_slices(d / "slices.png", **opts, **overlay)
         files.append("slices.png")
+        if overlay:
+            cut = [z for z in lay.levels if overlay["overlay"](z)]
+            info["task_slices_mm"] = cut or ("the task lies between the slices: none "
+                                             "cuts it (see task.stl)")
+        if ev.task is not None:
+            step("task mesh")
+            _task_meshes(d, mech, ev.task, res, files, info)
         if res.mesh_problem is not None:
             info["mesh"] = res.mesh_problem
         else:
@@ -170,8 +198,11 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
             L = length.length if length.status != "fallback" else None
             mesh = res.mesh()
             values, first = {}, None
-            drawn = drawn_voxels(res, lay.levels) if maps and L else None
-            for name in maps if L else ():
+            # κ maps for the workspace the study asked for (not for one drawn for a task),
+            # evaluated only on the voxels the pictures show (slice layers and surface)
+            mapped = maps if L and ev.workspace is not None else ()
+            drawn = drawn_voxels(res, lay.levels) if mapped else None
+            for name in mapped:
                 step(f"{name} map over the {int(drawn.sum())} drawn voxels (of "
                      f"{int(res.occupancy.sum())}) × {len(res.orientations.rotations())} "
                      "orientations")
@@ -194,7 +225,8 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
                 step(f"{first.metric} slices")
                 fig = slice_figure(res, values=np.where(np.isfinite(first.grid), first.grid,
                                                         np.nan),
-                                   label=f"{first.label}, L = {L:.4g} mm", **opts)
+                                   label=f"{first.label}, L = {L:.4g} mm", **opts,
+                                   **overlay)
                 name = f"{first.metric}_slices.png"
                 buf = io.BytesIO()
                 fig.savefig(buf, format="png", dpi=110)
@@ -202,3 +234,71 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
                 files.append(name)
     atomic.write_text(d / "design.json", json.dumps(_plain(info), indent=2) + "\n")
     return info
+
+
+# ---- requirement outputs (task region, actuators over the motions) ---------------------------
+
+
+def _task_overlay(mech, task, info: dict) -> dict:
+    """``slice_figure`` keywords that draw the task's sections in red (none without a task)."""
+    if task is None:
+        return {}
+    from ..requirements.task import task_outline
+
+    info["task"] = {**task.region.describe(), "orientations": task.orientations.describe()}
+    return {"overlay": lambda z: task_outline(mech, task.region, z),
+            "overlay_label": "the task region (required positions)"}
+
+
+def _task_drawing_resolution(mech, task) -> float:
+    """Grid spacing of the workspace drawn around a task when the study asks for none:
+    about 1/100 of the mechanism's size, never finer than the task's own resolution."""
+    return float(max(task.resolution, round(mech.scale / 100, 1)))
+
+
+def _task_meshes(d: Path, mech, task, res, files: list, info: dict) -> None:
+    """``task.stl`` (the task region, mm, base frame) and, with a workspace boundary,
+    ``workspace_task.glb`` (both in one scene: workspace grey and translucent, task red)."""
+    import trimesh
+
+    from ..requirements.task import task_mesh
+    from ..workspaces.mesh import write_mesh, write_scene
+
+    V, F = task_mesh(mech, task.region)
+    tm = trimesh.Trimesh(V, F, process=False)
+    write_mesh(tm, d / "task.stl")
+    files.append("task.stl")
+    info["task_mesh_bounds_mm"] = tm.bounds.tolist()
+    if res.mesh_problem is None:
+        write_scene({"workspace": (res.mesh(), (160, 160, 160, 90)),
+                     "task": (tm, (220, 30, 30, 255))}, d / "workspace_task.glb")
+        files.append("workspace_task.glb")
+
+
+def _actuator_plots(d: Path, study: Study, mech, r: dict, info: dict, files: list) -> None:
+    """``actuators-<motion>.png`` per required motion (forces or torques, speeds, the
+    torque–speed curve, the chosen actuator's limits) and ``actuators.json`` (the numbers
+    drawn)."""
+    from ..requirements.dynamics import inverse_dynamics
+    from ..requirements.plots import actuator_figure, actuator_plot_data
+
+    ev = study.evaluation
+    body = ev.payload.for_mechanism(mech)
+    spec = None
+    if ev.actuators is not None:
+        choice = study.space.evaluation_choices(None if r["params"] == BASELINE
+                                                else r["params"])
+        spec = ev.actuators.catalogue[choice.get("actuator", ev.actuators.default)]
+    data = {"actuator": None if spec is None else spec.describe(), "motions": []}
+    for m in ev.motions.motions(mech):
+        res = inverse_dynamics(mech, m, body)
+        fig = actuator_figure(res, spec)
+        name = f"actuators-{m.name}.png"
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=100)
+        atomic.write_bytes(d / name, buf.getvalue())
+        files.append(name)
+        data["motions"].append({**actuator_plot_data(res, spec), "file": name})
+    atomic.write_text(d / "actuators.json", json.dumps(_plain(data), indent=2) + "\n")
+    files.append("actuators.json")
+    info["actuators"] = data

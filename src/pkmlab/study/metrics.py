@@ -134,11 +134,12 @@ _ALL = [
            "1 if every sample of every required motion is within the stroke and not singular"),
     Metric("peak_actuator_force", "motions", "N", "worst-case",
            "largest |actuator force| over every sample of every required motion (Newton–Euler "
-           "of platform + payload, f = J⁻ᵀ·w)"),
+           "of platform + payload + legs, f = J⁻ᵀ·w; rotary families: crank torque in N·mm)"),
     Metric("rms_actuator_force", "motions", "N", "worst-case",
            "largest RMS actuator force (time-weighted, per actuator and motion)"),
     Metric("peak_actuator_speed", "motions", "mm/s", "worst-case",
-           "largest |actuator speed| over every sample of every required motion"),
+           "largest |actuator speed| over every sample of every required motion (rotary "
+           "families: rad/s)"),
     Metric("peak_actuator_power", "motions", "W", "worst-case",
            "largest |actuator force × speed| over every sample of every required motion"),
     # requirements: the payload held at rest over the workspace
@@ -157,9 +158,10 @@ _ALL = [
     Metric("actuator_torque_speed_margin", "actuators", "%", "worst-case",
            "100·min over samples of (available − required motor torque) / peak curve torque"),
     Metric("actuator_stroke_margin", "actuators", "mm", "worst-case",
-           "actuator travel − the largest travel an actuator uses over the motions"),
+           "actuator travel − the largest travel an actuator uses over the motions (rotary "
+           "actuators: angle range, in deg)"),
     Metric("actuator_force_rating", "actuators", "N", "exact",
-           "force limit of the chosen actuator (its size)"),
+           "force limit of the chosen actuator (its size; rotary: torque limit in N·mm)"),
 ]
 
 #: name → :class:`Metric`

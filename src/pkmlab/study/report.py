@@ -208,9 +208,53 @@ def _summary(study: Study, records, front, baseline) -> str:
         lines.append(row(label, baseline))
     for i, r in enumerate(front[:max(study.top, 1) * 2]):
         lines.append(row(f"Pareto {i + 1}", r))
+    lines += _requirement_margins(study, baseline, front[:max(study.top, 1) * 2], metrics)
+    lines += _catalogue_fits(study, records)
     if notes:
         lines += ["", "Notes (a value shown as — is undefined for the reason given):", *notes]
     lines += ["", "Lengths in mm, angles in degrees, volumes in cm³, forces in N. Metric "
               "definitions: `pkmlab metrics`. Full tables: evaluations.csv, pareto.csv; "
               "exported designs (mechanism YAML, workspace STL, slices, κ map) under designs/."]
     return "\n".join(lines) + "\n"
+
+
+#: requirement metrics that summary.md lists in its margins table (when evaluated)
+REQUIREMENT_MARGINS = ("task_contained", "task_margin", "task_orientation_margin",
+                       "motions_feasible", "peak_actuator_force", "peak_actuator_speed",
+                       "peak_actuator_power", "actuators_fit", "actuator_force_margin",
+                       "actuator_speed_margin", "actuator_torque_speed_margin",
+                       "actuator_stroke_margin")
+
+
+def _requirement_margins(study: Study, baseline, front, shown) -> list[str]:
+    """The task and actuator margins of the baseline and the Pareto designs listed above
+    (markdown lines; none when the study has no requirement blocks)."""
+    rows = ([("baseline", baseline)] if baseline is not None else []) + \
+        [(f"Pareto {i + 1}", r) for i, r in enumerate(front)]
+    names = [m for m in REQUIREMENT_MARGINS if any(m in r["metrics"] for _, r in rows)]
+    if not names:
+        return []
+    head = [f"{METRICS[m].label}" for m in names]
+    out = ["", "Requirement margins (task: mm and deg of room left; actuators: % of the "
+           "limit left, negative = exceeded; see `pkmlab metrics`):", "",
+           "| design | " + " | ".join(head) + " |", "|---" * (1 + len(names)) + "|"]
+    for label, r in rows:
+        out.append(f"| {label} | " + " | ".join(_fmt(r["metrics"].get(m)) for m in names)
+                   + " |")
+    return out
+
+
+def _catalogue_fits(study: Study, records) -> list[str]:
+    """Which catalogue actuators work: for a design variable choosing the actuator, per entry
+    the evaluated designs on which it fits (``actuators_fit``) out of those evaluated with it."""
+    var = next((v for v in study.variables if v.role == "actuator"), None)
+    if var is None:
+        return []
+    parts = []
+    for name in var.choices:
+        with_it = [r for r in records if r["status"] == "ok"
+                   and _params(study, r).get(var.name) == name]
+        fits = sum(r["metrics"].get("actuators_fit") == 1.0 for r in with_it)
+        parts.append(f"{name} fits {fits} of {len(with_it)}")
+    return ["", "Catalogue actuators (designs evaluated with each, on which it meets force, "
+            "speed, torque–speed and stroke along every motion): " + "; ".join(parts) + "."]

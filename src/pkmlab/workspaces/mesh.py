@@ -9,7 +9,7 @@ import numpy as np
 
 from ..atomic import write_bytes
 
-__all__ = ["boundary_mesh", "write_mesh", "STL_HEADER"]
+__all__ = ["boundary_mesh", "write_mesh", "write_scene", "STL_HEADER"]
 
 #: voxels per marching-cubes slab
 _MESH_SLAB = 4_000_000
@@ -97,3 +97,19 @@ def write_mesh(mesh, path, colors=None, values: dict | None = None) -> Path:
     else:
         raise ValueError(f"mesh format {suffix!r}: use .stl, .ply or .glb")
     return write_bytes(path, data)
+
+
+def write_scene(parts: dict, path) -> Path:
+    """Several meshes (mm) in one glTF binary scene, metres and +y up as :func:`write_mesh`:
+    ``parts`` is ``{name: (trimesh.Trimesh, (r, g, b, a) uint8 colour)}`` (e.g. a workspace
+    and a required task region inside it)."""
+    import trimesh
+
+    scene = trimesh.Scene()
+    to_gltf = [[1e-3, 0, 0, 0], [0, 0, 1e-3, 0], [0, -1e-3, 0, 0], [0, 0, 0, 1]]
+    for name, (mesh, colour) in parts.items():
+        m = mesh.copy()
+        m.visual = trimesh.visual.ColorVisuals(m, face_colors=np.tile(colour, (len(m.faces), 1)))
+        m.apply_transform(to_gltf)
+        scene.add_geometry(m, node_name=name, geom_name=name)
+    return write_bytes(Path(path), scene.export(file_type="glb"))

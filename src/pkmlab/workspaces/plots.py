@@ -23,9 +23,12 @@ __all__ = ["plot_slices", "slice_figure", "overlay_figure"]
 def slice_figure(result, window: float | None = None, spacing: float | None = None,
                  centre=None, columns: int | None = None, values: np.ndarray | None = None,
                  cmap: str = "viridis", label: str = "", layout: str = "auto",
-                 max_panels: int = MAX_PANELS):
+                 max_panels: int = MAX_PANELS, overlay=None, overlay_label: str = ""):
     """Build the figure (a :class:`matplotlib.figure.Figure`, no pyplot state, no global
     backend); ``values (nx, ny, nz)`` colours the sections (nearest voxel layer).
+    ``overlay(z)`` → closed polygons ``[(n, 2) mm, ...]`` drawn in red on the section at
+    height z (e.g. a required task region, :func:`pkmlab.requirements.task.task_outline`),
+    named ``overlay_label`` in the title.
 
     ``layout`` (``"auto"`` or ``"paper"``), ``window``, ``spacing``, ``centre`` and
     ``max_panels`` choose the sections (:func:`.slicing.slice_layout`; ``None``: the
@@ -66,6 +69,11 @@ def slice_figure(result, window: float | None = None, spacing: float | None = No
             img = np.where(sec, values[:, :, k], np.nan).T
             im = ax.imshow(img, origin="lower", extent=extent, cmap=cmap, vmin=vmin, vmax=vmax,
                            interpolation="nearest")
+        for poly in (overlay(z) if overlay is not None else ()):
+            if len(poly) == 1:
+                ax.plot(poly[:, 0], poly[:, 1], "r.", ms=3)
+            else:
+                ax.plot(poly[:, 0], poly[:, 1], "r-", lw=1)
         ax.set_title(f"z = {z:.1f} mm", fontsize=7)
     _outer_labels(axes, len(levels))
     if im is not None:
@@ -79,7 +87,9 @@ def slice_figure(result, window: float | None = None, spacing: float | None = No
                              ha="center", va="center", transform=axes.ravel()[0].transAxes,
                              fontsize=8)
     empty = " (empty)" if result.empty else ""
-    fig.suptitle(f"{name}: {result.kind} workspace{empty}\n{lay.describe()}", fontsize=9)
+    drawn = f"; red: {overlay_label}" if overlay is not None and overlay_label else ""
+    fig.suptitle(f"{name}: {result.kind} workspace{empty}\n{lay.describe()}{drawn}",
+                 fontsize=9)
     return fig
 
 
