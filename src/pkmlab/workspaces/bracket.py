@@ -1,0 +1,529 @@
+"""A guaranteed bracket ``[lower, upper]`` on a workspace volume over the continuous
+orientation set and the continuous x-y plane.
+
+The engine (:mod:`.engine`) is exact in z, but samples the orientation set and takes one column
+per ``h × h`` cell of the x-y plane. Here both are covered instead of sampled.
+
+**Leg bound over a cell.** For a family with radial column kernels (``column_radial``: psu6,
+ups6), leg ``i``'s stroke-feasible z set on the column through ``(x, y)`` at rotation ``R`` is
+``[A_i(d) - w_z, B_i(d) - w_z]`` where ``w = R·u_i - b_i`` (:meth:`leg_offsets`), ``d = |(x, y)
++ w_xy|``, ``A_i`` and ``B_i`` are monotone in ``d``, and the set exists for ``d <= d_i``.
+(The ends are the family's own ``column_leg`` evaluated at ``(d, 0)`` with ``w = 0``; a test
+checks this form for every such family.) Take an x-y cell (the square of half-width ``s``
+about a column) and an orientation cell (:mod:`.cells`) with centre rotation ``R0`` and angle
+bound α. Over the pair, ``w`` stays within ``r_i = 2 sin(α/2)·|u_i|`` of ``w0 = R0·u_i -
+b_i``, so ``d`` lies in ``[d⁻ - r_i, d⁺ + r_i]`` (``d⁻, d⁺`` the exact nearest and farthest
+distance of the square shifted by ``w0_xy``) and ``w_z`` in ``w0_z ± r_i``. Monotone ends take
+their extremes at the ends of the ``d`` range, so
+
+* *inner* (feasible at every point and rotation of the pair):
+  ``[max A(d±) - w0_z + r, min B(d±) - w0_z - r]``, if the set exists at ``d⁺ + r``;
+* *outer* (no point or rotation of the pair is feasible outside):
+  ``[min A(d±) - w0_z - r, max B(d±) - w0_z + r]``, none if it fails at ``d⁻ - r``;
+
+and the same with ``r = 0`` bound the x-y cell at the centre rotation alone (a *sample*).
+
+**Volumes.** With ``I`` and ``O`` the inner and outer column sets, ``Σ h²·|I| <= V <=
+Σ h²·|O|`` over the cells:
+
+* constant and dexterous (every orientation): ``I`` = intersection over the cells and legs of
+  the inner sets; ``O`` = intersection over the sampled centre rotations of the outer sets at
+  ``r = 0`` (a point feasible for every rotation is feasible for the samples);
+* reachable (some orientation): ``I`` = union over the sampled centre rotations of their inner
+  sets; ``O`` = union over the cells of the outer sets.
+
+**Refinement.** Per column, a cell whose inner set does not cut the running intersection of
+samples (dexterous), or whose outer set is empty or inside the running union of samples
+(reachable), can never move a bound: it is dropped. The others are split (branch and bound)
+while the orientation part of the gap is the larger; otherwise the x-y cells are halved and
+the search restarts on the children of the columns still in the outer set. It stops when
+``upper - lower <= target·upper`` or the budget (seconds or leg evaluations) runs out, and
+says which.
+
+**Connected to nominal.** Components are taken on the inner and outer sets separately (cells
+8-adjacent, z sets touching). The component of the inner set that contains the nominal
+position is a connected subset of the workspace through it, so it lies in the kept component;
+the kept component lies in the outer set's component through the nominal position. Both
+bounds are therefore guaranteed for "the component containing the nominal position". When the
+nominal position is not inside the inner set, the lower bound is 0; when it is outside the outer
+set the nominal position is certainly not in the workspace, the engine keeps the component
+*nearest* to it (not a set-theoretic rule), and the bracket covers every component instead
+(lower 0, upper the whole outer set), with a note.
+
+Only the actuator stroke (and connectivity) are bracketed; other constraints are refused.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+
+from .._intervals import label_pieces
+from ..errors import ParameterError
+from ..limits import RESOLUTION_MM
+from ..mechanisms._kernels import make_leg_eval
+from ..poses import as_frames, matrix_to_euler
+from . import cells as oc
+from .constraints import Constraints
+from .orientations import OrientationSet
+
+log = logging.getLogger(__name__)
+
+__all__ = ["VolumeBracket", "volume_bracket"]
+
+#: items (column × orientation cell) evaluated per batch
+_BATCH = 100_000
+#: floating-point slack (mm) added to every outer set and removed from every inner one
+_EPS = 1e-9
+
+
+@dataclass(frozen=True, eq=False)
+class VolumeBracket:
+    """A guaranteed volume bracket (mm³) and how it was reached.
+
+    Attributes:
+        lower, upper: the bracket (mm³).
+        target: relative width asked for (``upper - lower <= target·upper``).
+        stop_reason: ``"converged"``, ``"budget: seconds"``, ``"budget: evaluations"``,
+            ``"budget: cells"`` or ``"empty"``.
+        history: one dict per refinement step (level, cell size h, orientation cells, lower,
+            upper, seconds, evaluations).
+        resolution: the x-y cell size of the last level (mm).
+        evaluations: leg-bound evaluations spent.
+        seconds: wall time.
+        notes: remarks (connectivity, nominal position).
+        cells: the last level's column centres ``(n, 2)``; ``inner``/``outer``: its sets as
+            ``(column index, lo, hi)`` piece arrays, connectivity applied.
+    """
+
+    lower: float
+    upper: float
+    target: float
+    stop_reason: str
+    history: list
+    resolution: float
+    evaluations: int
+    seconds: float
+    notes: list = field(default_factory=list)
+    cells: np.ndarray | None = None
+    inner: tuple | None = None
+    outer: tuple | None = None
+
+    @property
+    def estimate(self) -> float:
+        """Midpoint of the bracket (mm³); it is within ``width / 2`` of the true volume."""
+        return 0.5 * (self.lower + self.upper)
+
+    @property
+    def width(self) -> float:
+        return self.upper - self.lower
+
+    @property
+    def relative_width(self) -> float:
+        return self.width / self.upper if self.upper > 0 else 0.0
+
+    def contains(self, points, which: str = "outer") -> np.ndarray:
+        """``(N,)`` bool: points in the final inner or outer set (closed cells)."""
+        P = np.asarray(points, float).reshape(-1, 3)
+        col, lo, hi = self.inner if which == "inner" else self.outer
+        out = np.zeros(len(P), dtype=bool)
+        h = self.resolution
+        for c in np.unique(col):
+            cx, cy = self.cells[c]
+            sel = (np.abs(P[:, 0] - cx) <= h / 2) & (np.abs(P[:, 1] - cy) <= h / 2)
+            for a, b in zip(lo[col == c], hi[col == c], strict=True):
+                out |= sel & (P[:, 2] >= a) & (P[:, 2] <= b)
+        return out
+
+    def describe(self) -> dict:
+        """Plain-dict summary (mm³ and cm³) for JSON."""
+        return {"lower_mm3": self.lower, "upper_mm3": self.upper,
+                "estimate_mm3": self.estimate, "lower_cm3": self.lower / 1e3,
+                "upper_cm3": self.upper / 1e3, "estimate_cm3": self.estimate / 1e3,
+                "relative_width": self.relative_width, "target": self.target,
+                "stop_reason": self.stop_reason, "final_resolution_mm": self.resolution,
+                "evaluations": self.evaluations, "seconds": self.seconds,
+                "history": list(self.history), "notes": list(self.notes)}
+
+
+# ---- interval helpers ---------------------------------------------------------------------------
+
+
+@njit(cache=True)
+def _merge(col, lo, hi, ncol, out_lo, out_hi, starts):
+    """Union per column of intervals sorted by (column, lo); returns the piece count.
+
+    ``starts (ncol + 1)`` receives each column's first piece."""
+    m = 0
+    n = col.shape[0]
+    t = 0
+    for c in range(ncol):
+        starts[c] = m
+        have = False
+        cl, ch = 0.0, 0.0
+        while t < n and col[t] == c:
+            if have and lo[t] <= ch:
+                if hi[t] > ch:
+                    ch = hi[t]
+            else:
+                if have:
+                    out_lo[m], out_hi[m] = cl, ch
+                    m += 1
+                cl, ch, have = lo[t], hi[t], True
+            t += 1
+        if have:
+            out_lo[m], out_hi[m] = cl, ch
+            m += 1
+    starts[ncol] = m
+    return m
+
+
+@njit(cache=True)
+def _inside(col, lo, hi, starts, plo, phi):
+    """``[lo, hi] ⊂`` one piece of column ``col``, for each query."""
+    out = np.zeros(col.shape[0], dtype=np.bool_)
+    for q in range(col.shape[0]):
+        c = col[q]
+        for k in range(starts[c], starts[c + 1]):
+            if plo[k] <= lo[q] and hi[q] <= phi[k]:
+                out[q] = True
+                break
+    return out
+
+
+def _union(ncol, *parts):
+    """Union per column of ``(col, lo, hi)`` interval arrays → pieces ``(col, lo, hi,
+    starts)``."""
+    col = np.concatenate([p[0] for p in parts]).astype(np.int64)
+    lo = np.concatenate([p[1] for p in parts]).astype(float)
+    hi = np.concatenate([p[2] for p in parts]).astype(float)
+    good = lo <= hi
+    col, lo, hi = col[good], lo[good], hi[good]
+    order = np.lexsort((lo, col))
+    col, lo, hi = col[order], lo[order], hi[order]
+    out_lo, out_hi = np.empty(len(lo)), np.empty(len(lo))
+    starts = np.empty(ncol + 1, dtype=np.int64)
+    m = _merge(col, lo, hi, ncol, out_lo, out_hi, starts)
+    pcol = np.repeat(np.arange(ncol), np.diff(starts))
+    return pcol, out_lo[:m], out_hi[:m], starts
+
+
+def _pieces_of(lo, hi, ok):
+    """Single intervals per column → pieces ``(col, lo, hi)``."""
+    good = ok & (lo <= hi)
+    idx = np.nonzero(good)[0]
+    return idx, lo[idx], hi[idx]
+
+
+def _length(pieces) -> float:
+    return float(np.sum(pieces[2] - pieces[1])) if len(pieces[0]) else 0.0
+
+
+# ---- the leg bounds over (x-y cell, orientation cell) pairs -------------------------------------
+
+
+class _Legs:
+    """What the leg bounds need from the mechanism."""
+
+    def __init__(self, mech, oset):
+        self.mech, self.oset = mech, oset
+        self.eval = make_leg_eval(type(mech).column_leg)
+        self.P = np.asarray(mech.column_params(), float)            # (6, 3)
+        self.unorm = np.linalg.norm(mech.tool_points, axis=1)        # (6,)
+        self.count = 0
+
+    def ends(self, d):
+        """``A(d), B(d), ok(d)`` per leg for ``d (..., 6)``."""
+        shape = d.shape
+        n = d.size
+        P = np.broadcast_to(self.P, shape + (3,)).reshape(-1, 3)
+        a, b, ok = self.eval(d.ravel(), np.zeros(n), np.zeros((n, 3)), P)
+        self.count += n
+        return a.reshape(shape), b.reshape(shape), ok.reshape(shape)
+
+    def reach(self) -> np.ndarray:
+        """``(6,)`` largest ``d`` at which each leg has a z set (bisection on ``ok``)."""
+        lo, hi = np.zeros(6), np.full(6, 10.0 * self.mech.scale + 1.0)
+        _, _, ok = self.ends(hi[None, :])
+        hi = np.where(ok[0], np.inf, hi)                 # unbounded legs: no limit
+        fin = np.isfinite(hi)
+        for _ in range(60):
+            mid = np.where(fin, 0.5 * (lo + hi), 0.0)
+            _, _, ok = self.ends(mid[None, :])
+            lo = np.where(ok[0] & fin, mid, lo)
+            hi = np.where(~ok[0] & fin, mid, hi)
+        return hi
+
+    def bounds(self, cx, cy, s, C, H):
+        """Per item: the four column intervals ``(lo, hi, ok)`` intersected over the legs:
+        ``in0, out0`` (x-y cell at the centre rotation) and ``inr, outr`` (x-y cell ×
+        orientation cell)."""
+        R = self.oset.rotations_at(C)
+        W = self.mech.leg_offsets(R)                                 # (n, 6, 3)
+        r = oc.chord(oc.angle_bound(self.oset, C, H))[:, None] * self.unorm
+        ax = np.abs(cx[:, None] + W[..., 0])
+        ay = np.abs(cy[:, None] + W[..., 1])
+        dmin = np.hypot(np.maximum(ax - s, 0.0), np.maximum(ay - s, 0.0))
+        dmax = np.hypot(ax + s, ay + s)
+        a, b, ok = self.ends(np.stack([dmin, dmax, np.maximum(dmin - r, 0.0), dmax + r]))
+        wz = W[..., 2]
+        out = {}
+        for name, i, j, rr in (("in0", 0, 1, 0.0), ("out0", 0, 1, 0.0), ("inr", 2, 3, r),
+                               ("outr", 2, 3, r)):
+            if name.startswith("in"):
+                lo = np.maximum(a[i], a[j]) - wz + rr + _EPS
+                hi = np.minimum(b[i], b[j]) - wz - rr - _EPS
+                good = ok[j]
+            else:
+                lo = np.minimum(a[i], a[j]) - wz - rr - _EPS
+                hi = np.maximum(b[i], b[j]) - wz + rr + _EPS
+                good = ok[i]
+            L, Hh = lo.max(axis=1), hi.min(axis=1)
+            out[name] = (L, Hh, good.all(axis=1) & (L <= Hh))
+        return out
+
+
+# ---- one x-y level ------------------------------------------------------------------------------
+
+
+class _Level:
+    """Columns of one x-y level with their orientation cells (items) and running samples."""
+
+    def __init__(self, legs, kind, cx, cy, h, C0, H0):
+        self.legs, self.kind, self.h = legs, kind, h
+        self.cx, self.cy = cx, cy
+        n, L = len(cx), len(C0)
+        self.col = np.repeat(np.arange(n), L)
+        self.C = np.tile(C0, (n, 1))
+        self.H = np.tile(H0, (n, 1))
+        if kind == "reachable":
+            e = np.empty(0)
+            self.samples = (np.empty(0, np.int64), e, e, np.zeros(n + 1, np.int64))
+        else:
+            self.s_in = [np.full(n, -np.inf), np.full(n, np.inf), np.ones(n, bool)]
+            self.s_out = [np.full(n, -np.inf), np.full(n, np.inf), np.ones(n, bool)]
+
+    def step(self):
+        """Evaluate the items; update the samples; keep the live items. Returns the column
+        sets ``(inner, outer, inner_if_exact, outer_if_exact)`` as piece arrays (the last two
+        estimate the gap with the orientation part removed)."""
+        n = len(self.cx)
+        res = {k: ([], [], []) for k in ("in0", "out0", "inr", "outr")}
+        for s in range(0, len(self.col), _BATCH):
+            c = self.col[s:s + _BATCH]
+            b = self.legs.bounds(self.cx[c], self.cy[c], 0.5 * self.h, self.C[s:s + _BATCH],
+                                 self.H[s:s + _BATCH])
+            for k, v in b.items():
+                for lst, arr in zip(res[k], v, strict=True):
+                    lst.append(arr)
+        E = np.empty(0)
+        ev = {k: tuple(np.concatenate(x) if x else E for x in v) for k, v in res.items()}
+        col = self.col
+        if self.kind == "reachable":
+            lo, hi, ok = ev["in0"]
+            self.samples = _union(n, self.samples[:3], (col[ok], lo[ok], hi[ok]))
+            pcol, plo, phi, starts = self.samples
+            lo, hi, ok = ev["outr"]
+            live = ok.copy()
+            live[ok] = ~_inside(col[ok], lo[ok], hi[ok], starts, plo, phi)
+            inner = (pcol, plo, phi)
+            outer = _union(n, inner, (col[live], lo[live], hi[live]))[:3]
+            lo0, hi0, ok0 = ev["out0"]
+            sel = live & ok0
+            outer_x = _union(n, inner, (col[sel], lo0[sel], hi0[sel]))[:3]
+            self._keep(live)
+            return inner, outer, inner, outer_x
+        for st, key in ((self.s_in, "in0"), (self.s_out, "out0")):
+            lo, hi, ok = ev[key]
+            np.maximum.at(st[0], col, lo)
+            np.minimum.at(st[1], col, hi)
+            np.logical_and.at(st[2], col, ok)
+        sin_ok = self.s_in[2] & (self.s_in[0] <= self.s_in[1])
+        sout_ok = self.s_out[2] & (self.s_out[0] <= self.s_out[1])
+        ref_lo = np.where(sin_ok, self.s_in[0], self.s_out[0])
+        ref_hi = np.where(sin_ok, self.s_in[1], self.s_out[1])
+        lo, hi, ok = ev["inr"]
+        live = sout_ok[col] & (~ok | (lo > ref_lo[col]) | (hi < ref_hi[col]))
+        ilo, ihi, iok = self.s_in[0].copy(), self.s_in[1].copy(), sin_ok.copy()
+        lc = col[live]
+        np.maximum.at(ilo, lc, lo[live])
+        np.minimum.at(ihi, lc, hi[live])
+        np.logical_and.at(iok, lc, ok[live])
+        inner = _pieces_of(ilo, ihi, iok & sout_ok)
+        outer = _pieces_of(self.s_out[0], self.s_out[1], sout_ok)
+        inner_x = _pieces_of(self.s_in[0], self.s_in[1], sin_ok & sout_ok)
+        self._keep(live)
+        return inner, outer, inner_x, outer
+
+    def _keep(self, live):
+        self.col, self.C, self.H = self.col[live], self.C[live], self.H[live]
+
+    def split(self):
+        C, H, parent = oc.split(self.C, self.H)
+        col = self.col[parent]
+        order = np.argsort(col, kind="stable")
+        self.col, self.C, self.H = col[order], C[order], H[order]
+
+
+# ---- connectivity -------------------------------------------------------------------------------
+
+
+def _connected(pieces, cx, cy, h, p_nom):
+    """Keep the pieces of the component through ``p_nom``: ``(pieces, found)``."""
+    pcol, plo, phi = pieces
+    if len(pcol) == 0:
+        return pieces, False
+    ix = np.round((cx - cx.min()) / h).astype(np.int64)
+    iy = np.round((cy - cy.min()) / h).astype(np.int64)
+    nx, ny = int(ix.max()) + 1, int(iy.max()) + 1
+    starts = np.searchsorted(pcol, np.arange(len(cx) + 1))
+    rank = np.arange(len(pcol)) - starts[pcol]
+    K = int(rank.max()) + 1
+    lo = np.full((nx, ny, K), np.inf)
+    hi = np.full((nx, ny, K), -np.inf)
+    lo[ix[pcol], iy[pcol], rank] = plo
+    hi[ix[pcol], iy[pcol], rank] = phi
+    labels, _ = label_pieces(lo, hi, 0.0)
+    lab = labels[ix[pcol], iy[pcol], rank]
+    near = ((np.abs(cx[pcol] - p_nom[0]) <= h / 2) & (np.abs(cy[pcol] - p_nom[1]) <= h / 2)
+            & (plo <= p_nom[2]) & (p_nom[2] <= phi))
+    if not near.any():
+        return pieces, False
+    keep = lab == lab[np.argmax(near)]
+    return (pcol[keep], plo[keep], phi[keep]), True
+
+
+# ---- driver -------------------------------------------------------------------------------------
+
+
+def _request(mech, kind, orientations, resolution, constraints):
+    from .engine import KINDS
+
+    if kind not in KINDS:
+        raise ParameterError("kind", f"one of {list(KINDS)}", kind)
+    if not (isinstance(resolution, int | float) and math.isfinite(resolution)
+            and RESOLUTION_MM[0] <= resolution <= RESOLUTION_MM[1]):
+        raise ParameterError("resolution", f"a grid spacing in [{RESOLUTION_MM[0]:g}, "
+                             f"{RESOLUTION_MM[1]:g}] mm", resolution)
+    if not mech.column_radial or mech.column_method is None:
+        raise ParameterError("bracket", "a family with radial column kernels (psu6, ups6); "
+                             f"family {mech.family!r} has none", mech.family)
+    cons = constraints or Constraints()
+    if cons.extra:
+        raise ParameterError("constraints", "the stroke (and connectivity) only: a volume "
+                             "bracket does not cover joint limits, link diameter or kappa_max",
+                             cons.describe())
+    if cons.stroke is not True:
+        mech = dataclasses.replace(mech, stroke_window=cons.stroke)
+    oset = orientations or OrientationSet.fixed()
+    if kind == "constant" and oset.kind != "fixed":
+        raise ParameterError("orientations", "a single fixed orientation for kind 'constant'",
+                             oset.kind)
+    _, Rn = as_frames(mech.nominal_pose)
+    return mech, oset.centred(tuple(matrix_to_euler(Rn[0]))), cons
+
+
+def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | None = None,
+                   resolution: float = 2.5, constraints: Constraints | None = None,
+                   target: float = 0.01, budget_s: float = 30.0,
+                   max_evaluations: float = 5e9, max_cells: int = 3_000_000) -> VolumeBracket:
+    """Bracket the volume of a workspace over the continuous orientation set (module notes).
+
+    Args:
+        mech, kind, orientations, resolution, constraints: as for :func:`pkmlab.workspace`;
+            ``resolution`` is the first x-y cell size (halved as needed).
+        target: stop when ``upper - lower <= target·upper``.
+        budget_s: wall-time budget (s); the step running when it runs out completes.
+        max_evaluations: budget of leg-bound evaluations.
+        max_cells: largest number of (column × orientation cell) items of one step.
+    """
+    t0 = time.perf_counter()
+    mech, oset, cons = _request(mech, kind, orientations, resolution, constraints)
+    legs = _Legs(mech, oset)
+    p_nom = mech.nominal_pose[:3]
+    # every feasible p has |p_xy + w_xy| <= reach_i, |w_xy + b_xy| <= |u_i|
+    reach = legs.reach()
+    rad = reach + legs.unorm
+    B = mech.base_points[:, :2]
+    box_lo = np.max(B - rad[:, None], axis=0)
+    box_hi = np.min(B + rad[:, None], axis=0)
+    h = float(resolution)
+    history: list[dict] = []
+    notes: list[str] = []
+    C0, H0 = oc.initial_cells(oset, 1)
+    if np.any(box_lo > box_hi):
+        return VolumeBracket(0.0, 0.0, target, "empty", history, h, legs.count,
+                             time.perf_counter() - t0, ["no position is within every leg's "
+                                                        "reach"])
+    gx = np.arange(math.floor(box_lo[0] / h), math.ceil(box_hi[0] / h) + 1) * h
+    gy = np.arange(math.floor(box_lo[1] / h), math.ceil(box_hi[1] / h) + 1) * h
+    X, Y = np.meshgrid(gx, gy, indexing="ij")
+    cx, cy = X.ravel(), Y.ravel()
+    level = 0
+    stop = None
+    while stop is None:
+        lv = _Level(legs, kind, cx, cy, h, C0, H0)
+        while True:
+            inner, outer, inner_x, outer_x = lv.step()
+            lower, upper, note, kept = _volumes(inner, outer, cons, lv, p_nom)
+            elapsed = time.perf_counter() - t0
+            history.append({"level": level, "h_mm": h, "items": int(len(lv.col)),
+                            "lower_mm3": lower, "upper_mm3": upper, "seconds": elapsed,
+                            "evaluations": legs.count})
+            log.debug("bracket %s", history[-1])
+            gap = upper - lower
+            if upper <= 0 or gap <= target * upper:
+                stop = "converged" if upper > 0 else "empty"
+            elif elapsed >= budget_s:
+                stop = "budget: seconds"
+            elif legs.count >= max_evaluations:
+                stop = "budget: evaluations"
+            if stop is not None:
+                break
+            g_orient = (_length(inner_x) - _length(inner)
+                        + _length(outer) - _length(outer_x)) * h * h
+            g_all = (_length(outer) - _length(inner)) * h * h
+            if len(lv.col) == 0 or g_orient <= 0.5 * (g_all - g_orient):
+                break                                    # the x-y cells dominate: halve h
+            nxt = len(lv.col) * 8
+            if nxt > max_cells:
+                stop = "budget: cells"
+                break
+            lv.split()
+        if stop is None:
+            alive = np.unique(kept[1][0])
+            cx = np.concatenate([lv.cx[alive] + dx * h / 4 for dx in (-1, 1) for _ in (0, 1)])
+            cy = np.concatenate([lv.cy[alive] + dy * h / 4 for _ in (0, 1) for dy in (-1, 1)])
+            h *= 0.5
+            level += 1
+            if len(cx) * len(C0) > max_cells:
+                stop = "budget: cells"
+    if note:
+        notes.append(note)
+    return VolumeBracket(lower, upper, target, stop, history, lv.h, legs.count,
+                         time.perf_counter() - t0, notes,
+                         np.stack([lv.cx, lv.cy], axis=1), kept[0], kept[1])
+
+
+def _volumes(inner, outer, cons, lv, p_nom):
+    """Bracket (mm³) with connectivity: ``(lower, upper, note, (inner, outer) kept)``."""
+    a = lv.h * lv.h
+    if not cons.connected:
+        return _length(inner) * a, _length(outer) * a, None, (inner, outer)
+    out_k, found_out = _connected(outer, lv.cx, lv.cy, lv.h, p_nom)
+    if not found_out:
+        e = np.empty(0)
+        return 0.0, _length(outer) * a, (
+            "the nominal position is outside the workspace: the bracket covers every "
+            "component (lower 0)"), ((np.empty(0, np.int64), e, e), outer)
+    in_k, found_in = _connected(inner, lv.cx, lv.cy, lv.h, p_nom)
+    if not found_in:
+        e = np.empty(0)
+        in_k = (np.empty(0, np.int64), e, e)
+    return _length(in_k) * a, _length(out_k) * a, None, (in_k, out_k)
