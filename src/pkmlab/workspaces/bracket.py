@@ -67,10 +67,10 @@ from numba import njit
 from .._intervals import label_pieces
 from ..errors import ParameterError
 from ..limits import RESOLUTION_MM
-from ..mechanisms._kernels import make_leg_eval
 from ..poses import as_frames, matrix_to_euler
 from . import cells as oc
 from .constraints import Constraints
+from .legbounds import Legs
 from .orientations import OrientationSet
 
 log = logging.getLogger(__name__)
@@ -79,8 +79,6 @@ __all__ = ["VolumeBracket", "volume_bracket"]
 
 #: items (column × orientation cell) evaluated per batch
 _BATCH = 100_000
-#: floating-point slack (mm) added to every outer set and removed from every inner one
-_EPS = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
@@ -225,71 +223,14 @@ def _length(pieces) -> float:
     return float(np.sum(pieces[2] - pieces[1])) if len(pieces[0]) else 0.0
 
 
-# ---- the leg bounds over (x-y cell, orientation cell) pairs -------------------------------------
-
-
-class _Legs:
-    """What the leg bounds need from the mechanism."""
-
-    def __init__(self, mech, oset):
-        self.mech, self.oset = mech, oset
-        self.eval = make_leg_eval(type(mech).column_leg)
-        self.P = np.asarray(mech.column_params(), float)            # (6, 3)
-        self.unorm = np.linalg.norm(mech.tool_points, axis=1)        # (6,)
-        self.count = 0
-
-    def ends(self, d):
-        """``A(d), B(d), ok(d)`` per leg for ``d (..., 6)``."""
-        shape = d.shape
-        n = d.size
-        P = np.broadcast_to(self.P, shape + (3,)).reshape(-1, 3)
-        a, b, ok = self.eval(d.ravel(), np.zeros(n), np.zeros((n, 3)), P)
-        self.count += n
-        return a.reshape(shape), b.reshape(shape), ok.reshape(shape)
-
-    def reach(self) -> np.ndarray:
-        """``(6,)`` largest ``d`` at which each leg has a z set (bisection on ``ok``)."""
-        lo, hi = np.zeros(6), np.full(6, 10.0 * self.mech.scale + 1.0)
-        _, _, ok = self.ends(hi[None, :])
-        hi = np.where(ok[0], np.inf, hi)                 # unbounded legs: no limit
-        fin = np.isfinite(hi)
-        for _ in range(60):
-            mid = np.where(fin, 0.5 * (lo + hi), 0.0)
-            _, _, ok = self.ends(mid[None, :])
-            lo = np.where(ok[0] & fin, mid, lo)
-            hi = np.where(~ok[0] & fin, mid, hi)
-        return hi
-
-    def bounds(self, cx, cy, s, C, H):
-        """Per item: the four column intervals ``(lo, hi, ok)`` intersected over the legs:
-        ``in0, out0`` (x-y cell at the centre rotation) and ``inr, outr`` (x-y cell ×
-        orientation cell)."""
-        R = self.oset.rotations_at(C)
-        W = self.mech.leg_offsets(R)                                 # (n, 6, 3)
-        r = oc.chord(oc.angle_bound(self.oset, C, H))[:, None] * self.unorm
-        ax = np.abs(cx[:, None] + W[..., 0])
-        ay = np.abs(cy[:, None] + W[..., 1])
-        dmin = np.hypot(np.maximum(ax - s, 0.0), np.maximum(ay - s, 0.0))
-        dmax = np.hypot(ax + s, ay + s)
-        a, b, ok = self.ends(np.stack([dmin, dmax, np.maximum(dmin - r, 0.0), dmax + r]))
-        wz = W[..., 2]
-        out = {}
-        for name, i, j, rr in (("in0", 0, 1, 0.0), ("out0", 0, 1, 0.0), ("inr", 2, 3, r),
-                               ("outr", 2, 3, r)):
-            if name.startswith("in"):
-                lo = np.maximum(a[i], a[j]) - wz + rr + _EPS
-                hi = np.minimum(b[i], b[j]) - wz - rr - _EPS
-                good = ok[j]
-            else:
-                lo = np.minimum(a[i], a[j]) - wz - rr - _EPS
-                hi = np.maximum(b[i], b[j]) - wz + rr + _EPS
-                good = ok[i]
-            L, Hh = lo.max(axis=1), hi.min(axis=1)
-            out[name] = (L, Hh, good.all(axis=1) & (L <= Hh))
-        return out
-
-
 # ---- one x-y level ------------------------------------------------------------------------------
+
+
+def _vertices(C, H):
+    """The distinct vertices of the cells ``C ± H``."""
+    signs = np.array(np.meshgrid(*[(-1.0, 1.0)] * 3, indexing="ij")).reshape(3, -1).T
+    V = (C[:, None, :] + signs[None] * H[:, None, :]).reshape(-1, 3)
+    return np.unique(np.round(V, 12), axis=0)
 
 
 class _Level:
@@ -302,6 +243,7 @@ class _Level:
         self.col = np.repeat(np.arange(n), L)
         self.C = np.tile(C0, (n, 1))
         self.H = np.tile(H0, (n, 1))
+        self.corners = _vertices(C0, H0)
         if kind == "reachable":
             e = np.empty(0)
             self.samples = (np.empty(0, np.int64), e, e, np.zeros(n + 1, np.int64))
@@ -324,26 +266,36 @@ class _Level:
                     lst.append(arr)
         E = np.empty(0)
         ev = {k: tuple(np.concatenate(x) if x else E for x in v) for k, v in res.items()}
-        col = self.col
+        col = scol = self.col
+        if self.corners is not None:
+            # the vertices of the first cells (where leg extremes often lie) as samples
+            V = self.corners
+            vc = np.repeat(np.arange(n), len(V))
+            b = self.legs.bounds(self.cx[vc], self.cy[vc], 0.5 * self.h, np.tile(V, (n, 1)),
+                                 None, with_cells=False)
+            for k in ("in0", "out0"):
+                ev[k] = tuple(np.concatenate([x, y]) for x, y in zip(ev[k], b[k], strict=True))
+            scol = np.concatenate([col, vc])
+            self.corners = None
         if self.kind == "reachable":
             lo, hi, ok = ev["in0"]
-            self.samples = _union(n, self.samples[:3], (col[ok], lo[ok], hi[ok]))
+            self.samples = _union(n, self.samples[:3], (scol[ok], lo[ok], hi[ok]))
             pcol, plo, phi, starts = self.samples
             lo, hi, ok = ev["outr"]
             live = ok.copy()
             live[ok] = ~_inside(col[ok], lo[ok], hi[ok], starts, plo, phi)
             inner = (pcol, plo, phi)
             outer = _union(n, inner, (col[live], lo[live], hi[live]))[:3]
-            lo0, hi0, ok0 = ev["out0"]
+            lo0, hi0, ok0 = (x[:len(col)] for x in ev["out0"])
             sel = live & ok0
             outer_x = _union(n, inner, (col[sel], lo0[sel], hi0[sel]))[:3]
             self._keep(live)
             return inner, outer, inner, outer_x
         for st, key in ((self.s_in, "in0"), (self.s_out, "out0")):
             lo, hi, ok = ev[key]
-            np.maximum.at(st[0], col, lo)
-            np.minimum.at(st[1], col, hi)
-            np.logical_and.at(st[2], col, ok)
+            np.maximum.at(st[0], scol, lo)
+            np.minimum.at(st[1], scol, hi)
+            np.logical_and.at(st[2], scol, ok)
         sin_ok = self.s_in[2] & (self.s_in[0] <= self.s_in[1])
         sout_ok = self.s_out[2] & (self.s_out[0] <= self.s_out[1])
         ref_lo = np.where(sin_ok, self.s_in[0], self.s_out[0])
@@ -445,7 +397,7 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
     """
     t0 = time.perf_counter()
     mech, oset, cons = _request(mech, kind, orientations, resolution, constraints)
-    legs = _Legs(mech, oset)
+    legs = Legs(mech, oset)
     p_nom = mech.nominal_pose[:3]
     # every feasible p has |p_xy + w_xy| <= reach_i, |w_xy + b_xy| <= |u_i|
     reach = legs.reach()

@@ -21,6 +21,15 @@ most the length of any path between them, ``∫ |ω| dt`` along the straight seg
 A platform point ``u`` (about the tool origin) then lies within ``2 sin(α/2)·|u|`` of its
 position at the centre rotation, α the bound (capped at π): :func:`chord`.
 
+**Second order** (:func:`axes`, :func:`remainder`). At the centre, ``∂(R·u)/∂P_k = a_k ×
+R·u`` with the axes ``a_k`` of the parametrisation: ``(Rz·Ry·e_x, Rz·e_y, e_z)`` for Euler
+angles, ``R_c·(e_z - Rz(φ)Ry(θ)e_z, Rz(φ)e_y, Rz(φ)Ry(θ)e_z)`` for tilt-torsion. Along the
+straight segment to any point of the cell, ``f(t) = R(t)·u`` has ``f'' = ω'×f + ω×(ω×f)``;
+the axes turn at most as fast as the rotation built before them, which gives ``|ω'| <= S²/2``
+for Euler angles and ``|ω'| <= S²`` for tilt-torsion (``S`` the sum of the half-widths), so
+the linearisation ``R0·u + Σ_k a_k × R0·u · ΔP_k`` is within ``½(|ω'| + |ω|²)·|u|`` of
+``R·u``: :func:`remainder` returns that factor of ``|u|``.
+
 Single-axis boxes are the union of three segments (one angle at a time): their cells have
 zero width on two coordinates.
 """
@@ -31,7 +40,7 @@ import math
 
 import numpy as np
 
-__all__ = ["initial_cells", "split", "angle_bound", "chord"]
+__all__ = ["initial_cells", "split", "angle_bound", "chord", "axes", "remainder"]
 
 
 def _axis_cells(lo: float, hi: float, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -111,3 +120,43 @@ def angle_bound(oset, centres: np.ndarray, halves: np.ndarray) -> np.ndarray:
 def chord(angle: np.ndarray) -> np.ndarray:
     """Largest displacement of a unit vector rotated by at most ``angle`` (rad)."""
     return 2 * np.sin(0.5 * np.minimum(np.asarray(angle, float), math.pi))
+
+
+def _rot(axis: int, a: np.ndarray) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    R = np.zeros(np.shape(a) + (3, 3))
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    R[..., axis, axis] = 1.0
+    R[..., i, i], R[..., i, j], R[..., j, i], R[..., j, j] = c, -s, s, c
+    return R
+
+
+def axes(oset, centres: np.ndarray) -> np.ndarray:
+    """``(L, 3, 3)``: the axes ``a_k`` (rows, base frame) with ``∂R/∂P_k = [a_k]× R`` at each
+    cell centre."""
+    P = np.asarray(centres, float)
+    ez = np.array([0.0, 0.0, 1.0])
+    ey = np.array([0.0, 1.0, 0.0])
+    if oset.kind != "tilt-torsion":
+        t = P + (np.zeros(3) if oset.centre is None else np.asarray(oset.centre))
+        Rz = _rot(2, t[:, 2])
+        a_z = np.broadcast_to(ez, (len(P), 3))
+        a_y = Rz @ ey
+        a_x = (Rz @ _rot(1, t[:, 1])) @ np.array([1.0, 0.0, 0.0])
+        return np.stack([a_x, a_y, a_z], axis=1)
+    from ..poses import euler_to_matrix
+
+    Rc = euler_to_matrix(np.zeros(3) if oset.centre is None else np.asarray(oset.centre))
+    Rz = _rot(2, P[:, 0])
+    q = (Rz @ _rot(1, P[:, 1])) @ ez
+    A = np.stack([ez - q, Rz @ ey, q], axis=1)              # local frame
+    return A @ Rc.T
+
+
+def remainder(oset, centres: np.ndarray, halves: np.ndarray) -> np.ndarray:
+    """``(L,)``: the linearisation error of ``R·u`` over a cell, per unit ``|u|``."""
+    H = np.abs(np.asarray(halves, float))
+    S = H.sum(axis=1)
+    w = np.minimum(angle_bound(oset, centres, halves), S)
+    dw = 0.5 * S**2 if oset.kind != "tilt-torsion" else S**2
+    return 0.5 * (dw + w**2)
