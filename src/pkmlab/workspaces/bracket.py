@@ -226,6 +226,41 @@ def _length(pieces) -> float:
 # ---- one x-y level ------------------------------------------------------------------------------
 
 
+def _tri_positive(f1, f2, f3, area):
+    """``∫ max(f, 0)`` over a triangle of ``area`` for ``f`` affine with vertex values."""
+    v = np.sort(np.stack([f1, f2, f3]), axis=0)[::-1]
+    a, b, c = (np.maximum(np.minimum(x, 1e12), -1e12) for x in v)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        one = area * a**3 / (3 * (a - b) * (a - c))
+        two = area * (a + b + c) / 3 + area * (-c) ** 3 / (3 * (a - c) * (b - c))
+    out = np.where(c >= 0, area * (a + b + c) / 3,
+                   np.where(a <= 0, 0.0, np.where(b <= 0, one, two)))
+    return np.nan_to_num(out, nan=0.0, posinf=0.0)
+
+
+def _tri_volume(f, area, pick):
+    """``∫ f₊`` over the square from corner values ``f (n, 4)`` (corners counter-clockwise),
+    under its two triangulations, combined by ``pick`` (max for a lower bound of a concave
+    ``f``, min for an upper bound by an affine one)."""
+    d1 = _tri_positive(f[:, 0], f[:, 1], f[:, 2], area) + _tri_positive(f[:, 0], f[:, 2],
+                                                                         f[:, 3], area)
+    d2 = _tri_positive(f[:, 0], f[:, 1], f[:, 3], area) + _tri_positive(f[:, 1], f[:, 2],
+                                                                         f[:, 3], area)
+    return pick(d1, d2)
+
+
+def _collect(parts):
+    """Concatenate per-batch outputs of :meth:`Legs.bounds` (tuples and dicts of arrays)."""
+    out = {}
+    for k in parts[0] if parts else ():
+        v = parts[0][k]
+        if isinstance(v, dict):
+            out[k] = {f: np.concatenate([p[k][f] for p in parts]) for f in v}
+        else:
+            out[k] = tuple(np.concatenate([p[k][i] for p in parts]) for i in range(len(v)))
+    return out
+
+
 def _vertices(C, H):
     """The distinct vertices of the cells ``C ± H``."""
     signs = np.array(np.meshgrid(*[(-1.0, 1.0)] * 3, indexing="ij")).reshape(3, -1).T
@@ -250,22 +285,22 @@ class _Level:
         else:
             self.s_in = [np.full(n, -np.inf), np.full(n, np.inf), np.ones(n, bool)]
             self.s_out = [np.full(n, -np.inf), np.full(n, np.inf), np.ones(n, bool)]
+            # x-y second order: samples' ends at the corners, best upper-volume pieces
+            self.pl = {"top": np.full((n, 4), np.inf), "bot": np.full((n, 4), -np.inf),
+                       "plane_c": np.full(n, np.inf), "plane": np.full((n, 4), np.inf),
+                       "piece_c": np.full(n, -np.inf), "piece": np.full((n, 4), -np.inf)}
+        self.pl_lower = self.pl_upper = None
 
     def step(self):
         """Evaluate the items; update the samples; keep the live items. Returns the column
         sets ``(inner, outer, inner_if_exact, outer_if_exact)`` as piece arrays (the last two
         estimate the gap with the orientation part removed)."""
         n = len(self.cx)
-        res = {k: ([], [], []) for k in ("in0", "out0", "inr", "outr")}
-        for s in range(0, len(self.col), _BATCH):
-            c = self.col[s:s + _BATCH]
-            b = self.legs.bounds(self.cx[c], self.cy[c], 0.5 * self.h, self.C[s:s + _BATCH],
-                                 self.H[s:s + _BATCH])
-            for k, v in b.items():
-                for lst, arr in zip(res[k], v, strict=True):
-                    lst.append(arr)
-        E = np.empty(0)
-        ev = {k: tuple(np.concatenate(x) if x else E for x in v) for k, v in res.items()}
+        parts = [self.legs.bounds(self.cx[self.col[s:s + _BATCH]],
+                                  self.cy[self.col[s:s + _BATCH]], 0.5 * self.h,
+                                  self.C[s:s + _BATCH], self.H[s:s + _BATCH])
+                 for s in range(0, max(len(self.col), 1), _BATCH)]
+        ev = _collect(parts)
         col = scol = self.col
         if self.corners is not None:
             # the vertices of the first cells (where leg extremes often lie) as samples
@@ -273,8 +308,9 @@ class _Level:
             vc = np.repeat(np.arange(n), len(V))
             b = self.legs.bounds(self.cx[vc], self.cy[vc], 0.5 * self.h, np.tile(V, (n, 1)),
                                  None, with_cells=False)
-            for k in ("in0", "out0"):
-                ev[k] = tuple(np.concatenate([x, y]) for x, y in zip(ev[k], b[k], strict=True))
+            for k in ("in0", "out0", "pl_sample"):
+                if k in b:
+                    ev[k] = _collect([{k: ev[k]}, {k: b[k]}])[k] if k in ev else b[k]
             scol = np.concatenate([col, vc])
             self.corners = None
         if self.kind == "reachable":
@@ -302,6 +338,8 @@ class _Level:
         ref_hi = np.where(sin_ok, self.s_in[1], self.s_out[1])
         lo, hi, ok = ev["inr"]
         live = sout_ok[col] & (~ok | (lo > ref_lo[col]) | (hi < ref_hi[col]))
+        if "pl_cell" in ev:
+            live |= self._planar(ev["pl_sample"], ev["pl_cell"], ok, scol, col, live, sout_ok)
         ilo, ihi, iok = self.s_in[0].copy(), self.s_in[1].copy(), sin_ok.copy()
         lc = col[live]
         np.maximum.at(ilo, lc, lo[live])
@@ -312,6 +350,41 @@ class _Level:
         inner_x = _pieces_of(self.s_in[0], self.s_in[1], sin_ok & sout_ok)
         self._keep(live)
         return inner, outer, inner_x, outer
+
+    def _planar(self, sample, cell, ok, scol, col, live, sout_ok):
+        """x-y second order (dexterous): update the samples' corner values and upper-volume
+        pieces, mark the cells that could still move a corner bound live, and set the
+        per-column volume bounds ``pl_lower`` / ``pl_upper`` (mm³)."""
+        pl, n = self.pl, len(self.cx)
+        np.minimum.at(pl["top"], scol, sample["top"])
+        np.maximum.at(pl["bot"], scol, sample["bot"])
+        for key, better in (("plane", np.less), ("piece", np.greater)):
+            best = pl[key + "_c"].copy()
+            (np.minimum if key == "plane" else np.maximum).at(best, scol, sample[key + "_c"])
+            win = better(sample[key + "_c"], pl[key + "_c"][scol]) \
+                & (sample[key + "_c"] == best[scol])
+            pl[key][scol[win]] = sample[key][win]
+            pl[key + "_c"] = best
+        grow = ~ok | np.any(cell["bot"] > pl["bot"][col], axis=1) \
+            | np.any(cell["top"] < pl["top"][col], axis=1)
+        grow &= sout_ok[col]
+        keep = live | grow
+        bot, top = pl["bot"].copy(), pl["top"].copy()
+        np.maximum.at(bot, col[keep], cell["bot"][keep])
+        np.minimum.at(top, col[keep], cell["top"][keep])
+        fine = np.ones(n, bool)
+        np.logical_and.at(fine, col[keep], ok[keep])
+        a = 0.5 * self.h * self.h
+        low = _tri_volume(top - bot, a, np.maximum)
+        self.pl_lower_x = _tri_volume(pl["top"] - pl["bot"], a, np.maximum)
+        self.pl_lower = np.where(fine & sout_ok, low, 0.0)
+        self.pl_centre = (0.5 * (bot[:, 0] + bot[:, 2]), 0.5 * (top[:, 0] + top[:, 2]),
+                          0.5 * (bot[:, 1] + bot[:, 3]), 0.5 * (top[:, 1] + top[:, 3]))
+        A = pl["plane"] - pl["piece"]
+        self.pl_upper = np.where(np.isfinite(A).all(axis=1),
+                                 _tri_volume(np.where(np.isfinite(A), A, 0.0), a, np.minimum),
+                                 np.inf)
+        return grow
 
     def _keep(self, live):
         self.col, self.C, self.H = self.col[live], self.C[live], self.H[live]
@@ -441,7 +514,10 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
             g_orient = (_length(inner_x) - _length(inner)
                         + _length(outer) - _length(outer_x)) * h * h
             g_all = (_length(outer) - _length(inner)) * h * h
-            if len(lv.col) == 0 or g_orient <= 0.5 * (g_all - g_orient):
+            if lv.pl_lower is not None:
+                g_orient = max(0.0, float(lv.pl_lower_x.sum() - lv.pl_lower.sum()))
+                g_all = gap
+            if not np.any(lv.H > 0) or g_orient <= 0.5 * (g_all - g_orient):
                 break                                    # the x-y cells dominate: halve h
             nxt = len(lv.col) * 8
             if nxt > max_cells:
@@ -464,18 +540,35 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
 
 
 def _volumes(inner, outer, cons, lv, p_nom):
-    """Bracket (mm³) with connectivity: ``(lower, upper, note, (inner, outer) kept)``."""
+    """Bracket (mm³) with connectivity: ``(lower, upper, note, (inner, outer) kept)``.
+
+    Per column, the box sets' volume is combined with the x-y second-order bounds when
+    there are any (dexterous and constant): the larger lower bound, the smaller upper one. A
+    column's second-order lower region (convex: above a convex bound, below a concave one)
+    counts only when it meets the column's kept box piece (so it joins the kept component)."""
     a = lv.h * lv.h
-    if not cons.connected:
-        return _length(inner) * a, _length(outer) * a, None, (inner, outer)
-    out_k, found_out = _connected(outer, lv.cx, lv.cy, lv.h, p_nom)
-    if not found_out:
-        e = np.empty(0)
-        return 0.0, _length(outer) * a, (
-            "the nominal position is outside the workspace: the bracket covers every "
-            "component (lower 0)"), ((np.empty(0, np.int64), e, e), outer)
-    in_k, found_in = _connected(inner, lv.cx, lv.cy, lv.h, p_nom)
-    if not found_in:
-        e = np.empty(0)
-        in_k = (np.empty(0, np.int64), e, e)
-    return _length(in_k) * a, _length(out_k) * a, None, (in_k, out_k)
+    e = np.empty(0)
+    note = None
+    if cons.connected:
+        out_k, found_out = _connected(outer, lv.cx, lv.cy, lv.h, p_nom)
+        in_k, found_in = _connected(inner, lv.cx, lv.cy, lv.h, p_nom)
+        if not found_out:
+            note = ("the nominal position is outside the workspace: the bracket covers every "
+                    "component (lower 0)")
+            out_k = outer
+        if not (found_in and found_out):
+            in_k = (np.empty(0, np.int64), e, e)
+    else:
+        in_k, out_k = inner, outer
+    n = len(lv.cx)
+    low = np.bincount(in_k[0], in_k[2] - in_k[1], minlength=n) * a
+    up = np.bincount(out_k[0], out_k[2] - out_k[1], minlength=n) * a
+    if lv.pl_lower is not None:
+        up = np.minimum(up, lv.pl_upper)
+        b0, t0 = lv.pl_centre[0][in_k[0]], lv.pl_centre[1][in_k[0]]
+        meet = np.zeros(n, bool)
+        meet[in_k[0][(np.maximum(b0, in_k[1]) <= np.minimum(t0, in_k[2]))]] = True
+        if not cons.connected:
+            meet[:] = True
+        low = np.where(meet, np.maximum(low, lv.pl_lower), low)
+    return float(low.sum()), float(up.sum()), note, (in_k, out_k)

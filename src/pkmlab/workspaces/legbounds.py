@@ -80,6 +80,7 @@ class Legs:
         second = (self.second(cx, cy, s, C, H, W, r) if with_cells and self.profile is not None
                   else None)
         out = {}
+        legs = {}
         for name, i, j, rr in todo:
             if name.startswith("in"):
                 lo = np.maximum(a[i], a[j]) - wz + rr
@@ -96,7 +97,51 @@ class Legs:
             sgn = 1.0 if name.startswith("in") else -1.0
             L, Hh = (lo + sgn * EPS).max(axis=1), (hi - sgn * EPS).min(axis=1)
             out[name] = (L, Hh, good.all(axis=1) & (L <= Hh))
+            legs[name] = (lo, hi)
+        if self.planar:
+            corner = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], float) * s   # (4, 2)
+            out["pl_sample"] = self._sample_corners(cx, cy, W, corner)
+            if with_cells:
+                out["pl_cell"] = _cell_corners(second, legs["inr"], corner)
         return out
+
+    @property
+    def planar(self) -> bool:
+        """Whether the x-y second-order (piecewise-linear) volume bounds apply: every end
+        is ``c + sqrt(...)`` (concave in x-y), as for psu6 and ups6 above the base."""
+        return self.profile is not None and bool(np.all(self.profile[:, :, 1] > 0))
+
+    def _sample_corners(self, cx, cy, W, corner):
+        """At exact rotations: each end at the square's corners, exact, and the volume-upper
+        pieces (see :mod:`.bracket`): the tangent plane at the centre of the leg with the
+        lowest upper end, the lower end at the corners of the leg with the highest one."""
+        v0 = np.stack([cx[:, None] + W[..., 0], cy[:, None] + W[..., 1]], axis=-1)   # (n,6,2)
+        vc = v0[:, :, None, :] + corner                                              # (n,6,4,2)
+        d2 = np.sum(vc**2, axis=-1)
+        c, K = self.profile[:, :, 0], self.profile[:, :, 2]                           # (6, 2)
+        wz = W[..., 2][..., None]
+        lo_end = c[:, 0, None] + np.sqrt(np.maximum(K[:, 0, None] - d2, 0)) - wz
+        hi_end = c[:, 1, None] + np.sqrt(np.maximum(K[:, 1, None] - d2, 0)) - wz
+        reach = d2 <= K[:, 1, None]                  # the upper end's sphere bounds the reach
+        top = np.where(reach, hi_end, -np.inf).min(axis=1)                           # (n, 4)
+        bot = np.where(reach, lo_end, np.inf).max(axis=1)
+        d0 = np.sum(v0**2, axis=-1)                                                  # (n, 6)
+        e_hi = c[:, 1] + np.sqrt(np.maximum(K[:, 1] - d0, 0)) - W[..., 2]
+        e_lo = c[:, 0] + np.sqrt(np.maximum(K[:, 0] - d0, 0)) - W[..., 2]
+        n = np.arange(len(cx))
+        j = np.argmin(np.where(d0 < K[:, 1], e_hi, np.inf), axis=1)
+        g = np.sqrt(np.maximum(K[j, 1] - d0[n, j], 0))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            grad = -v0[n, j] / g[:, None]
+        plane = e_hi[n, j, None] + grad @ corner.T
+        ok_plane = (d0[n, j] < K[j, 1]) & np.all(plane >= (c[j, 1] - W[n, j, 2])[:, None], axis=1)
+        k = np.argmax(np.where(d0 < K[:, 0], e_lo, -np.inf), axis=1)
+        ok_piece = np.all(d2[n, k] < K[k, 0][:, None], axis=1)
+        return {"top": top, "bot": bot,
+                "plane_c": np.where(ok_plane, e_hi[n, j], np.inf),
+                "plane": np.where(ok_plane[:, None], plane, np.inf),
+                "piece_c": np.where(ok_piece, e_lo[n, k], -np.inf),
+                "piece": np.where(ok_piece[:, None], lo_end[n, k], -np.inf)}
 
 
     def second(self, cx, cy, s, C, H, W, r):
@@ -132,7 +177,28 @@ class Legs:
             up = sig > 0
             hi = np.where(up, np.maximum(E0 + lin, flat + lz), E0 + lin + curv)
             lo = np.where(up, E0 - lin - curv, np.minimum(E0 - lin, flat - lz))
-            out.append((np.where(inside, lo, -np.inf), np.where(inside, hi, np.inf)))
+            lin_th = lin - (np.abs(ell[..., 0]) + np.abs(ell[..., 1])) * s
+            out.append((np.where(inside, lo, -np.inf), np.where(inside, hi, np.inf),
+                        {"E0": E0, "g": grad, "lin_th": lin_th, "flat": flat, "lz": lz,
+                         "curv": curv, "inside": inside, "v": v}))
         return out
 
 
+
+
+def _cell_corners(second, box, corner):
+    """Per item, at the x-y square's corners: an upper bound of the lower end that is convex
+    over the square (per leg the tangent plane at the centre or the square's constant bound,
+    whichever is lower on average), and a pointwise lower bound of the upper end."""
+    (_, _, lo_end), (_, _, hi_end) = second
+    box_lo, box_hi = box                                          # (n, 6), valid on the square
+    tang = np.maximum(lo_end["E0"][..., None] + lo_end["lin_th"][..., None]
+                      + lo_end["g"] @ corner.T, (lo_end["flat"] + lo_end["lz"])[..., None])
+    tang = np.where(lo_end["inside"][..., None], tang, np.inf)
+    use = tang.mean(axis=-1) < box_lo
+    bot = np.where(use[..., None], tang, box_lo[..., None]).max(axis=1) + EPS
+    pt = hi_end["E0"][..., None] + hi_end["g"] @ corner.T - hi_end["lin_th"][..., None] \
+        - hi_end["curv"][..., None]                               # curv = ½·M·(s√2 + r)²
+    pt = np.where(hi_end["inside"][..., None], pt, -np.inf)
+    top = np.maximum(pt, box_hi[..., None]).min(axis=1) - EPS
+    return {"bot": bot, "top": top}
