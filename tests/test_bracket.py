@@ -220,3 +220,20 @@ def test_cli_prints_and_writes_the_bracket(tmp_path):
     r = CliRunner().invoke(app, ["workspace", str(HOPKINS), "--bracket", "--bracket-target",
                                  "2", "--out", str(tmp_path)])
     assert r.exit_code == 2 and "--bracket-target" in r.output
+
+
+def test_positive_part_of_an_affine_function_integrates_exactly():
+    """The closed form behind the x-y second-order volumes, against a fine midpoint rule."""
+    from pkmlab.workspaces.bracket import _tri_positive
+
+    rng = np.random.default_rng(4)
+    f = rng.normal(size=(200, 3))
+    n = 300                      # centroid rule on the n² sub-triangles (up and down ones)
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    up, down = i + j <= n - 1, i + j <= n - 2
+    b1 = np.concatenate([(i[up] + 1 / 3) / n, (i[down] + 2 / 3) / n])
+    b2 = np.concatenate([(j[up] + 1 / 3) / n, (j[down] + 2 / 3) / n])
+    vals = f[:, 0, None] * (1 - b1 - b2) + f[:, 1, None] * b1 + f[:, 2, None] * b2
+    approx = np.maximum(vals, 0).mean(axis=1)
+    exact = _tri_positive(f[:, 0], f[:, 1], f[:, 2], 1.0)
+    np.testing.assert_allclose(exact, approx, atol=2e-4)
