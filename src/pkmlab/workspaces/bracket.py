@@ -282,6 +282,7 @@ class _Level:
         if kind == "reachable":
             e = np.empty(0)
             self.samples = (np.empty(0, np.int64), e, e, np.zeros(n + 1, np.int64))
+            self.samples_out = self.samples
         else:
             self.s_in = [np.full(n, -np.inf), np.full(n, np.inf), np.ones(n, bool)]
             self.s_out = [np.full(n, -np.inf), np.full(n, np.inf), np.ones(n, bool)]
@@ -314,17 +315,19 @@ class _Level:
             scol = np.concatenate([col, vc])
             self.corners = None
         if self.kind == "reachable":
+            # lower: union of the samples' x-y inner sets; upper: union of the samples' x-y
+            # outer sets and of the outer sets of the cells that still reach beyond them
             lo, hi, ok = ev["in0"]
             self.samples = _union(n, self.samples[:3], (scol[ok], lo[ok], hi[ok]))
-            pcol, plo, phi, starts = self.samples
+            lo, hi, ok = ev["out0"]
+            self.samples_out = _union(n, self.samples_out[:3], (scol[ok], lo[ok], hi[ok]))
+            pcol, plo, phi, starts = self.samples_out
             lo, hi, ok = ev["outr"]
             live = ok.copy()
             live[ok] = ~_inside(col[ok], lo[ok], hi[ok], starts, plo, phi)
-            inner = (pcol, plo, phi)
-            outer = _union(n, inner, (col[live], lo[live], hi[live]))[:3]
-            lo0, hi0, ok0 = (x[:len(col)] for x in ev["out0"])
-            sel = live & ok0
-            outer_x = _union(n, inner, (col[sel], lo0[sel], hi0[sel]))[:3]
+            outer_x = (pcol, plo, phi)
+            outer = _union(n, outer_x, (col[live], lo[live], hi[live]))[:3]
+            inner = self.samples[:3]
             self._keep(live)
             return inner, outer, inner, outer_x
         for st, key in ((self.s_in, "in0"), (self.s_out, "out0")):
