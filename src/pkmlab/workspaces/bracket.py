@@ -97,7 +97,10 @@ class VolumeBracket:
         seconds: wall time.
         notes: remarks (connectivity, nominal position).
         cells: the last level's column centres ``(n, 2)``; ``inner``/``outer``: its sets as
-            ``(column index, lo, hi)`` piece arrays, connectivity applied.
+            ``(column index, lo, hi)`` piece arrays, connectivity applied. These are the
+            per-cell (first order in x-y) sets: ``inner`` lies inside the workspace and the
+            workspace inside ``outer``; the x-y second-order volume bounds (constant,
+            dexterous) are tighter than their volumes and are not stored as sets.
     """
 
     lower: float
