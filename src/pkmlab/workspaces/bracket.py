@@ -293,7 +293,7 @@ class _Level:
             self.pl = {"top": np.full((n, 4), np.inf), "bot": np.full((n, 4), -np.inf),
                        "plane_c": np.full(n, np.inf), "plane": np.full((n, 4), np.inf),
                        "piece_c": np.full(n, -np.inf), "piece": np.full((n, 4), -np.inf)}
-        self.pl_lower = self.pl_upper = None
+        self.pl_lower = self.pl_upper = self.reach_pl = None
 
     def step(self):
         """Evaluate the items; update the samples; keep the live items. Returns the column
@@ -322,6 +322,8 @@ class _Level:
             # outer sets and of the outer sets of the cells that still reach beyond them
             lo, hi, ok = ev["in0"]
             self.samples = _union(n, self.samples[:3], (scol[ok], lo[ok], hi[ok]))
+            if "pl_sample" in ev:
+                self._reach_planar(ev["pl_sample"], lo, hi, ok, scol)
             lo, hi, ok = ev["out0"]
             self.samples_out = _union(n, self.samples_out[:3], (scol[ok], lo[ok], hi[ok]))
             pcol, plo, phi, starts = self.samples_out
@@ -391,6 +393,38 @@ class _Level:
                                  _tri_volume(np.where(np.isfinite(A), A, 0.0), a, np.minimum),
                                  np.inf)
         return grow
+
+    def _reach_planar(self, sample, lo, hi, ok, scol):
+        """x-y second order (reachable), for columns whose union of samples is one interval
+        ``[L, U]``: the sample ``a`` with the lowest inner end and ``b`` with the highest meet
+        it at every point of the square, so the column holds ``[min(bottom_a, L),
+        max(top_b, U)]`` everywhere; ``top_b`` is concave (at least its corner interpolation)
+        and ``bottom_a`` below a convex bound (at most its corner interpolation)."""
+        n = len(self.cx)
+        if self.reach_pl is None:
+            self.reach_pl = {"L": np.full(n, np.inf), "gbot": np.full((n, 4), np.inf),
+                             "U": np.full(n, -np.inf), "top": np.full((n, 4), -np.inf)}
+        st = self.reach_pl
+        for end, val, key, better in (("L", lo, "gbot", np.less), ("U", hi, "top", np.greater)):
+            v = np.where(ok, val, np.inf if end == "L" else -np.inf)
+            best = st[end].copy()
+            (np.minimum if end == "L" else np.maximum).at(best, scol, v)
+            win = ok & better(v, st[end][scol]) & (v == best[scol])
+            st[key][scol[win]] = sample[key][win]
+            st[end] = best
+        pcol, plo, phi, starts = self.samples
+        one = np.diff(starts) == 1
+        A = self.h * self.h
+        t, g = st["top"], np.where(np.isfinite(st["gbot"]), st["gbot"], 1e12)
+        int_t = A * np.maximum(2 * t[:, 0] + t[:, 1] + 2 * t[:, 2] + t[:, 3],
+                               t[:, 0] + 2 * t[:, 1] + t[:, 2] + 2 * t[:, 3]) / 6
+        int_g = A * np.minimum(2 * g[:, 0] + g[:, 1] + 2 * g[:, 2] + g[:, 3],
+                               g[:, 0] + 2 * g[:, 1] + g[:, 2] + 2 * g[:, 3]) / 6
+        with np.errstate(invalid="ignore"):
+            vol = np.maximum(int_t, st["U"] * A) - np.minimum(int_g, st["L"] * A)
+        self.pl_lower = np.where(one & np.isfinite(vol), np.maximum(vol, 0.0), 0.0)
+        self.pl_upper = np.full(n, np.inf)
+        self.pl_centre = (st["L"], st["U"])
 
     def _keep(self, live):
         self.col, self.C, self.H = self.col[live], self.C[live], self.H[live]
@@ -520,7 +554,7 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
             g_orient = (_length(inner_x) - _length(inner)
                         + _length(outer) - _length(outer_x)) * h * h
             g_all = (_length(outer) - _length(inner)) * h * h
-            if lv.pl_lower is not None:
+            if lv.pl_lower is not None and kind != "reachable":
                 g_orient = max(0.0, float(lv.pl_lower_x.sum() - lv.pl_lower.sum()))
                 g_all = gap
             if not np.any(lv.H > 0) or g_orient <= 0.5 * (g_all - g_orient):

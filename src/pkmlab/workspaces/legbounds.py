@@ -137,7 +137,15 @@ class Legs:
         ok_plane = (d0[n, j] < K[j, 1]) & np.all(plane >= (c[j, 1] - W[n, j, 2])[:, None], axis=1)
         k = np.argmax(np.where(d0 < K[:, 0], e_lo, -np.inf), axis=1)
         ok_piece = np.all(d2[n, k] < K[k, 0][:, None], axis=1)
-        return {"top": top, "bot": bot,
+        # a convex bound of the bottom over the square: per leg the tangent plane of its lower
+        # end at the centre (or the flat part beyond the sphere), the larger over the legs
+        g_lo = np.sqrt(np.maximum(K[:, 0] - d0, 0))
+        inside = d0 < K[:, 0] * (1 - 1e-12)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            gr = np.where(inside[..., None], -v0 / g_lo[..., None], 0.0)
+        tang = np.maximum(e_lo[..., None] + gr @ corner.T, (c[:, 0] - W[..., 2])[..., None])
+        gbot = np.where(inside.all(axis=1)[:, None], tang.max(axis=1), np.inf)
+        return {"top": top, "bot": bot, "gbot": gbot,
                 "plane_c": np.where(ok_plane, e_hi[n, j], np.inf),
                 "plane": np.where(ok_plane[:, None], plane, np.inf),
                 "piece_c": np.where(ok_piece, e_lo[n, k], -np.inf),
