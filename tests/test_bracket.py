@@ -224,7 +224,7 @@ def test_cli_prints_and_writes_the_bracket(tmp_path):
 
 def test_positive_part_of_an_affine_function_integrates_exactly():
     """The closed form behind the x-y second-order volumes, against a fine midpoint rule."""
-    from pkmlab.workspaces.bracket import _tri_positive
+    from pkmlab.workspaces.bracket_sets import tri_positive
 
     rng = np.random.default_rng(4)
     f = rng.normal(size=(200, 3))
@@ -235,5 +235,5 @@ def test_positive_part_of_an_affine_function_integrates_exactly():
     b2 = np.concatenate([(j[up] + 1 / 3) / n, (j[down] + 2 / 3) / n])
     vals = f[:, 0, None] * (1 - b1 - b2) + f[:, 1, None] * b1 + f[:, 2, None] * b2
     approx = np.maximum(vals, 0).mean(axis=1)
-    exact = _tri_positive(f[:, 0], f[:, 1], f[:, 2], 1.0)
+    exact = tri_positive(f[:, 0], f[:, 1], f[:, 2], 1.0)
     np.testing.assert_allclose(exact, approx, atol=2e-4)

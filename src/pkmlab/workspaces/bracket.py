@@ -62,13 +62,12 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
-from .._intervals import label_pieces
 from ..errors import ParameterError
 from ..limits import RESOLUTION_MM
 from ..poses import as_frames, matrix_to_euler
 from . import cells as oc
+from .bracket_sets import connected, inside, length, pieces_of, tri_volume, union
 from .constraints import Constraints
 from .legbounds import Legs
 from .orientations import OrientationSet
@@ -153,103 +152,7 @@ class VolumeBracket:
                 "history": list(self.history), "notes": list(self.notes)}
 
 
-# ---- interval helpers ---------------------------------------------------------------------------
-
-
-@njit(cache=True)
-def _merge(col, lo, hi, ncol, out_lo, out_hi, starts):
-    """Union per column of intervals sorted by (column, lo); returns the piece count.
-
-    ``starts (ncol + 1)`` receives each column's first piece."""
-    m = 0
-    n = col.shape[0]
-    t = 0
-    for c in range(ncol):
-        starts[c] = m
-        have = False
-        cl, ch = 0.0, 0.0
-        while t < n and col[t] == c:
-            if have and lo[t] <= ch:
-                if hi[t] > ch:
-                    ch = hi[t]
-            else:
-                if have:
-                    out_lo[m], out_hi[m] = cl, ch
-                    m += 1
-                cl, ch, have = lo[t], hi[t], True
-            t += 1
-        if have:
-            out_lo[m], out_hi[m] = cl, ch
-            m += 1
-    starts[ncol] = m
-    return m
-
-
-@njit(cache=True)
-def _inside(col, lo, hi, starts, plo, phi):
-    """``[lo, hi] ⊂`` one piece of column ``col``, for each query."""
-    out = np.zeros(col.shape[0], dtype=np.bool_)
-    for q in range(col.shape[0]):
-        c = col[q]
-        for k in range(starts[c], starts[c + 1]):
-            if plo[k] <= lo[q] and hi[q] <= phi[k]:
-                out[q] = True
-                break
-    return out
-
-
-def _union(ncol, *parts):
-    """Union per column of ``(col, lo, hi)`` interval arrays → pieces ``(col, lo, hi,
-    starts)``."""
-    col = np.concatenate([p[0] for p in parts]).astype(np.int64)
-    lo = np.concatenate([p[1] for p in parts]).astype(float)
-    hi = np.concatenate([p[2] for p in parts]).astype(float)
-    good = lo <= hi
-    col, lo, hi = col[good], lo[good], hi[good]
-    order = np.lexsort((lo, col))
-    col, lo, hi = col[order], lo[order], hi[order]
-    out_lo, out_hi = np.empty(len(lo)), np.empty(len(lo))
-    starts = np.empty(ncol + 1, dtype=np.int64)
-    m = _merge(col, lo, hi, ncol, out_lo, out_hi, starts)
-    pcol = np.repeat(np.arange(ncol), np.diff(starts))
-    return pcol, out_lo[:m], out_hi[:m], starts
-
-
-def _pieces_of(lo, hi, ok):
-    """Single intervals per column → pieces ``(col, lo, hi)``."""
-    good = ok & (lo <= hi)
-    idx = np.nonzero(good)[0]
-    return idx, lo[idx], hi[idx]
-
-
-def _length(pieces) -> float:
-    return float(np.sum(pieces[2] - pieces[1])) if len(pieces[0]) else 0.0
-
-
 # ---- one x-y level ------------------------------------------------------------------------------
-
-
-def _tri_positive(f1, f2, f3, area):
-    """``∫ max(f, 0)`` over a triangle of ``area`` for ``f`` affine with vertex values."""
-    v = np.sort(np.stack([f1, f2, f3]), axis=0)[::-1]
-    a, b, c = (np.maximum(np.minimum(x, 1e12), -1e12) for x in v)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        one = area * a**3 / (3 * (a - b) * (a - c))
-        two = area * (a + b + c) / 3 + area * (-c) ** 3 / (3 * (a - c) * (b - c))
-    out = np.where(c >= 0, area * (a + b + c) / 3,
-                   np.where(a <= 0, 0.0, np.where(b <= 0, one, two)))
-    return np.nan_to_num(out, nan=0.0, posinf=0.0)
-
-
-def _tri_volume(f, area, pick):
-    """``∫ f₊`` over the square from corner values ``f (n, 4)`` (corners counter-clockwise),
-    under its two triangulations, combined by ``pick`` (max for a lower bound of a concave
-    ``f``, min for an upper bound by an affine one)."""
-    d1 = _tri_positive(f[:, 0], f[:, 1], f[:, 2], area) + _tri_positive(f[:, 0], f[:, 2],
-                                                                         f[:, 3], area)
-    d2 = _tri_positive(f[:, 0], f[:, 1], f[:, 3], area) + _tri_positive(f[:, 1], f[:, 2],
-                                                                         f[:, 3], area)
-    return pick(d1, d2)
 
 
 def _collect(parts):
@@ -321,17 +224,17 @@ class _Level:
             # lower: union of the samples' x-y inner sets; upper: union of the samples' x-y
             # outer sets and of the outer sets of the cells that still reach beyond them
             lo, hi, ok = ev["in0"]
-            self.samples = _union(n, self.samples[:3], (scol[ok], lo[ok], hi[ok]))
+            self.samples = union(n, self.samples[:3], (scol[ok], lo[ok], hi[ok]))
             if "pl_sample" in ev:
                 self._reach_planar(ev["pl_sample"], lo, hi, ok, scol)
             lo, hi, ok = ev["out0"]
-            self.samples_out = _union(n, self.samples_out[:3], (scol[ok], lo[ok], hi[ok]))
+            self.samples_out = union(n, self.samples_out[:3], (scol[ok], lo[ok], hi[ok]))
             pcol, plo, phi, starts = self.samples_out
             lo, hi, ok = ev["outr"]
             live = ok.copy()
-            live[ok] = ~_inside(col[ok], lo[ok], hi[ok], starts, plo, phi)
+            live[ok] = ~inside(col[ok], lo[ok], hi[ok], starts, plo, phi)
             outer_x = (pcol, plo, phi)
-            outer = _union(n, outer_x, (col[live], lo[live], hi[live]))[:3]
+            outer = union(n, outer_x, (col[live], lo[live], hi[live]))[:3]
             inner = self.samples[:3]
             self._keep(live)
             return inner, outer, inner, outer_x
@@ -353,9 +256,9 @@ class _Level:
         np.maximum.at(ilo, lc, lo[live])
         np.minimum.at(ihi, lc, hi[live])
         np.logical_and.at(iok, lc, ok[live])
-        inner = _pieces_of(ilo, ihi, iok & sout_ok)
-        outer = _pieces_of(self.s_out[0], self.s_out[1], sout_ok)
-        inner_x = _pieces_of(self.s_in[0], self.s_in[1], sin_ok & sout_ok)
+        inner = pieces_of(ilo, ihi, iok & sout_ok)
+        outer = pieces_of(self.s_out[0], self.s_out[1], sout_ok)
+        inner_x = pieces_of(self.s_in[0], self.s_in[1], sin_ok & sout_ok)
         self._keep(live)
         return inner, outer, inner_x, outer
 
@@ -383,14 +286,14 @@ class _Level:
         fine = np.ones(n, bool)
         np.logical_and.at(fine, col[keep], ok[keep])
         a = 0.5 * self.h * self.h
-        low = _tri_volume(top - bot, a, np.maximum)
-        self.pl_lower_x = _tri_volume(pl["top"] - pl["bot"], a, np.maximum)
+        low = tri_volume(top - bot, a, np.maximum)
+        self.pl_lower_x = tri_volume(pl["top"] - pl["bot"], a, np.maximum)
         self.pl_lower = np.where(fine & sout_ok, low, 0.0)
         self.pl_centre = (0.5 * (bot[:, 0] + bot[:, 2]), 0.5 * (top[:, 0] + top[:, 2]),
                           0.5 * (bot[:, 1] + bot[:, 3]), 0.5 * (top[:, 1] + top[:, 3]))
         A = pl["plane"] - pl["piece"]
         self.pl_upper = np.where(np.isfinite(A).all(axis=1),
-                                 _tri_volume(np.where(np.isfinite(A), A, 0.0), a, np.minimum),
+                                 tri_volume(np.where(np.isfinite(A), A, 0.0), a, np.minimum),
                                  np.inf)
         return grow
 
@@ -434,34 +337,6 @@ class _Level:
         col = self.col[parent]
         order = np.argsort(col, kind="stable")
         self.col, self.C, self.H = col[order], C[order], H[order]
-
-
-# ---- connectivity -------------------------------------------------------------------------------
-
-
-def _connected(pieces, cx, cy, h, p_nom):
-    """Keep the pieces of the component through ``p_nom``: ``(pieces, found)``."""
-    pcol, plo, phi = pieces
-    if len(pcol) == 0:
-        return pieces, False
-    ix = np.round((cx - cx.min()) / h).astype(np.int64)
-    iy = np.round((cy - cy.min()) / h).astype(np.int64)
-    nx, ny = int(ix.max()) + 1, int(iy.max()) + 1
-    starts = np.searchsorted(pcol, np.arange(len(cx) + 1))
-    rank = np.arange(len(pcol)) - starts[pcol]
-    K = int(rank.max()) + 1
-    lo = np.full((nx, ny, K), np.inf)
-    hi = np.full((nx, ny, K), -np.inf)
-    lo[ix[pcol], iy[pcol], rank] = plo
-    hi[ix[pcol], iy[pcol], rank] = phi
-    labels, _ = label_pieces(lo, hi, 0.0)
-    lab = labels[ix[pcol], iy[pcol], rank]
-    near = ((np.abs(cx[pcol] - p_nom[0]) <= h / 2) & (np.abs(cy[pcol] - p_nom[1]) <= h / 2)
-            & (plo <= p_nom[2]) & (p_nom[2] <= phi))
-    if not near.any():
-        return pieces, False
-    keep = lab == lab[np.argmax(near)]
-    return (pcol[keep], plo[keep], phi[keep]), True
 
 
 # ---- driver -------------------------------------------------------------------------------------
@@ -551,9 +426,9 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
                 stop = "budget: evaluations"
             if stop is not None:
                 break
-            g_orient = (_length(inner_x) - _length(inner)
-                        + _length(outer) - _length(outer_x)) * h * h
-            g_all = (_length(outer) - _length(inner)) * h * h
+            g_orient = (length(inner_x) - length(inner)
+                        + length(outer) - length(outer_x)) * h * h
+            g_all = (length(outer) - length(inner)) * h * h
             if lv.pl_lower is not None and kind != "reachable":
                 g_orient = max(0.0, float(lv.pl_lower_x.sum() - lv.pl_lower.sum()))
                 g_all = gap
@@ -590,8 +465,8 @@ def _volumes(inner, outer, cons, lv, p_nom):
     e = np.empty(0)
     note = None
     if cons.connected:
-        out_k, found_out = _connected(outer, lv.cx, lv.cy, lv.h, p_nom)
-        in_k, found_in = _connected(inner, lv.cx, lv.cy, lv.h, p_nom)
+        out_k, found_out = connected(outer, lv.cx, lv.cy, lv.h, p_nom)
+        in_k, found_in = connected(inner, lv.cx, lv.cy, lv.h, p_nom)
         if not found_out:
             note = ("the nominal position is outside the workspace: the bracket covers every "
                     "component (lower 0)")
