@@ -85,7 +85,9 @@ class VolumeBracket:
     """A guaranteed volume bracket (mm³) and how it was reached.
 
     Attributes:
-        lower, upper: the bracket (mm³).
+        lower, upper: the bracket (mm³): the intersection of every step's bracket (each
+            holds; a new x-y level restarts the orientation refinement, so the last step is not
+            always the tightest).
         target: relative width asked for (``upper - lower <= target·upper``).
         stop_reason: ``"converged"``, ``"budget: seconds"``, ``"budget: evaluations"``,
             ``"budget: cells"`` or ``"empty"``.
@@ -407,16 +409,26 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
     cx, cy = X.ravel(), Y.ravel()
     level = 0
     stop = None
+    lower, upper, outside, seen_outside = 0.0, math.inf, False, False
     while stop is None:
         lv = _Level(legs, kind, cx, cy, h, C0, H0)
         while True:
             inner, outer, inner_x, outer_x = lv.step()
-            lower, upper, note, kept = _volumes(inner, outer, cons, lv, p_nom)
+            lo_s, up_s, note, kept = _volumes(inner, outer, cons, lv, p_nom)
             elapsed = time.perf_counter() - t0
             history.append({"level": level, "h_mm": h, "items": int(len(lv.col)),
-                            "lower_mm3": lower, "upper_mm3": upper, "seconds": elapsed,
+                            "lower_mm3": lo_s, "upper_mm3": up_s, "seconds": elapsed,
                             "evaluations": legs.count})
             log.debug("bracket %s", history[-1])
+            # every step's bracket holds, so their intersection does (after the nominal
+            # position is found outside, only the steps covering every component bound above)
+            outside = outside or note is not None
+            lower = max(lower, lo_s)
+            if note is not None and not seen_outside:
+                upper = up_s
+            elif note is not None or not outside:
+                upper = min(upper, up_s)
+            seen_outside = outside
             gap = upper - lower
             if upper <= 0 or gap <= target * upper:
                 stop = "converged" if upper > 0 else "empty"
@@ -447,8 +459,9 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
             level += 1
             if len(cx) * len(C0) > max_cells:
                 stop = "budget: cells"
-    if note:
-        notes.append(note)
+    if outside:
+        notes.append("the nominal position is outside the workspace: the bracket covers every "
+                     "component (lower 0)")
     return VolumeBracket(lower, upper, target, stop, history, lv.h, legs.count,
                          time.perf_counter() - t0, notes,
                          np.stack([lv.cx, lv.cy], axis=1), kept[0], kept[1])
