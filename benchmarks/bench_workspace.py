@@ -15,6 +15,8 @@ Prints, in one run:
   column method, against a plain NumPy brute force (the closed-form crank angle of every voxel
   × orientation × leg) timed on every ``RSS_STRIDE``-th x slab of the same grid and
   extrapolated by the slab count; the two agree voxel for voxel on those slabs.
+* the time to a guaranteed 1 % volume bracket per family and kind (:func:`bracket_report`;
+  ``bench_workspace.py bracket`` runs only that).
 
 Targets on 2 cores: ≤ 10 ms (6-PSU), ≤ 50 ms (6-UPS), ratio ≥ 1000×, < 1 GB at 1 mm;
 6-RSS ratio ≥ 500×.
@@ -282,5 +284,36 @@ def main() -> None:
     rss_main()
 
 
+def bracket_report(budget_s: float = 120.0) -> None:
+    """Time to a guaranteed 1 % volume bracket (pkmlab.workspaces.bracket), per family and
+    kind, against the plain sampled engine call of the same request (no guarantee) timed in
+    the same run. The machine's load is printed with it."""
+    import os
+
+    from pkmlab.workspaces.bracket import volume_bracket
+
+    print(f"volume bracket, time to 1 % (load {os.getloadavg()[0]:.1f} on "
+          f"{os.cpu_count()} cores):")
+    psu = load_mechanism(ROOT / "studies/mechanisms/hopkins-williams-6psu.yaml")
+    ups = load_mechanism(ROOT / "studies/mechanisms/gough-stewart-6ups.yaml")
+    box10 = OrientationSet.box(np.radians([10.0] * 3))
+    box5 = OrientationSet.box(np.radians([5.0] * 3))
+    for fam, mech, h in (("psu6", psu, 2.5), ("ups6", ups, 5.0)):
+        for kind, oset in (("constant", None), ("dexterous", box10), ("reachable", box5)):
+            t_engine, _ = timed(lambda m=mech, k=kind, o=oset, g=h: workspace(m, k, o, g), 3)
+            b = volume_bracket(mech, kind, oset, h, target=0.01, budget_s=budget_s)
+            hit = next((r["seconds"] for r in b.history
+                        if r["upper_mm3"] - r["lower_mm3"] <= 0.01 * r["upper_mm3"]), None)
+            what = (f"{hit:.1f} s ({hit / t_engine:.0f}x the sampled engine call, "
+                    f"{t_engine * 1e3:.0f} ms)" if hit is not None else
+                    f"not within {budget_s:g} s: width {100 * b.relative_width:.1f} %")
+            print(f"  {fam} {kind:9s} h {h:g} mm: [{b.lower / 1e3:.1f}, {b.upper / 1e3:.1f}] "
+                  f"cm3, {what}, final x-y cell {b.resolution:g} mm")
+
+
 if __name__ == "__main__":
-    main()
+    if sys.argv[1:] == ["bracket"]:
+        bracket_report()
+    else:
+        main()
+        bracket_report()

@@ -53,6 +53,14 @@ def _write_workspace(res, out_dir: Path, mesh_formats: list[str], slices: dict) 
     return [out_dir / f.name for f in files]
 
 
+def _print_bracket(res, vb) -> None:
+    if vb:
+        out.print(f"  guaranteed volume bracket [{vb['lower_cm3']:.3f}, {vb['upper_cm3']:.3f}] cm³ "
+                  f"over the continuous set (width {100 * vb['relative_width']:.2f} %, "
+                  f"{escape(vb['stop_reason'])}, {vb['seconds']:.1f} s, final x-y cell "
+                  f"{vb['final_resolution_mm']:g} mm)")
+
+
 def _workspace_summary(res, written, as_json: bool, extra: dict | None = None) -> None:
     m = res.metrics()
     m["files"] = [str(p) for p in written]
@@ -85,6 +93,7 @@ def _workspace_summary(res, written, as_json: bool, extra: dict | None = None) -
             out.print(f"  inscribed vertical cylinder r = {cyl['radius_mm']:.2f} mm at ({cx:.2f}, "
                       f"{cy:.2f}) mm, z {z0:.2f} … {z1:.2f} mm: {cyl['volume_cm3']:.3f} cm³, "
                       f"{cyl['verified_samples']} points verified")
+    _print_bracket(res, (extra or {}).get("volume_bracket"))
     if extra and extra.get("orientation_convergence"):
         out.print("  orientation sampling convergence (volume in cm³):")
         for row in extra["orientation_convergence"]:
@@ -125,6 +134,15 @@ def workspace(
     convergence: Annotated[bool, typer.Option(
         "--convergence", help="also report the volume for 3, 5, 7, 9, 13, 17 samples")]
     = False,
+    bracket: Annotated[bool, typer.Option(
+        "--bracket", help="also bracket the volume over the continuous orientation set and "
+                          "x-y plane: guaranteed [lower, upper] (psu6, ups6; stroke only)")]
+    = False,
+    bracket_budget: Annotated[float, typer.Option(
+        help="--bracket: wall-time budget in s (the bracket stops there if not yet at "
+             "--bracket-target)")] = 20.0,
+    bracket_target: Annotated[float, typer.Option(
+        help="--bracket: relative width to reach, (upper - lower) / upper")] = 0.01,
     mesh: Annotated[str, typer.Option(
         help="mesh formats, comma-separated: stl (mm), ply (mm), glb (m, y up)")] = "stl",
     slice_layout: Annotated[str, typer.Option(
@@ -159,6 +177,15 @@ def workspace(
             from ..workspaces.engine import orientation_convergence
 
             extra["orientation_convergence"] = orientation_convergence(mech, **req)
+        if bracket:
+            from ..workspaces.bracket import volume_bracket
+
+            if not (bracket_budget > 0):
+                raise ParameterError("--bracket-budget", "a time > 0 s", bracket_budget)
+            if not (0 < bracket_target < 1):
+                raise ParameterError("--bracket-target", "a fraction in (0, 1)", bracket_target)
+            extra["volume_bracket"] = volume_bracket(
+                mech, **req, target=bracket_target, budget_s=bracket_budget).describe()
     except ParameterError as exc:
         _fail(exc)
     written = _write_workspace(res, out_dir, formats, spec.slice_options())

@@ -21,7 +21,8 @@ method whose name starts with ``_``):
 * workspace hooks: ``position_bounds(R)``, and for families with exact column intervals
   ``column_method``, ``column_leg``, ``column_params()``, ``leg_offsets(R)`` and
   ``column_intervals(xs, ys, R, mode)`` (and ``column_radial`` when the leg intervals are
-  monotone functions of the distance from the leg's column axis);
+  monotone functions of the distance from the leg's column axis, with ``column_profile()``
+  giving their closed form for the guaranteed volume bracket, :mod:`pkmlab.workspaces.bracket`);
 * equality and hashing by geometry (two mechanisms with the same family, joints, stroke, tool
   offset and nominal pose are equal, whatever their names).
 
@@ -176,6 +177,14 @@ class Mechanism:
     def column_params(self) -> np.ndarray:  # pragma: no cover - optional
         """``(6, 3)`` per-leg parameters of ``column_leg``."""
         raise NotImplementedError
+
+    def column_profile(self) -> np.ndarray | None:
+        """``(6, 2, 3)`` or ``None``: for ``column_radial`` families whose leg ends have the
+        form ``c + σ·sqrt(max(K - d², 0)) - w_z`` (``d`` the horizontal distance from the leg's
+        column axis), ``(c, σ, K)`` of each leg's lower and upper end. The volume bracket then
+        bounds each end over a cell to second order (a sphere's curvature is known);
+        ``None``: first order only."""
+        return None
 
     def leg_offsets(self, R: np.ndarray) -> np.ndarray:
         """``(M, 6, 3)`` offsets ``w_i = R·u_i - b_i`` (u_i platform joints about the tool)."""

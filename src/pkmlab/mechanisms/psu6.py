@@ -182,6 +182,15 @@ class PSU6(Mechanism):
         lo, hi = self.stroke
         return np.stack([self.link_length**2, np.full(6, lo), np.full(6, hi)], axis=1)
 
+    def column_profile(self) -> np.ndarray:
+        """``(6, 2, 3)``: each leg's lower and upper column end as ``(c, σ, K)``, the end
+        being ``c + σ·sqrt(max(K - d², 0)) - w_z`` (see :class:`.base.Mechanism`)."""
+        lo, hi = self.stroke
+        K = self.link_length**2
+        one = np.ones(6)
+        return np.stack([np.stack([lo * one, one, K], axis=1),
+                         np.stack([hi * one, one, K], axis=1)], axis=1)
+
     def position_bounds(self, R):
         """Per orientation, the box each leg's reach and stroke allow: ``(M, 2, 3)``."""
         W = self.leg_offsets(R)

@@ -181,6 +181,16 @@ class UPS6(Mechanism):
         lo, hi = self.stroke
         return np.stack([self._sides, np.full(6, lo * lo), np.full(6, hi * hi)], axis=1)
 
+    def column_profile(self) -> np.ndarray:
+        """``(6, 2, 3)``: each leg's lower and upper column end as ``(c, σ, K)``, the end
+        being ``c + σ·sqrt(max(K - d², 0)) - w_z`` (see :class:`.base.Mechanism`)."""
+        lo2, hi2 = self.stroke[0] ** 2, self.stroke[1] ** 2
+        up = self._sides > 0
+        z, one = np.zeros(6), np.ones(6)
+        sig = np.where(up, one, -one)
+        return np.stack([np.stack([z, sig, np.where(up, lo2, hi2)], axis=1),
+                         np.stack([z, sig, np.where(up, hi2, lo2)], axis=1)], axis=1)
+
     def position_bounds(self, R):
         """Per orientation: each leg within qmax, on its working-mode side: ``(M, 2, 3)``."""
         W = self.leg_offsets(R)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..config import to_display
-from .metrics import METRICS
+from .metrics import KIND_VOLUMES, METRICS
 from .space import DesignSpace, Variable
 
 __all__ = ["Study", "Evaluation", "DexterityPlan", "TrajectoryPlan", "Objective",
@@ -50,6 +50,7 @@ class Evaluation:
     motions: object | None = None           # requirements.spec.MotionsPlan
     payload: object | None = None           # requirements.spec.PayloadPlan
     actuators: object | None = None         # requirements.spec.ActuatorsPlan
+    volume_bracket: object | None = None    # spec.VolumeBracketSpec
 
     @property
     def evaluators(self) -> tuple[str, ...]:
@@ -57,7 +58,7 @@ class Evaluation:
         names = ["geometry"]
         if self.workspace is not None:
             names.append("workspace")
-            names += [n for n in ("inscribed", "orientation_capability")
+            names += [n for n in ("inscribed", "orientation_capability", "volume_bracket")
                       if getattr(self, n)]
             if self.dexterity is not None:
                 names.append("dexterity")
@@ -73,9 +74,7 @@ class Evaluation:
         """Every metric this evaluation writes a value for."""
         kind = None if self.workspace is None else self.workspace.kind
         return tuple(m.name for m in METRICS.values() if m.evaluator in self.evaluators
-                     and not (m.name.endswith("_volume") and m.name.split("_")[0]
-                              in ("constant", "reachable", "dexterous")
-                              and m.name != f"{kind}_volume"))
+                     and KIND_VOLUMES.get(m.name, kind) == kind)
 
 
 @dataclass(frozen=True)
@@ -157,6 +156,8 @@ class Study:
             plan = getattr(ev, block)
             if plan is not None:
                 evaluate[block] = plan.source
+        if ev.volume_bracket is not None:
+            evaluate["volume_bracket"] = ev.volume_bracket.model_dump()
         return {
             "study": self.name, "description": self.description,
             "mechanism": {"inline": to_display(self.space.base_spec)},

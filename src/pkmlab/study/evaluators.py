@@ -37,6 +37,7 @@ from ..requirements.static import static_loads
 from ..requirements.task import task_margins
 from ..trajectory import check_trajectory, paper_motion
 from ..workspaces import OrientationSet, workspace
+from ..workspaces.bracket import volume_bracket
 from ..workspaces.engine import SINGULAR_NOTE
 from ..workspaces.optima import orientation_capability, supports_continuous
 from .metrics import metrics_of
@@ -106,6 +107,25 @@ def _workspace(mech, ctx: Context) -> dict:
         if note.startswith(SINGULAR_NOTE):
             ctx.notes["workspace_volume"] = note
     return out
+
+
+@_evaluator("volume_bracket")
+def _volume_bracket(mech, ctx: Context) -> dict:
+    plan = ctx.evaluation.volume_bracket
+    req = ctx.evaluation.request
+    b = volume_bracket(mech, req["kind"], req["orientations"], req["resolution"],
+                       req["constraints"], target=plan.target, budget_s=plan.budget)
+    lo, hi = b.lower / 1e3, b.upper / 1e3
+    k = req["kind"]
+    if b.stop_reason != "converged":
+        ctx.notes["workspace_volume_lower"] = (
+            f"bracket stopped: {b.stop_reason} at {100 * b.relative_width:.2f} % width "
+            f"(x-y cell {b.resolution:g} mm)")
+    for n in b.notes:
+        ctx.notes["workspace_volume_upper"] = n
+    return {"workspace_volume_lower": lo, "workspace_volume_upper": hi,
+            "workspace_volume_bracket_width": 100 * b.relative_width,
+            f"{k}_volume_lower": lo, f"{k}_volume_upper": hi}
 
 
 @_evaluator("inscribed")

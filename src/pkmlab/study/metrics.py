@@ -16,7 +16,12 @@ Kinds of number (``statistic``):
   (``<name>_bracket``, and ``<name>_upper`` where given) how far above it the truth can be;
 * ``sampled`` — a Monte-Carlo statistic over random poses (its name says so, or it carries a
   standard error);
-* ``flag`` — 1 or 0.
+* ``flag`` — 1 or 0;
+* ``guaranteed`` — a proven bound over the *continuous* orientation set and x-y plane
+  (:mod:`pkmlab.workspaces.bracket`): ``*_volume_lower`` never exceeds the true volume,
+  ``*_volume_upper`` never falls below it. An objective that maximises a volume should use
+  ``*_volume_lower`` (a design is credited only with volume it certainly has); a constraint
+  "volume ≤ limit" should use ``*_volume_upper``.
 """
 
 from __future__ import annotations
@@ -26,7 +31,7 @@ from dataclasses import dataclass
 __all__ = ["Metric", "METRICS", "KIND_VOLUMES", "metric", "metrics_of", "metrics_markdown",
            "STATISTICS"]
 
-STATISTICS = ("exact", "grid", "worst-case", "bound", "sampled", "flag")
+STATISTICS = ("exact", "grid", "worst-case", "bound", "sampled", "flag", "guaranteed")
 
 
 @dataclass(frozen=True)
@@ -73,6 +78,19 @@ _ALL = [
     Metric("dexterous_volume", "workspace", "cm³", "grid",
            "workspace_volume when the requested kind is 'dexterous'"),
     Metric("workspace_empty", "workspace", "", "flag", "1 if the requested workspace is empty"),
+    # guaranteed volume bracket (evaluate.volume_bracket)
+    Metric("workspace_volume_lower", "volume_bracket", "cm³", "guaranteed",
+           "proven lower bound of the requested workspace's volume over the continuous "
+           "orientation set and x-y plane (stroke and connectivity; psu6, ups6): the one to "
+           "maximise"),
+    Metric("workspace_volume_upper", "volume_bracket", "cm³", "guaranteed",
+           "proven upper bound of the same volume: the one to constrain from above"),
+    Metric("workspace_volume_bracket_width", "volume_bracket", "%", "guaranteed",
+           "100·(upper − lower)/upper when the bracket stopped (target or budget; which one "
+           "is in the notes)"),
+    *[Metric(f"{k}_volume_{b}", "volume_bracket", "cm³", "guaranteed",
+             f"workspace_volume_{b} when the requested kind is '{k}'")
+      for k in ("constant", "reachable", "dexterous") for b in ("lower", "upper")],
     Metric("z_span", "workspace", "mm", "grid", "height of the workspace (0 when empty)"),
     # inscribed shapes
     Metric("inscribed_box_volume", "inscribed", "cm³", "grid",
@@ -168,8 +186,8 @@ _ALL = [
 METRICS: dict[str, Metric] = {m.name: m for m in _ALL}
 
 #: ``<kind>_volume`` → the workspace kind it requires
-KIND_VOLUMES = {"constant_volume": "constant", "reachable_volume": "reachable",
-                "dexterous_volume": "dexterous"}
+KIND_VOLUMES = {f"{k}_volume{b}": k for k in ("constant", "reachable", "dexterous")
+                for b in ("", "_lower", "_upper")}
 
 
 def metric(name: str) -> Metric:

@@ -120,11 +120,21 @@ class TrajectorySpec(_Model):
     payload: float = Field(0.0, ge=0, allow_inf_nan=False, description="payload mass (kg)")
 
 
+class VolumeBracketSpec(_Model):
+    budget: float = Field(2.0, gt=0, le=3600, allow_inf_nan=False,
+                          description="wall-time budget per candidate (s)")
+    target: float = Field(0.01, gt=0, lt=1, allow_inf_nan=False,
+                          description="relative width (upper - lower) / upper to reach")
+
+
 class EvaluateSpec(_Model):
     workspace: dict[str, Any] | None = Field(None, description="a workspace request (see "
                                              "'pkmlab workspace'): kind, box or tilt, ...")
     inscribed: bool = False
     orientation_capability: bool = False
+    volume_bracket: VolumeBracketSpec | None = Field(
+        None, description="guaranteed volume bracket over the continuous orientation set "
+        "(workspace_volume_lower / _upper): budget (s), target (relative width)")
     dexterity: DexteritySpec | None = None
     trajectory: TrajectorySpec | None = None
     task: dict[str, Any] | None = Field(None, description="a required workspace: shape (box, "
@@ -292,15 +302,15 @@ def _metric(name: Any, where: str, evaluation: Evaluation) -> str:
         need = METRICS[name].evaluator
         raise ParameterError(where, f"a metric the evaluation computes (add evaluate.{need}"
                              + (" and evaluate.workspace" if need in ("inscribed",
-                                "orientation_capability", "dexterity", "payload") else "")
-                             + ")", name)
+                                "orientation_capability", "dexterity", "payload",
+                                "volume_bracket") else "") + ")", name)
     return name
 
 
 def _evaluation(ev: EvaluateSpec, base: Path) -> Evaluation:
     ws = None if ev.workspace is None else workspace_spec(ev.workspace,
                                                           prefix="evaluate.workspace.")
-    for block in ("inscribed", "orientation_capability", "dexterity"):
+    for block in ("inscribed", "orientation_capability", "dexterity", "volume_bracket"):
         if getattr(ev, block) not in (None, False) and ws is None:
             raise ParameterError(f"evaluate.{block}", "used with an evaluate.workspace block "
                                  "(it is computed over that workspace)", "no workspace")
@@ -312,7 +322,7 @@ def _evaluation(ev: EvaluateSpec, base: Path) -> Evaluation:
                                                         dx.gci_samples, dx.force_limit),
         trajectory=None if ev.trajectory is None else TrajectoryPlan(
             ev.trajectory.segment_time, ev.trajectory.payload),
-        **_requirements(ev, base))
+        volume_bracket=ev.volume_bracket, **_requirements(ev, base))
 
 
 def _requirements(ev: EvaluateSpec, base: Path) -> dict:

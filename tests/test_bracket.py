@@ -1,0 +1,239 @@
+"""The guaranteed volume bracket (pkmlab.workspaces.bracket): its cell bounds, its soundness
+against independent evaluations of the kinematics, its narrowing with the budget, and the study
+metrics and CLI fields that carry it."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+
+import numpy as np
+import pytest
+import yaml
+from conftest import MECH_DIR
+from typer.testing import CliRunner
+
+from pkmlab import load_mechanism
+from pkmlab.cli import app
+from pkmlab.errors import ParameterError
+from pkmlab.mechanisms._kernels import make_leg_eval
+from pkmlab.study import evaluators as ev_mod
+from pkmlab.study import load_study
+from pkmlab.workspaces import OrientationSet, workspace
+from pkmlab.workspaces import cells as oc
+from pkmlab.workspaces.bracket import volume_bracket
+from pkmlab.workspaces.constraints import Constraints
+
+HOPKINS = MECH_DIR / "hopkins-williams-6psu.yaml"
+UPS = MECH_DIR / "gough-stewart-6ups.yaml"
+D5 = math.radians(5.0)
+
+
+@pytest.fixture(scope="module")
+def psu():
+    return load_mechanism(HOPKINS)
+
+
+@pytest.fixture(scope="module")
+def ups():
+    return load_mechanism(UPS)
+
+
+# ---- the cell bounds ----------------------------------------------------------------------------
+
+SETS = [OrientationSet.box([0.3, 0.2, 0.4], centre=(0.1, -0.2, 0.3)),
+        OrientationSet.box([0.3, 0.0, 0.4], "single-axis", centre=(0.0, 0.0, 0.5)),
+        OrientationSet.tilt_torsion(0.6, 0.3, centre=(0.1, 0.2, -0.1))]
+
+
+@pytest.mark.parametrize("oset", SETS, ids=["box", "single-axis", "tilt-torsion"])
+def test_cells_cover_the_set_and_bound_the_rotation(oset):
+    rng = np.random.default_rng(3)
+    C, H = oc.initial_cells(oset, 2)
+    for _ in range(2):
+        C, H, _ = oc.split(C, H)
+    lo, hi = C - H, C + H
+    # every sample of the set lies in some cell
+    P = oset.with_samples(5).parameters()
+    if oset.kind == "tilt-torsion":
+        P[:, 0] = np.mod(P[:, 0], 2 * math.pi)
+    inside = np.all((P[:, None] >= lo[None] - 1e-12) & (P[:, None] <= hi[None] + 1e-12), axis=2)
+    assert inside.any(axis=1).all()
+    # the angle, chord and linearisation bounds hold at random points of random cells
+    u = np.array([80.0, 30.0, -47.0])
+    A, R0 = oc.axes(oset, C), oset.rotations_at(C)
+    for _ in range(30):
+        D = rng.uniform(-1, 1, C.shape) * H
+        R = oset.rotations_at(C + D)
+        move = np.linalg.norm(R @ u - R0 @ u, axis=1)
+        assert np.all(move <= oc.chord(oc.angle_bound(oset, C, H)) * np.linalg.norm(u) + 1e-9)
+        lin = R0 @ u + sum(np.cross(A[:, k], R0 @ u) * D[:, k:k + 1] for k in range(3))
+        err = np.linalg.norm(R @ u - lin, axis=1)
+        assert np.all(err <= oc.remainder(oset, C, H) * np.linalg.norm(u) + 1e-9)
+
+
+@pytest.mark.parametrize("name", ["psu", "ups", "ups-below"])
+def test_column_profile_is_the_column_kernel(name, request):
+    """The closed form the second-order bounds use is what the family's kernel computes
+    (for the 6-UPS also in the mirrored working mode, platform below the base joints)."""
+    mech = request.getfixturevalue(name.split("-")[0])
+    if name == "ups-below":
+        mech = dataclasses.replace(mech, nominal=np.array([0.0, 0.0, -600.0, 0.0, 0.0, 0.0]))
+        assert np.all(mech.column_profile()[:, :, 1] == -1)
+    rng = np.random.default_rng(0)
+    ev = make_leg_eval(type(mech).column_leg)
+    n = 3000
+    leg = rng.integers(0, 6, n)
+    x, y = rng.uniform(-800, 800, (2, n))
+    W = rng.uniform(-300, 300, (n, 3))
+    a, b, ok = ev(x, y, W, mech.column_params()[leg])
+    d = np.hypot(x + W[:, 0], y + W[:, 1])
+    prof = mech.column_profile()[leg]                      # (n, 2, 3)
+    ends = prof[:, :, 0] + prof[:, :, 1] * np.sqrt(np.maximum(prof[:, :, 2] - d[:, None] ** 2,
+                                                              0.0)) - W[:, 2:3]
+    assert ok.any() and (~ok).any()
+    np.testing.assert_allclose(a[ok], ends[ok, 0], atol=1e-9)
+    np.testing.assert_allclose(b[ok], ends[ok, 1], atol=1e-9)
+
+
+# ---- soundness against the kinematics -----------------------------------------------------------
+
+
+def _feasible(mech, p, R):
+    """(N,) True where every leg of pose (p, R) is within the stroke (the IK, not the
+    column kernels)."""
+    return mech.inverse((p, R)).valid
+
+
+def _points(b, which, n, rng):
+    col, lo, hi = b.inner if which == "inner" else b.outer
+    k = rng.integers(0, len(col), n)
+    c = b.cells[col[k]]
+    h = b.resolution
+    xy = c + rng.uniform(-h / 2, h / 2, (n, 2))
+    z = lo[k] + rng.uniform(0, 1, n) * (hi[k] - lo[k])
+    return np.column_stack([xy, z])
+
+
+def test_dexterous_bracket_is_sound_pointwise(psu):
+    """Inner points work at random orientations of the continuous set; points the outer set
+    excludes fail at some orientation (or at all, for the nominal one)."""
+    oset = OrientationSet.box([D5] * 3)
+    b = volume_bracket(psu, "dexterous", oset, 5.0, budget_s=60, max_evaluations=1.5e6)
+    assert 0 < b.lower < b.upper
+    rng = np.random.default_rng(1)
+    P = _points(b, "inner", 400, rng)
+    for _ in range(20):
+        R = oset.rotations_at(rng.uniform(-D5, D5, (len(P), 3)))
+        assert _feasible(psu, P, R).all()
+    # a dense cloud around the workspace: whatever works at every grid orientation is in outer
+    lo = np.array([-90, -90, 220.0])
+    Q = lo + rng.uniform(0, 1, (20000, 3)) * np.array([180, 180, 160.0])
+    ok = np.ones(len(Q), bool)
+    for R in oset.with_samples(3).rotations():
+        ok &= _feasible(psu, Q, np.broadcast_to(R, (len(Q), 3, 3)))
+    assert ok.sum() > 100
+    assert b.contains(Q[ok], "outer").all()
+
+
+def test_reachable_bracket_is_sound_pointwise(ups):
+    oset = OrientationSet.tilt_torsion(math.radians(8), math.radians(5))
+    b = volume_bracket(ups, "reachable", oset, 25.0, budget_s=60, max_evaluations=4e5)
+    assert 0 < b.lower <= b.upper
+    rng = np.random.default_rng(2)
+    # a point feasible at any orientation of the set lies in the outer set
+    nom = ups.nominal_pose[:3]
+    Q = nom + rng.uniform(-1, 1, (20000, 3)) * np.array([500, 500, 350.0])
+    R = oset.rotations_at(np.column_stack([rng.uniform(0, 2 * math.pi, len(Q)),
+                                           rng.uniform(0, oset.tilt, len(Q)),
+                                           rng.uniform(-oset.torsion, oset.torsion, len(Q))]))
+    ok = _feasible(ups, Q, R)
+    assert ok.sum() > 100
+    assert b.contains(Q[ok], "outer").all()
+
+
+def test_bracket_contains_a_dense_estimate_and_narrows_with_the_budget(psu):
+    """Constant kind: the engine at a 2x finer grid (exact in z, second order in x-y) lies
+    inside every bracket, and a larger budget gives a narrower one."""
+    dense = workspace(psu, "constant", resolution=2.5).volume
+    widths = []
+    for budget in (1e5, 8e6):
+        b = volume_bracket(psu, "constant", None, 5.0, target=0.002, budget_s=120,
+                           max_evaluations=budget)
+        assert b.lower <= dense <= b.upper
+        assert b.stop_reason in ("budget: evaluations", "converged")
+        widths.append(b.width)
+        assert [r["h_mm"] for r in b.history] == sorted((r["h_mm"] for r in b.history),
+                                                        reverse=True)
+    assert widths[1] < 0.2 * widths[0]
+
+
+def test_bracket_refuses_what_it_cannot_guarantee(psu):
+    luzi = load_mechanism(MECH_DIR / "luzi-3chain.yaml")
+    with pytest.raises(ParameterError, match="bracket"):
+        volume_bracket(luzi, "constant")
+    with pytest.raises(ParameterError, match="constraints"):
+        volume_bracket(psu, "constant", constraints=Constraints(kappa_max=50.0))
+
+
+# ---- study metrics and CLI ----------------------------------------------------------------------
+
+
+def test_study_writes_the_bracket_metrics(tmp_path):
+    data = {
+        "study": "bracket", "mechanism": {"file": str(HOPKINS)},
+        "design": {"link_length": {"low": "200 mm", "high": "260 mm"}},
+        "evaluate": {"workspace": {"kind": "dexterous", "box": ["5 deg"] * 3, "samples": 2,
+                                   "resolution": "10 mm"},
+                     "volume_bracket": {"budget": 1.0, "target": 0.2}},
+        "objectives": [{"maximize": "dexterous_volume_lower"}],
+        "constraints": [{"workspace_volume_upper": {"max": 1e6}}],
+        "optimizer": {"method": "sobol", "samples": 2}, "seed": 1,
+        "output": str(tmp_path / "out"), "top": 1,
+    }
+    p = tmp_path / "s.yaml"
+    p.write_text(yaml.safe_dump(data))
+    s = load_study(p)
+    metrics, _ = ev_mod.evaluate_mechanism(s.baseline(), s.evaluation, 0)
+    for n in ("workspace_volume_lower", "workspace_volume_upper", "dexterous_volume_lower",
+              "dexterous_volume_upper", "workspace_volume_bracket_width"):
+        assert n in metrics
+    assert "constant_volume_lower" not in metrics
+    assert metrics["dexterous_volume_lower"] <= metrics["dexterous_volume"] * 1.001 + 1e-9
+    assert metrics["dexterous_volume_lower"] <= metrics["dexterous_volume_upper"]
+    bad = dict(data, objectives=[{"maximize": "reachable_volume_lower"}])
+    p.write_text(yaml.safe_dump(bad))
+    with pytest.raises(ParameterError, match="dexterous_volume"):
+        load_study(p)
+
+
+def test_cli_prints_and_writes_the_bracket(tmp_path):
+    r = CliRunner().invoke(app, ["workspace", str(HOPKINS), "--resolution", "10",
+                                 "--bracket", "--bracket-budget", "1", "--bracket-target",
+                                 "0.2", "--out", str(tmp_path), "--json"])
+    assert r.exit_code == 0, r.output
+    vb = json.loads(r.output)["volume_bracket"]
+    assert vb["lower_mm3"] <= vb["estimate_mm3"] <= vb["upper_mm3"]
+    assert vb["stop_reason"] in ("converged", "budget: seconds")
+    assert vb["history"] and "lower_mm3" in vb["history"][0]
+    r = CliRunner().invoke(app, ["workspace", str(HOPKINS), "--bracket", "--bracket-target",
+                                 "2", "--out", str(tmp_path)])
+    assert r.exit_code == 2 and "--bracket-target" in r.output
+
+
+def test_positive_part_of_an_affine_function_integrates_exactly():
+    """The closed form behind the x-y second-order volumes, against a fine midpoint rule."""
+    from pkmlab.workspaces.bracket_sets import tri_positive
+
+    rng = np.random.default_rng(4)
+    f = rng.normal(size=(200, 3))
+    n = 300                      # centroid rule on the n² sub-triangles (up and down ones)
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    up, down = i + j <= n - 1, i + j <= n - 2
+    b1 = np.concatenate([(i[up] + 1 / 3) / n, (i[down] + 2 / 3) / n])
+    b2 = np.concatenate([(j[up] + 1 / 3) / n, (j[down] + 2 / 3) / n])
+    vals = f[:, 0, None] * (1 - b1 - b2) + f[:, 1, None] * b1 + f[:, 2, None] * b2
+    approx = np.maximum(vals, 0).mean(axis=1)
+    exact = tri_positive(f[:, 0], f[:, 1], f[:, 2], 1.0)
+    np.testing.assert_allclose(exact, approx, atol=2e-4)
