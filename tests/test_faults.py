@@ -163,10 +163,14 @@ def test_absurd_lengths_name_their_field(capsys, tmp_path, field, value):
     one_line(code, err, field, "at most 1e+06 mm")
 
 
-def test_collapsed_segment_time_is_refused(capsys, tmp_path):
-    code, _, err = cli(capsys, "trajectory", HW, "--paper-motion", "--segment-time", "1e-300",
+@pytest.mark.parametrize("option,value", [("--segment-time", "1e-300"), ("--payload", "-1"),
+                                          ("--max-speed", "-5"), ("--max-force", "nan")])
+def test_absurd_trajectory_options_name_the_option_typed(capsys, tmp_path, option, value):
+    """The error names the option the user typed, not the library's argument name."""
+    code, _, err = cli(capsys, "trajectory", HW, "--paper-motion", option, value,
                        "--out", tmp_path)
-    one_line(code, err, "segment_time", "got 1e-300")
+    line = one_line(code, err, f"error: {option}: must be", f"got {value}")
+    assert "_" not in line.split(":")[1], line
 
 
 def test_unreachable_dask_scheduler_is_one_line_quickly(capsys, tmp_path):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import sys
 from pathlib import Path
 from typing import Annotated
@@ -119,6 +120,25 @@ def _progress_bar(total: int):
     return prog, (lambda n: prog.advance(task, n))
 
 
+@contextlib.contextmanager
+def _estimate_lines():
+    """The study's time estimate (logged by the optimiser module before the first candidate)
+    as a ``pkmlab:`` line on stderr; the candidates' own log lines stay quiet."""
+    import logging
+
+    logger = logging.getLogger("pkmlab.study.optimisers")
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("pkmlab: %(message)s"))
+    old = logger.level
+    logger.addHandler(handler)
+    logger.setLevel(logging.INFO)
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(old)
+
+
 @app.command()
 def run(
     study_file: StudyArg,
@@ -158,7 +178,9 @@ def run(
     try:
         if prog is not None:
             prog.start()
-        store = run_study(study, runner, resume=resume, overwrite=overwrite, progress=advance)
+        with _estimate_lines():
+            store = run_study(study, runner, resume=resume, overwrite=overwrite,
+                              progress=advance)
     except ParameterError as exc:
         _fail(exc)
     finally:
