@@ -311,6 +311,97 @@ def test_read_only_output_folder_is_one_line(capsys, tmp_path, monkeypatch):
     del real_open
 
 
+# ---- 4b. real file-system faults on a small tmpfs ------------------------------------------------
+
+@pytest.fixture
+def tmpfs(tmp_path):
+    """A real 16 MiB tmpfs, mounted for the test and unmounted after it. Needs root and a
+    mount permitted by the container; otherwise skipped (the simulated tests above still run)."""
+    import shutil
+
+    mnt = tmp_path / "mnt"
+    mnt.mkdir()
+    if os.geteuid() != 0 or shutil.which("mount") is None:
+        pytest.skip("a real full disk / read-only mount needs root and mount(8)")
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=16m", "tmpfs", str(mnt)],
+                       capture_output=True, text=True)
+    if r.returncode:
+        pytest.skip(f"mount not permitted here: {r.stderr.strip()}")
+    try:
+        yield mnt
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
+
+
+def _fill(folder: Path) -> Path:
+    """Write zeros into ``folder`` until the file system is full (ENOSPC)."""
+    filler = folder / "filler"
+    with open(filler, "wb") as fh:
+        try:
+            while True:
+                fh.write(b"\0" * 65536)
+                fh.flush()
+        except OSError as exc:
+            assert exc.errno == errno.ENOSPC
+    return filler
+
+
+def test_real_full_disk_mid_run_keeps_what_was_committed(capsys, tmp_path, tmpfs, monkeypatch):
+    """The disk fills after the third commit: one line naming the full disk, exit 2; the
+    committed evaluations survive and, once space is freed, --resume finishes the study."""
+    from pkmlab.study import store as store_mod
+
+    out = tmpfs / "out"
+    p = small_study(tmp_path, optimizer={"method": "sobol", "samples": 16}, output=str(out))
+    real_put, state = store_mod.Store.put, {"n": 0}
+
+    def put_then_fill(self, *a, **k):
+        row = real_put(self, *a, **k)
+        state["n"] += 1
+        if state["n"] == 3:
+            state["filler"] = _fill(tmpfs)
+        return row
+
+    monkeypatch.setattr(store_mod.Store, "put", put_then_fill)
+    code, _, err = cli(capsys, "run", p)
+    one_line(code, err, "No space left on device", str(out))
+    monkeypatch.setattr(store_mod.Store, "put", real_put)
+    state["filler"].unlink()
+    con = sqlite3.connect(out / "evaluations.sqlite")
+    assert con.execute("SELECT COUNT(*) FROM evaluations").fetchone()[0] >= 3
+    con.close()
+    store = run_study(load_study(p), SerialRunner(), resume=True)
+    assert len(store.all()) == 17
+    store.close()
+
+
+def test_real_full_disk_before_the_store_exists(capsys, tmp_path, tmpfs):
+    _fill(tmpfs)
+    code, _, err = cli(capsys, "run", small_study(tmp_path, output=str(tmpfs / "out")))
+    one_line(code, err, "No space left on device")
+
+
+def test_real_read_only_mount(capsys, tmp_path, tmpfs, finished):
+    """A read-only file system: a new run and a resumed run refuse in one line; report reads
+    the store (opened read-only) and stops in one line at the first file it cannot write."""
+    import shutil
+
+    shutil.copytree(finished, tmpfs / "done")
+    r = subprocess.run(["mount", "-o", "remount,ro", str(tmpfs)], capture_output=True,
+                       text=True)
+    if r.returncode:
+        pytest.skip(f"remount read-only not permitted: {r.stderr.strip()}")
+    before = (tmpfs / "done" / "evaluations.sqlite").read_bytes()
+    code, _, err = cli(capsys, "run", small_study(tmp_path, output=str(tmpfs / "new")))
+    one_line(code, err, "Read-only file system", str(tmpfs / "new"))
+    code, _, err = cli(capsys, "run", small_study(tmp_path, output=str(tmpfs / "done")),
+                       "--resume")
+    one_line(code, err, "Read-only file system")
+    code, _, err = cli(capsys, "report", tmpfs / "done")
+    one_line(code, err, "Read-only file system", str(tmpfs / "done"))
+    assert (tmpfs / "done" / "evaluations.sqlite").read_bytes() == before
+
+
 # ---- 6. singular mechanisms --------------------------------------------------------------------
 
 def test_architecturally_singular_mechanism_is_reported(capsys, tmp_path):
@@ -376,20 +467,25 @@ def _wait_rows(db: Path, n: int, timeout=120) -> int:
     return 0
 
 
-@pytest.mark.parametrize("when", ["early", "mid"])
-def test_kill_9_leaves_no_workers_and_resume_finishes(tmp_path, when):
-    p, proc = _start(tmp_path, "--jobs", "2")
+@pytest.mark.parametrize("when", ["early", "mid", "late"])
+def test_kill_9_leaves_no_workers_and_resume_finishes(capsys, tmp_path, when):
+    """kill -9 before the store exists (early), while evaluating (mid) and once every
+    evaluation is stored, while the report is being written (late)."""
+    n = 16 if when == "late" else 64
+    p, proc = _start(tmp_path, *(() if when == "late" else ("--jobs", "2")), samples=n)
     db = tmp_path / "out" / "evaluations.sqlite"
     if when == "early":
         time.sleep(1.0)
     else:
-        assert _wait_rows(db, 3)
+        assert _wait_rows(db, 3 if when == "mid" else n + 1)
     workers = set()
     deadline = time.time() + 20
-    while time.time() < deadline and not workers and when == "mid":
+    while time.time() < deadline and not workers and when != "early":
         workers = {c for c in _children(proc.pid)}
+        if when == "late":
+            break
         time.sleep(0.1)
-    assert workers or when == "early", "no loky workers seen"
+    assert workers or when != "mid", "no loky workers seen"
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     deadline = time.time() + 15
@@ -399,8 +495,11 @@ def test_kill_9_leaves_no_workers_and_resume_finishes(tmp_path, when):
     store = run_study(load_study(p), SerialRunner(), resume=(tmp_path / "out" / "evaluations"
                                                              ".sqlite").exists(),
                       overwrite=not db.exists())
-    assert len(store.all()) == 65
+    assert len(store.all()) == n + 1
     store.close()
+    if when == "late":
+        code, _, err = cli(capsys, "report", tmp_path / "out")
+        assert code == 0, err
 
 
 def test_ctrl_c_stops_the_run_cleanly_and_resume_finishes(tmp_path):
