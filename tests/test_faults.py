@@ -173,6 +173,19 @@ def test_absurd_trajectory_options_name_the_option_typed(capsys, tmp_path, optio
     assert "_" not in line.split(":")[1], line
 
 
+@pytest.mark.parametrize("args,field", [
+    (["workspace", "--link-diameter", "-1"], "--link-diameter"),
+    (["workspace", "--joint-limit", "1,x"], "--joint-limit[1]"),
+    (["workspace", "--kappa-max", "0"], "--kappa-max"),
+    (["workspace", "--stroke", "5,1"], "--stroke"),
+    (["workspace", "--resolution", "1e-300"], "--resolution"),
+    (["compare", "--resolution", "-3"], "--resolution"),
+    (["dexterity", "--metric", "foo"], "--metric")])
+def test_bad_options_name_the_option_typed(capsys, tmp_path, args, field):
+    code, _, err = cli(capsys, args[0], HW, *args[1:], "--out", tmp_path)
+    one_line(code, err, f"error: {field}: must be")
+
+
 def test_unreachable_dask_scheduler_is_one_line_quickly(capsys, tmp_path):
     pytest.importorskip("distributed")
     p = small_study(tmp_path)

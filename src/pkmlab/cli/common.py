@@ -36,7 +36,14 @@ OPTION_NAMES = {"resolution": "--resolution", "segment_time": "--segment-time",
                 "payload_mass_kg": "--payload", "max_speed": "--max-speed",
                 "max_force": "--max-force", "well_conditioned": "--well-conditioned",
                 "force_required": "--force-required", "metric": "--metric",
-                "samples": "--samples", "kind": "--kind"}
+                "samples": "--samples", "kind": "--kind",
+                "--constraints.link_diameter": "--link-diameter",
+                "--constraints.kappa_max": "--kappa-max",
+                "--constraints.joint_limits": "--joint-limit",
+                "--constraints.joint_limits.base": "--joint-limit[0]",
+                "--constraints.joint_limits.platform": "--joint-limit[1]",
+                "--constraints.stroke": "--stroke", "--constraints.stroke[0]": "--stroke[0]",
+                "--constraints.stroke[1]": "--stroke[1]"}
 
 
 def _fail(exc: Exception, options: dict[str, str] | None = None) -> None:
