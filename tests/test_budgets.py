@@ -156,3 +156,31 @@ def test_the_first_chunk_of_ten_million_candidates_is_small(tmp_path, method):
     finally:
         tracemalloc.stop()
     assert seen == [256] and peak < 8 * 2**20, peak
+
+
+def test_the_suggested_resolution_fits_both_budgets(monkeypatch):
+    """A grid over the memory budget suggests a spacing whose estimate fits the time budget
+    too (Luzi at 0.05 mm: 705 GiB; with a 1 h budget, 0.5 mm would fit memory but not time)."""
+    import pkmlab.workspaces.engine as engine
+    from pkmlab.memory import memory_limit
+
+    monkeypatch.setenv(ENV, "1h")
+    mech = pkmlab.load_mechanism(LUZI)
+    with pytest.raises(ParameterError, match="fit in") as info:
+        engine.workspace(mech, "constant", resolution=0.05)
+    h = float(str(info.value).split("try >= ")[1].split(" mm")[0])
+
+    class Stop(Exception):
+        pass
+
+    seen = {}
+
+    def record_time(field, need, *a, **k):
+        seen["seconds"] = need
+        raise Stop
+
+    monkeypatch.setattr(engine, "require", lambda f, need, *a, **k: seen.update(bytes=need))
+    monkeypatch.setattr(engine, "require_time", record_time)
+    with pytest.raises(Stop):
+        engine.workspace(mech, "constant", resolution=h)
+    assert seen["bytes"] <= memory_limit() and seen["seconds"] <= 3600.0, (h, seen)
