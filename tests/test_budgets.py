@@ -59,19 +59,21 @@ def test_long_workspace_estimate_is_shown_before_the_work(capsys, tmp_path, monk
 
 def test_the_cost_model_is_the_right_order_of_magnitude():
     """The sampled-method model against a measured Luzi grid (~1 s): within a factor of 6
-    either way (it is meant to err long; the machine is shared, so the bound is loose)."""
+    either way. CPU time, not wall time: the model is for an unloaded core, and the test
+    machine is shared."""
     from pkmlab.workspaces import workspace
 
     mech = pkmlab.load_mechanism(LUZI)
     workspace(mech, "constant", resolution=30.0)                  # compile first
-    res = workspace(mech, "constant", resolution=12.0)
+    cpu = time.process_time()
+    workspace(mech, "constant", resolution=12.0)
+    cpu = time.process_time() - cpu
     bounds = mech.position_bounds(np.eye(3)[None])[0]
     cols = np.prod([len(np.arange(np.ceil(bounds[0, i] / 12), np.floor(bounds[1, i] / 12) + 1))
                     for i in range(2)])
     nz = int((bounds[1, 2] - bounds[0, 2]) / 12) + 1
     est = workspace_seconds(int(cols), 1, 6, nz, sampled=True)
-    ratio = est / res.timings["total_s"]
-    assert 1 / 6 < ratio < 6, (est, res.timings["total_s"])
+    assert 1 / 6 < est / cpu < 6, (est, cpu)
 
 
 def test_a_study_over_the_time_budget_stops_after_the_baseline(tmp_path, monkeypatch, caplog):
