@@ -562,3 +562,25 @@ def test_mesh_in_slabs_is_the_same_watertight_mesh(monkeypatch):
     slabs = res.mesh()
     assert slabs.is_watertight and len(slabs.faces) == len(whole.faces)
     assert slabs.volume == pytest.approx(whole.volume, rel=1e-9)
+
+
+def test_a_study_of_thin_workspaces_finishes_its_report_and_resumes(capsys, tmp_path):
+    """Designs whose dexterous workspace is a sliver (Hopkins at ±23°, 2.5 mm, where marching
+    cubes used to raise after every evaluation was stored): the run exports them without a
+    mesh, with the reason, writes its report and exits 0; --resume does the same."""
+    p = small_study(tmp_path, design={"link_length": {"low": "224 mm", "high": "226 mm"}},
+                    evaluate={"workspace": {"kind": "dexterous", "box": ["23 deg"] * 3,
+                                            "samples": 3, "resolution": "2.5 mm"}},
+                    objectives=[{"maximize": "dexterous_volume"}],
+                    optimizer={"method": "sobol", "samples": 2})
+    for extra in ([], ["--resume"]):
+        code, _, err = cli(capsys, "run", p, *extra)
+        assert code == 0, err
+        assert (tmp_path / "out" / "report.html").exists()
+    import json
+
+    designs = tmp_path / "out" / "designs"
+    assert json.loads((designs / "index.json").read_text())["problems"] == []
+    infos = [json.loads((d / "design.json").read_text()) for d in designs.iterdir()
+             if d.is_dir()]
+    assert infos and all("thinner than one grid cell" in i["mesh"] for i in infos), infos
