@@ -388,6 +388,28 @@ def test_real_full_disk_mid_run_keeps_what_was_committed(capsys, tmp_path, tmpfs
     store.close()
 
 
+def test_real_full_disk_while_writing_the_report(capsys, tmp_path, tmpfs, monkeypatch):
+    """Every evaluation is stored, then the disk fills as the report is written: one line
+    naming the folder; once space is freed, `report` rebuilds it from the complete store."""
+    from pkmlab.study import report as report_mod
+
+    out = tmpfs / "out"
+    real = report_mod.write_report
+    state = {}
+
+    def fill_then_write(*a, **k):
+        state["filler"] = _fill(tmpfs)
+        return real(*a, **k)
+
+    monkeypatch.setattr(report_mod, "write_report", fill_then_write)
+    code, _, err = cli(capsys, "run", small_study(tmp_path, output=str(out)))
+    one_line(code, err, "No space left on device", str(out))
+    monkeypatch.setattr(report_mod, "write_report", real)
+    state["filler"].unlink()
+    code, _, err = cli(capsys, "report", out)
+    assert code == 0, err
+
+
 def test_real_full_disk_before_the_store_exists(capsys, tmp_path, tmpfs):
     _fill(tmpfs)
     code, _, err = cli(capsys, "run", small_study(tmp_path, output=str(tmpfs / "out")))

@@ -121,6 +121,18 @@ def _progress_bar(total: int):
 
 
 @contextlib.contextmanager
+def _writing_into(folder: Path):
+    """A file-system error without a path (a full disk while writing) names the results
+    folder being written."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is None:
+            exc.filename = f"writing the results into {folder}"
+        raise
+
+
+@contextlib.contextmanager
 def _estimate_lines():
     """The study's time estimate (logged by the optimiser module before the first candidate)
     as a ``pkmlab:`` line on stderr; the candidates' own log lines stay quiet."""
@@ -191,7 +203,7 @@ def run(
     records = store.all()
     store.close()
     outp = Path(study.output)
-    with log_lines():
+    with log_lines(), _writing_into(outp):
         info = write_report(outp, study, records)
         _, problems = export_designs(outp, study, pareto_records(study, records))
         page = write_study_page(outp, study, records)
@@ -239,7 +251,7 @@ def report(results_dir: Annotated[Path, typer.Argument(help="a study's results f
     from ..webreport import write_study_page
 
     study, records = _open_results(results_dir)
-    with log_lines():
+    with log_lines(), _writing_into(results_dir):
         info = write_report(results_dir, study, records)
         info["report"] = str(write_study_page(results_dir, study, records))
     info["output"] = str(results_dir)
