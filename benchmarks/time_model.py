@@ -66,7 +66,9 @@ def main() -> None:
             f"{f} {kind} h={h:g} {res.method}: {cols} columns × {M} orientations"
             + (f" × {nz} z" if sampled else "") + f": measured {t:.3f} s, model {est:.3f} s "
             f"(model/measured {est / t:.2f}); {1e9 * max(t - OVERHEAD_S, 0) / n:.2f} ns per "
-            f"{'voxel' if sampled else 'column'}-leg ({t / base:.1f}× the baseline)\n")
+            f"{'voxel' if sampled else 'column'}-leg "
+            f"({max(t - OVERHEAD_S, 0) / n / (base / len(work)):.1f}× the baseline's "
+            "multiply-add)\n")
 
 
 if __name__ == "__main__":
