@@ -537,17 +537,25 @@ def test_kill_9_leaves_no_workers_and_resume_finishes(capsys, tmp_path, when):
         assert code == 0, err
 
 
-def test_ctrl_c_stops_the_run_cleanly_and_resume_finishes(tmp_path):
-    p, proc = _start(tmp_path)
+@pytest.mark.parametrize("when", ["mid", "late"])
+def test_ctrl_c_stops_the_run_cleanly_and_resume_finishes(capsys, tmp_path, when):
+    """Ctrl-C while evaluating (mid) and once every evaluation is stored, while the designs
+    are exported and the report written (late)."""
+    n = 64 if when == "mid" else 16
+    p, proc = _start(tmp_path, samples=n)
     db = tmp_path / "out" / "evaluations.sqlite"
-    assert _wait_rows(db, 2)
+    assert _wait_rows(db, 2 if when == "mid" else n + 1)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
+    assert error_lines(err) == ["interrupted"], err
     assert "Traceback" not in err and len(error_lines(err)) <= 1, err
     store = run_study(load_study(p), SerialRunner(), resume=True)
-    assert len(store.all()) == 65
+    assert len(store.all()) == n + 1
     store.close()
+    if when == "late":
+        code, _, err = cli(capsys, "report", tmp_path / "out")
+        assert code == 0, err
 
 
 def test_two_concurrent_runs_one_is_refused(tmp_path):
