@@ -163,10 +163,27 @@ def test_absurd_lengths_name_their_field(capsys, tmp_path, field, value):
     one_line(code, err, field, "at most 1e+06 mm")
 
 
-def test_collapsed_segment_time_is_refused(capsys, tmp_path):
-    code, _, err = cli(capsys, "trajectory", HW, "--paper-motion", "--segment-time", "1e-300",
+@pytest.mark.parametrize("option,value", [("--segment-time", "1e-300"), ("--payload", "-1"),
+                                          ("--max-speed", "-5"), ("--max-force", "nan")])
+def test_absurd_trajectory_options_name_the_option_typed(capsys, tmp_path, option, value):
+    """The error names the option the user typed, not the library's argument name."""
+    code, _, err = cli(capsys, "trajectory", HW, "--paper-motion", option, value,
                        "--out", tmp_path)
-    one_line(code, err, "segment_time", "got 1e-300")
+    line = one_line(code, err, f"error: {option}: must be", f"got {value}")
+    assert "_" not in line.split(":")[1], line
+
+
+@pytest.mark.parametrize("args,field", [
+    (["workspace", "--link-diameter", "-1"], "--link-diameter"),
+    (["workspace", "--joint-limit", "1,x"], "--joint-limit[1]"),
+    (["workspace", "--kappa-max", "0"], "--kappa-max"),
+    (["workspace", "--stroke", "5,1"], "--stroke"),
+    (["workspace", "--resolution", "1e-300"], "--resolution"),
+    (["compare", "--resolution", "-3"], "--resolution"),
+    (["dexterity", "--metric", "foo"], "--metric")])
+def test_bad_options_name_the_option_typed(capsys, tmp_path, args, field):
+    code, _, err = cli(capsys, args[0], HW, *args[1:], "--out", tmp_path)
+    one_line(code, err, f"error: {field}: must be")
 
 
 def test_unreachable_dask_scheduler_is_one_line_quickly(capsys, tmp_path):
@@ -307,6 +324,119 @@ def test_read_only_output_folder_is_one_line(capsys, tmp_path, monkeypatch):
     del real_open
 
 
+# ---- 4b. real file-system faults on a small tmpfs ------------------------------------------------
+
+@pytest.fixture
+def tmpfs(tmp_path):
+    """A real 16 MiB tmpfs, mounted for the test and unmounted after it. Needs root and a
+    mount permitted by the container; otherwise skipped (the simulated tests above still run)."""
+    import shutil
+
+    mnt = tmp_path / "mnt"
+    mnt.mkdir()
+    if os.geteuid() != 0 or shutil.which("mount") is None:
+        pytest.skip("a real full disk / read-only mount needs root and mount(8)")
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=16m", "tmpfs", str(mnt)],
+                       capture_output=True, text=True)
+    if r.returncode:
+        pytest.skip(f"mount not permitted here: {r.stderr.strip()}")
+    try:
+        yield mnt
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
+
+
+def _fill(folder: Path) -> Path:
+    """Write zeros into ``folder`` until the file system is full (ENOSPC)."""
+    filler = folder / "filler"
+    with open(filler, "wb") as fh:
+        try:
+            while True:
+                fh.write(b"\0" * 65536)
+                fh.flush()
+        except OSError as exc:
+            assert exc.errno == errno.ENOSPC
+    return filler
+
+
+def test_real_full_disk_mid_run_keeps_what_was_committed(capsys, tmp_path, tmpfs, monkeypatch):
+    """The disk fills after the third commit: one line naming the full disk, exit 2; the
+    committed evaluations survive and, once space is freed, --resume finishes the study."""
+    from pkmlab.study import store as store_mod
+
+    out = tmpfs / "out"
+    p = small_study(tmp_path, optimizer={"method": "sobol", "samples": 16}, output=str(out))
+    real_put, state = store_mod.Store.put, {"n": 0}
+
+    def put_then_fill(self, *a, **k):
+        row = real_put(self, *a, **k)
+        state["n"] += 1
+        if state["n"] == 3:
+            state["filler"] = _fill(tmpfs)
+        return row
+
+    monkeypatch.setattr(store_mod.Store, "put", put_then_fill)
+    code, _, err = cli(capsys, "run", p)
+    one_line(code, err, "No space left on device", str(out))
+    monkeypatch.setattr(store_mod.Store, "put", real_put)
+    state["filler"].unlink()
+    con = sqlite3.connect(out / "evaluations.sqlite")
+    assert con.execute("SELECT COUNT(*) FROM evaluations").fetchone()[0] >= 3
+    con.close()
+    store = run_study(load_study(p), SerialRunner(), resume=True)
+    assert len(store.all()) == 17
+    store.close()
+
+
+def test_real_full_disk_while_writing_the_report(capsys, tmp_path, tmpfs, monkeypatch):
+    """Every evaluation is stored, then the disk fills as the report is written: one line
+    naming the folder; once space is freed, `report` rebuilds it from the complete store."""
+    from pkmlab.study import report as report_mod
+
+    out = tmpfs / "out"
+    real = report_mod.write_report
+    state = {}
+
+    def fill_then_write(*a, **k):
+        state["filler"] = _fill(tmpfs)
+        return real(*a, **k)
+
+    monkeypatch.setattr(report_mod, "write_report", fill_then_write)
+    code, _, err = cli(capsys, "run", small_study(tmp_path, output=str(out)))
+    one_line(code, err, "No space left on device", str(out))
+    monkeypatch.setattr(report_mod, "write_report", real)
+    state["filler"].unlink()
+    code, _, err = cli(capsys, "report", out)
+    assert code == 0, err
+
+
+def test_real_full_disk_before_the_store_exists(capsys, tmp_path, tmpfs):
+    _fill(tmpfs)
+    code, _, err = cli(capsys, "run", small_study(tmp_path, output=str(tmpfs / "out")))
+    one_line(code, err, "No space left on device")
+
+
+def test_real_read_only_mount(capsys, tmp_path, tmpfs, finished):
+    """A read-only file system: a new run and a resumed run refuse in one line; report reads
+    the store (opened read-only) and stops in one line at the first file it cannot write."""
+    import shutil
+
+    shutil.copytree(finished, tmpfs / "done")
+    r = subprocess.run(["mount", "-o", "remount,ro", str(tmpfs)], capture_output=True,
+                       text=True)
+    if r.returncode:
+        pytest.skip(f"remount read-only not permitted: {r.stderr.strip()}")
+    before = (tmpfs / "done" / "evaluations.sqlite").read_bytes()
+    code, _, err = cli(capsys, "run", small_study(tmp_path, output=str(tmpfs / "new")))
+    one_line(code, err, "Read-only file system", str(tmpfs / "new"))
+    code, _, err = cli(capsys, "run", small_study(tmp_path, output=str(tmpfs / "done")),
+                       "--resume")
+    one_line(code, err, "Read-only file system")
+    code, _, err = cli(capsys, "report", tmpfs / "done")
+    one_line(code, err, "Read-only file system", str(tmpfs / "done"))
+    assert (tmpfs / "done" / "evaluations.sqlite").read_bytes() == before
+
+
 # ---- 6. singular mechanisms --------------------------------------------------------------------
 
 def test_architecturally_singular_mechanism_is_reported(capsys, tmp_path):
@@ -372,20 +502,25 @@ def _wait_rows(db: Path, n: int, timeout=120) -> int:
     return 0
 
 
-@pytest.mark.parametrize("when", ["early", "mid"])
-def test_kill_9_leaves_no_workers_and_resume_finishes(tmp_path, when):
-    p, proc = _start(tmp_path, "--jobs", "2")
+@pytest.mark.parametrize("when", ["early", "mid", "late"])
+def test_kill_9_leaves_no_workers_and_resume_finishes(capsys, tmp_path, when):
+    """kill -9 before the store exists (early), while evaluating (mid) and once every
+    evaluation is stored, while the report is being written (late)."""
+    n = 16 if when == "late" else 64
+    p, proc = _start(tmp_path, *(() if when == "late" else ("--jobs", "2")), samples=n)
     db = tmp_path / "out" / "evaluations.sqlite"
     if when == "early":
         time.sleep(1.0)
     else:
-        assert _wait_rows(db, 3)
+        assert _wait_rows(db, 3 if when == "mid" else n + 1)
     workers = set()
     deadline = time.time() + 20
-    while time.time() < deadline and not workers and when == "mid":
+    while time.time() < deadline and not workers and when != "early":
         workers = {c for c in _children(proc.pid)}
+        if when == "late":
+            break
         time.sleep(0.1)
-    assert workers or when == "early", "no loky workers seen"
+    assert workers or when != "mid", "no loky workers seen"
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     deadline = time.time() + 15
@@ -395,21 +530,32 @@ def test_kill_9_leaves_no_workers_and_resume_finishes(tmp_path, when):
     store = run_study(load_study(p), SerialRunner(), resume=(tmp_path / "out" / "evaluations"
                                                              ".sqlite").exists(),
                       overwrite=not db.exists())
-    assert len(store.all()) == 65
+    assert len(store.all()) == n + 1
     store.close()
+    if when == "late":
+        code, _, err = cli(capsys, "report", tmp_path / "out")
+        assert code == 0, err
 
 
-def test_ctrl_c_stops_the_run_cleanly_and_resume_finishes(tmp_path):
-    p, proc = _start(tmp_path)
+@pytest.mark.parametrize("when", ["mid", "late"])
+def test_ctrl_c_stops_the_run_cleanly_and_resume_finishes(capsys, tmp_path, when):
+    """Ctrl-C while evaluating (mid) and once every evaluation is stored, while the designs
+    are exported and the report written (late)."""
+    n = 64 if when == "mid" else 16
+    p, proc = _start(tmp_path, samples=n)
     db = tmp_path / "out" / "evaluations.sqlite"
-    assert _wait_rows(db, 2)
+    assert _wait_rows(db, 2 if when == "mid" else n + 1)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
+    assert error_lines(err) == ["interrupted"], err
     assert "Traceback" not in err and len(error_lines(err)) <= 1, err
     store = run_study(load_study(p), SerialRunner(), resume=True)
-    assert len(store.all()) == 65
+    assert len(store.all()) == n + 1
     store.close()
+    if when == "late":
+        code, _, err = cli(capsys, "report", tmp_path / "out")
+        assert code == 0, err
 
 
 def test_two_concurrent_runs_one_is_refused(tmp_path):
@@ -446,3 +592,25 @@ def test_mesh_in_slabs_is_the_same_watertight_mesh(monkeypatch):
     slabs = res.mesh()
     assert slabs.is_watertight and len(slabs.faces) == len(whole.faces)
     assert slabs.volume == pytest.approx(whole.volume, rel=1e-9)
+
+
+def test_a_study_of_thin_workspaces_finishes_its_report_and_resumes(capsys, tmp_path):
+    """Designs whose dexterous workspace is a sliver (Hopkins at ±23°, 2.5 mm, where marching
+    cubes used to raise after every evaluation was stored): the run exports them without a
+    mesh, with the reason, writes its report and exits 0; --resume does the same."""
+    p = small_study(tmp_path, design={"link_length": {"low": "224 mm", "high": "226 mm"}},
+                    evaluate={"workspace": {"kind": "dexterous", "box": ["23 deg"] * 3,
+                                            "samples": 3, "resolution": "2.5 mm"}},
+                    objectives=[{"maximize": "dexterous_volume"}],
+                    optimizer={"method": "sobol", "samples": 2})
+    for extra in ([], ["--resume"]):
+        code, _, err = cli(capsys, "run", p, *extra)
+        assert code == 0, err
+        assert (tmp_path / "out" / "report.html").exists()
+    import json
+
+    designs = tmp_path / "out" / "designs"
+    assert json.loads((designs / "index.json").read_text())["problems"] == []
+    infos = [json.loads((d / "design.json").read_text()) for d in designs.iterdir()
+             if d.is_dir()]
+    assert infos and all("thinner than one grid cell" in i["mesh"] for i in infos), infos

@@ -6,7 +6,7 @@ check against the same numbers, so that whatever validates also runs.
 
 from __future__ import annotations
 
-__all__ = ["SEGMENT_TIME_S", "MEMORY_FRACTION", "LENGTH_MAX_MM", "RESOLUTION_MM",
+__all__ = ["SEGMENT_TIME_S", "MEMORY_FRACTION", "TIME_LIMIT_S", "LENGTH_MAX_MM", "RESOLUTION_MM",
            "EULER_HALF_RANGE_DEG", "SAMPLES_PER_ANGLE", "GCI_SAMPLES", "CAPABILITY_MAX_DEG"]
 
 #: Duration of one leg of the paper's lobe motion (s): 1 ms .. 1 day.
@@ -14,6 +14,9 @@ SEGMENT_TIME_S = (1e-3, 86400.0)
 #: Default memory budget of one command: this share of the machine's physical memory
 #: (``PKMLAB_MEMORY_LIMIT`` overrides it; see :mod:`pkmlab.memory`).
 MEMORY_FRACTION = 0.5
+#: Default time budget of one command (s): one day (``PKMLAB_TIME_LIMIT`` overrides it; see
+#: :mod:`pkmlab.time_budget`).
+TIME_LIMIT_S = 86400.0
 #: Largest length magnitude anywhere (mm): 1 km; beyond it products of lengths overflow and
 #: printed values become unreadable.
 LENGTH_MAX_MM = 1.0e6

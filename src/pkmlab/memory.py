@@ -14,7 +14,8 @@ import re
 from .errors import ParameterError, Shown
 from .limits import MEMORY_FRACTION
 
-__all__ = ["memory_limit", "format_bytes", "require", "coarser_resolution"]
+__all__ = ["memory_limit", "format_bytes", "require", "coarser_resolution",
+           "readable_step"]
 
 _UNITS = {"": 1, "b": 1, "k": 1e3, "kb": 1e3, "m": 1e6, "mb": 1e6, "g": 1e9, "gb": 1e9,
           "t": 1e12, "tb": 1e12, "kib": 2**10, "mib": 2**20, "gib": 2**30, "tib": 2**40}
@@ -64,9 +65,14 @@ def coarser_resolution(h: float, need: float, exponent: float = 2.0) -> float:
     """A grid spacing that would fit: memory scales as ``h**-exponent``; rounded up to a
     readable value."""
     limit = memory_limit()
-    target = h * (max(need, 1.0) / max(limit, 1)) ** (1.0 / exponent) * 1.05
+    return readable_step(h * (max(need, 1.0) / max(limit, 1)) ** (1.0 / exponent) * 1.05, h)
+
+
+def readable_step(target: float, fallback: float) -> float:
+    """The smallest of 1, 1.25, 1.5, 2, 2.5, 3, 4, 5, 6, 8 × 10^k at least ``target``
+    (``fallback`` when ``target`` is not a positive finite number)."""
     if not math.isfinite(target) or target <= 0:
-        return h
+        return fallback
     mag = 10 ** math.floor(math.log10(target))
     for step in (1, 1.25, 1.5, 2, 2.5, 3, 4, 5, 6, 8, 10):
         if step * mag >= target:

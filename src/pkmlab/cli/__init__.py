@@ -58,6 +58,8 @@ def main() -> None:
 
     try:
         code = app(standalone_mode=False)      # click returns an Exit's code in this mode
+        if code == 130:                        # typer turns Ctrl-C into Exit(130), silently
+            sys.stderr.write("interrupted\n")
         raise SystemExit(code if isinstance(code, int) else 0)
     except typer.Exit as exc:
         raise SystemExit(exc.exit_code) from None

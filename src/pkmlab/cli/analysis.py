@@ -340,8 +340,11 @@ def compare(
         _fail(ParameterError("--box", "an angle in [0, 90] deg", box))
     if not 1 <= samples <= 101:
         _fail(ParameterError("--samples", "an integer in [1, 101]", samples))
-    with log_lines():
-        table_rows = compare_designs(designs, box_deg=box, resolution=h, samples=samples)
+    try:
+        with log_lines():
+            table_rows = compare_designs(designs, box_deg=box, resolution=h, samples=samples)
+    except ParameterError as exc:
+        _fail(exc)
     out_dir.mkdir(parents=True, exist_ok=True)
     md = comparison_markdown(table_rows, box)
     (out_dir / "compare.md").write_text(md)

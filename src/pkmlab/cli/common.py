@@ -31,8 +31,28 @@ JSON_HELP = ("Print JSON. Pose keys: x, y, z (mm), theta_x, theta_y, theta_z (de
              "deg (rotary families such as rss6; the key actuator_unit says which).")
 
 
-def _fail(exc: Exception) -> None:
+#: library argument names → the command-line options a user typed for them
+OPTION_NAMES = {"resolution": "--resolution", "segment_time": "--segment-time",
+                "payload_mass_kg": "--payload", "max_speed": "--max-speed",
+                "max_force": "--max-force", "well_conditioned": "--well-conditioned",
+                "force_required": "--force-required", "metric": "--metric",
+                "samples": "--samples", "kind": "--kind",
+                "--constraints.link_diameter": "--link-diameter",
+                "--constraints.kappa_max": "--kappa-max",
+                "--constraints.joint_limits": "--joint-limit",
+                "--constraints.joint_limits.base": "--joint-limit[0]",
+                "--constraints.joint_limits.platform": "--joint-limit[1]",
+                "--constraints.stroke": "--stroke", "--constraints.stroke[0]": "--stroke[0]",
+                "--constraints.stroke[1]": "--stroke[1]"}
+
+
+def _fail(exc: Exception, options: dict[str, str] | None = None) -> None:
+    """Print one error line and exit 2. ``options`` (default :data:`OPTION_NAMES`) renames a
+    library argument in the message to the command-line option the user typed."""
     if isinstance(exc, ParameterError):
+        field = (OPTION_NAMES if options is None else options).get(exc.field)
+        if field is not None:
+            exc = ParameterError(field, exc.allowed, exc.got, exc.where)
         locate_error(exc)  # the line and column of its field, when it came from a file
     err.print(Text("error", style="bold red") + Text(": " + " ".join(str(exc).split())))
     raise typer.Exit(code=2)

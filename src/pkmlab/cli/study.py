@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import sys
 from pathlib import Path
 from typing import Annotated
@@ -119,6 +120,37 @@ def _progress_bar(total: int):
     return prog, (lambda n: prog.advance(task, n))
 
 
+@contextlib.contextmanager
+def _writing_into(folder: Path):
+    """A file-system error without a path (a full disk while writing) names the results
+    folder being written."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is None:
+            exc.filename = f"writing the results into {folder}"
+        raise
+
+
+@contextlib.contextmanager
+def _estimate_lines():
+    """The study's time estimate (logged by the optimiser module before the first candidate)
+    as a ``pkmlab:`` line on stderr; the candidates' own log lines stay quiet."""
+    import logging
+
+    logger = logging.getLogger("pkmlab.study.optimisers")
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("pkmlab: %(message)s"))
+    old = logger.level
+    logger.addHandler(handler)
+    logger.setLevel(logging.INFO)
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(old)
+
+
 @app.command()
 def run(
     study_file: StudyArg,
@@ -158,7 +190,9 @@ def run(
     try:
         if prog is not None:
             prog.start()
-        store = run_study(study, runner, resume=resume, overwrite=overwrite, progress=advance)
+        with _estimate_lines():
+            store = run_study(study, runner, resume=resume, overwrite=overwrite,
+                              progress=advance)
     except ParameterError as exc:
         _fail(exc)
     finally:
@@ -169,7 +203,7 @@ def run(
     records = store.all()
     store.close()
     outp = Path(study.output)
-    with log_lines():
+    with log_lines(), _writing_into(outp):
         info = write_report(outp, study, records)
         _, problems = export_designs(outp, study, pareto_records(study, records))
         page = write_study_page(outp, study, records)
@@ -217,7 +251,7 @@ def report(results_dir: Annotated[Path, typer.Argument(help="a study's results f
     from ..webreport import write_study_page
 
     study, records = _open_results(results_dir)
-    with log_lines():
+    with log_lines(), _writing_into(results_dir):
         info = write_report(results_dir, study, records)
         info["report"] = str(write_study_page(results_dir, study, records))
     info["output"] = str(results_dir)

@@ -11,6 +11,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from ..errors import ParameterError
+from ..progress import log_lines
 from .common import (
     AllComponentsOpt,
     BoxOpt,
@@ -168,7 +169,8 @@ def workspace(
         _fail(ParameterError("--mesh", "comma-separated formats from ['stl', 'ply', 'glb']",
                              mesh))
     try:
-        res = compute(mech, **req, refine=refine)
+        with log_lines():                 # the time estimate of a long grid, before it runs
+            res = compute(mech, **req, refine=refine)
         extra = {}
         if inscribed and not res.empty:
             extra = {"inscribed_box": res.inscribed_box().as_dict(),

@@ -21,7 +21,7 @@ from .. import __version__
 from ..errors import CandidateError, ParameterError
 from .definition import PENALTY, Study
 from .evaluators import evaluate_design
-from .optimisers import OPTIMISERS
+from .optimisers import OPTIMISERS, check_time
 from .store import Store, candidate_key
 
 log = logging.getLogger(__name__)
@@ -175,6 +175,19 @@ def run_study(study: Study, runner, *, resume: bool = False, overwrite: bool = F
     return store
 
 
+def _check_time(study: Study, runner, store: Store, seconds: float) -> None:
+    """The remaining evaluations at the baseline's measured time must fit the time budget;
+    over it, the baseline is timed once more (its first evaluation may have compiled the
+    kernels) before the study is refused."""
+    done = store.conn.execute("SELECT COUNT(*) FROM evaluations").fetchone()[0]
+    workers = getattr(runner, "jobs", 1)
+    try:
+        check_time(study.space, study.optimizer, done, seconds, workers)
+    except ParameterError:
+        again = evaluate_design(study.space, None, study.evaluation, study.seed)["seconds"]
+        check_time(study.space, study.optimizer, done, min(seconds, again), workers)
+
+
 def _run(study: Study, runner, store: Store, fp: str, progress) -> None:
     store.set_meta("fingerprint", fp)
     store.set_meta("resolved", study.resolved())
@@ -208,5 +221,6 @@ def _run(study: Study, runner, store: Store, fp: str, progress) -> None:
     if store.get(base_key) is None:
         for k, result in runner.map(evaluate_design, [(base_key, (space, None, ev, seed))]):
             commit(k, "baseline", BASELINE, result)
+    _check_time(study, runner, store, store.get(base_key)["seconds"])
     OPTIMISERS[study.optimizer.method](space, evaluate_batch, study.optimizer, seed)
     store.set_meta("complete", True)

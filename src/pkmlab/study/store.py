@@ -7,6 +7,7 @@ so a resumed run finds them instead of evaluating again.
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
 import math
@@ -75,7 +76,12 @@ def diagnose(path: str | Path) -> str:
             "with the sqlite3 tool's .recover, or rerun the study with --overwrite)")
 
 
-def _damaged(path: Path, exc: Exception) -> ParameterError:
+def _damaged(path: Path, exc: Exception) -> Exception:
+    """The error for a store that cannot be read or written: a full disk is a file-system
+    error (nothing is damaged), anything else a damaged store with what can be recovered."""
+    if getattr(exc, "sqlite_errorcode", None) == sqlite3.SQLITE_FULL:
+        return OSError(errno.ENOSPC, "No space left on device (the results store cannot "
+                       "grow; free space, then run --resume)", str(path))
     return ParameterError("store", "a readable pkmlab results store",
                           f"{path}: {exc}; {diagnose(path)}")
 
@@ -140,6 +146,15 @@ class Store:
 
     def put(self, key: str, role: str, params: dict, result: dict) -> dict:
         """Commit one finished evaluation (ignored if the key is already stored)."""
+        try:
+            self._put(key, role, params, result)
+        except sqlite3.OperationalError as exc:
+            if getattr(exc, "sqlite_errorcode", None) == sqlite3.SQLITE_FULL:
+                raise _damaged(self.path, exc) from None
+            raise
+        return self.get(key)
+
+    def _put(self, key: str, role: str, params: dict, result: dict) -> None:
         self.conn.execute(
             "INSERT OR IGNORE INTO evaluations (key, role, params, metrics, status, reason, "
             "seconds, notes) VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
@@ -149,7 +164,6 @@ class Store:
         self._commits += 1
         if self._commits % CHECKPOINT_EVERY == 0:
             self.checkpoint()
-        return self.get(key)
 
     def checkpoint(self) -> None:
         """Fold the write-ahead log into ``evaluations.sqlite``."""

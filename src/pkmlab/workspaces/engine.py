@@ -30,6 +30,7 @@ from ..limits import RESOLUTION_MM
 from ..mechanisms import NO_STROKE
 from ..memory import coarser_resolution, require
 from ..poses import as_frames, matrix_to_euler
+from ..time_budget import coarser_for_time, require_time, workspace_seconds
 from .constraints import Constraints, check
 from .field import interval_field
 from .orientations import OrientationSet
@@ -125,9 +126,12 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
     nz = int(max(0.0, zb[1] - zb[0]) / h) + 1
     need = estimate_bytes(len(xs), len(ys), nz, len(R), use_columns,
                           use_columns and bool(cons.extra) and not mech.column_invariant)
-    require("resolution", need, "a grid whose arrays",
-            f"{h:g} mm ({len(xs)} × {len(ys)} columns, {len(R)} orientations)",
-            f"try >= {coarser_resolution(h, need):g} mm")
+    secs = workspace_seconds(len(xs) * len(ys), len(R), len(mech.actuator_names), nz,
+                             not use_columns)
+    got = f"{h:g} mm ({len(xs)} × {len(ys)} columns, {len(R)} orientations)"
+    fit = max(coarser_resolution(h, need), coarser_for_time(h, secs, 2 if use_columns else 3))
+    require("resolution", need, "a grid whose arrays", got, f"try >= {fit:g} mm")
+    require_time("resolution", secs, "a grid whose evaluation is", got, f"try >= {fit:g} mm")
     timings = {}
     sampled = False
     lo = hi = field = None
