@@ -50,6 +50,8 @@ from numba.extending import register_jitable
 from ..errors import ParameterError
 from ..poses import euler_to_matrix
 from . import _kernels
+from ._crank import crank_column_leg, crank_params
+from ._set_columns import set_column_intervals
 from .base import NO_STROKE, Mechanism, as_points, as_stroke, as_vector3
 from .rss6 import _atan2
 
@@ -272,6 +274,13 @@ class SixLeg(Mechanism):
         for a in (self.kinds, self.axes, self.zero_directions, self.crank_length,
                   self.link_length, self.branch):
             a.setflags(write=False)
+        if crank.all():
+            # Set-valued (crank) column legs: no single-interval ``column_leg`` and no radial
+            # intervals for this instance, so refine, the exact task check and the continuous
+            # optima (which need them) decline it as they decline rss6. The instance values
+            # shadow the class ones that the linear-leg instances keep.
+            set_(self, "column_leg", None)
+            set_(self, "column_radial", False)
 
     # ---- conversions -------------------------------------------------------------------------
     @classmethod
@@ -428,8 +437,11 @@ class SixLeg(Mechanism):
     # ---- workspace hooks -------------------------------------------------------------------
     @property
     def column_method(self) -> str | None:     # type: ignore[override]
-        """``"quadratic"`` (any prismatic leg) or ``"linear"`` when every leg is prismatic or a
-        vertical-rail slider, else ``None`` (sampled)."""
+        """``"crank"`` when every leg is a crank (exact set-valued legs, :mod:`._crank`);
+        ``"quadratic"`` (any prismatic leg) or ``"linear"`` when every leg is prismatic or a
+        vertical-rail slider; else ``None`` (sampled)."""
+        if np.all(self._mask("crank")):
+            return "crank"
         prism = self._mask("prismatic")
         if not np.all(prism | self._vertical):
             return None
@@ -440,9 +452,14 @@ class SixLeg(Mechanism):
         return bool(np.all(self._vertical))
 
     def column_params(self) -> np.ndarray:
-        """``(6, 3)`` parameters of :func:`_sixleg_column_leg` (only with a column method)."""
-        if self.column_method is None:
+        """``(6, 3)`` parameters of :func:`_sixleg_column_leg`, or for cranks the ``(6, 15)``
+        rows of :func:`._crank.crank_column_leg` (only with a column method)."""
+        method = self.column_method
+        if method is None:
             raise ValueError(f"{self.name or 'this sixleg'} has legs without column intervals")
+        if method == "crank":
+            return crank_params(self.zero_directions, self.v_directions, self.crank_length,
+                                self.link_length, self.branch, self.stroke)
         lo, hi = self.stroke
         sigma = self.axes[:, 2]                              # ±1 on vertical rails
         c = -sigma * self.branch
@@ -450,6 +467,14 @@ class SixLeg(Mechanism):
         p1 = np.where(self._vertical, np.where(sigma > 0, lo, -hi), self._sides * lo * lo)
         p2 = np.where(self._vertical, np.where(sigma > 0, hi, -lo), self._sides * hi * hi)
         return np.stack([k, p1, p2], axis=1)
+
+    def column_intervals(self, xs, ys, R, mode, allowed=None, K=8):
+        """As :meth:`.base.Mechanism.column_intervals`; crank legs use the exact set-valued
+        legs of :mod:`._crank` (as ``rss6``), whose dexterous sets have up to ``K`` pieces."""
+        if self.column_method == "crank":
+            return set_column_intervals(crank_column_leg, self.leg_offsets(R),
+                                        self.column_params(), xs, ys, R, mode, allowed, K)
+        return super().column_intervals(xs, ys, R, mode, allowed, K)
 
     def position_bounds(self, R):
         """Per orientation, the intersection over legs of each leg's reach box ``(M, 2, 3)``:
