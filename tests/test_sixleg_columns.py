@@ -1,10 +1,12 @@
-"""Exact crank columns of the generic ``sixleg`` family (all legs cranks).
+"""Exact crank and inclined-rail slider columns of the generic ``sixleg`` family.
 
 A ``sixleg`` declared from an ``rss6`` (same joints, axes, lengths, branches, window) must give
 the same column sets and workspace volumes as ``rss6``'s own exact crank method (validated
 against dense IK in ``test_rss6_columns.py``), and its interval ends must be where the
 *sixleg's own* IK kernel flips validity. Paths that need single-interval radial legs (refine,
-exact task check, continuous optima) must decline it as they decline ``rss6``.
+exact task check, continuous optima) must decline it as they decline ``rss6``. Inclined and
+horizontal rails (``mechanisms/_slider.py``) are checked against the IK on a dense z grid and
+at 1e-9 mm either side of every interval end.
 """
 
 from __future__ import annotations
@@ -115,3 +117,102 @@ def test_crank_sixleg_declines_radial_only_paths():
         ROOT / "studies/mechanisms/gough-stewart-6ups.yaml"))
     assert ups.column_radial and ups.column_leg is not None and supports_continuous(ups)
     assert task_contained(ups, task).method == "exact"
+
+
+# ---- inclined and horizontal rails ------------------------------------------------------------
+
+def _hexaglide(incl_deg):
+    from test_sixleg import _hexaglide as make
+
+    return make(incl_deg)
+
+
+def _mixed():
+    from test_sixleg import _mixed_linear
+
+    return _mixed_linear()
+
+
+SLIDERS = {"hexaglide": lambda: pkmlab.load_mechanism(ROOT / "studies/mechanisms/"
+                                                       "hexaglide-6pus.yaml"),
+           "inclined20": lambda: _hexaglide(20.0), "mixed": _mixed}
+DZ = 0.1                                           # dense z step (mm)
+
+
+@pytest.mark.parametrize("name", sorted(SLIDERS))
+@pytest.mark.parametrize("mode", ["all", "any"])
+def test_slider_columns_match_dense_ik(name, mode):
+    m = SLIDERS[name]()
+    assert m.column_method == "slider" and m.column_leg is None and not m.column_radial
+    oset = OrientationSet.box(np.radians([4.0] * 3), "simultaneous", samples=2)
+    _, Rn = pkmlab.poses.as_frames(m.nominal_pose)
+    R = oset.centred(tuple(pkmlab.poses.matrix_to_euler(Rn[0]))).rotations()
+    c = m.nominal_pose[:2]
+    xs, ys = c[0] + np.linspace(-60.0, 60.0, 3), c[1] + np.linspace(-50.0, 50.0, 3)
+    lo, hi, over = m.column_intervals(xs, ys, R, mode)
+    assert over == 0
+    agg = np.all if mode == "all" else np.any
+    zb = m.position_bounds(R)[:, :, 2]
+    zs = np.arange(zb[:, 0].min() - 1.0, zb[:, 1].max() + 1.0, DZ)
+    pieces = 0
+    for ix, iy in np.ndindex(len(xs), len(ys)):
+        p = np.tile([xs[ix], ys[iy], 0.0], (len(zs), 1))
+        p[:, 2] = zs
+        v = m.inverse((np.repeat(p, len(R), axis=0), np.tile(R, (len(zs), 1, 1)))).valid
+        v = v.reshape(len(zs), len(R))
+        inside = agg(v, axis=1)
+        sel = lo[ix, iy] <= hi[ix, iy]
+        a, b = lo[ix, iy][sel], hi[ix, iy][sel]
+        assert np.all(a > zs[0]) and np.all(b < zs[-1])
+        assert abs(inside.sum() * DZ - np.sum(b - a)) <= 2 * len(a) * DZ + 1e-9
+        for a_k, b_k in zip(a, b, strict=True):
+            probe = np.array([a_k + EPS, b_k - EPS, a_k - EPS, b_k + EPS])
+            q = np.repeat(np.array([[xs[ix], ys[iy], 0.0]]), 4, axis=0)
+            q[:, 2] = probe
+            vv = np.stack([m.inverse((q, np.broadcast_to(Rm, (4, 3, 3)).copy())).valid
+                           for Rm in R], axis=1)
+            assert agg(vv[:2], axis=1).all() and not agg(vv[2:], axis=1).any()
+        pieces += len(a)
+    assert pieces >= 5
+
+
+@pytest.mark.parametrize("name", ["hexaglide", "inclined20"])
+def test_slider_workspace_against_sampled(name):
+    m = SLIDERS[name]()
+    r = workspace(m, "constant", resolution=8.0)
+    s = workspace(m, "constant", resolution=8.0, method="sampled")
+    assert r.method == "columns (slider), exact in z" and s.method == "sampled voxels"
+    assert abs(r.volume - s.volume) <= r.volume_error + s.volume_error
+    box = OrientationSet.box(np.radians([5.0] * 3), "simultaneous", samples=2)
+    d = workspace(m, "dexterous", box, 8.0, refine=True)
+    assert d.volume > 0 and any("refine: not available" in n for n in d.notes)
+
+
+def test_slider_interval_against_a_numpy_scan():
+    """:func:`._slider.slider_interval` on 300 random legs (inclination ±80°, any heading,
+    branch, side, window) against the leg conditions evaluated in NumPy (h² ≥ 0, side, stroke)
+    on a 0.05 mm z grid: the sets differ only at grid points next to the interval ends."""
+    from pkmlab.mechanisms._slider import slider_interval
+
+    rng = np.random.default_rng(7)
+    zs = np.arange(-1200.0, 1200.0, 0.05)
+    nonempty = 0
+    for _ in range(300):
+        incl, head = np.radians(rng.uniform(-80, 80)), rng.uniform(0, 2 * np.pi)
+        e = np.array([np.cos(incl) * np.cos(head), np.cos(incl) * np.sin(head), np.sin(incl)])
+        ln, b, s = rng.uniform(100, 500), rng.choice([-1.0, 1.0]), rng.choice([-1.0, 1.0])
+        X, Y, wz = rng.uniform(-400, 400), rng.uniform(-400, 400), rng.uniform(-100, 100)
+        qmin, qmax = np.sort(rng.uniform(-400, 400, 2))
+        lo, hi, ok = slider_interval(X, Y, wz, *e, ln, b, s, qmin, qmax)
+        d = np.stack([np.full_like(zs, X), np.full_like(zs, Y), zs + wz], axis=1)
+        t = d @ e
+        perp = d - t[:, None] * e
+        h2 = ln * ln - np.sum(perp**2, axis=1)
+        h = np.sqrt(np.clip(h2, 0.0, None))
+        q = t + b * h
+        v = (h2 >= 0) & (s * (perp[:, 2] - b * h * e[2]) >= 0) & (q >= qmin) & (q <= qmax)
+        exact = (zs >= lo) & (zs <= hi) if ok else np.zeros(len(zs), dtype=bool)
+        near = (np.abs(zs - lo) < 0.05) | (np.abs(zs - hi) < 0.05) if ok else exact
+        assert np.array_equal(exact[~near], v[~near])
+        nonempty += bool(ok and lo <= hi)
+    assert nonempty > 60
