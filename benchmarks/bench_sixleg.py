@@ -3,7 +3,8 @@
 IK throughput (10⁶ poses near nominal) and the Jacobian (10⁵ poses) of the generic declaration
 (``SixLeg.from_mechanism``) of each shipped 6-PSU / 6-UPS / 6-RSS against the family's own
 kernels (ratio = generic time / fast time), and the Hexaglide-like 6-PUS (sliders on horizontal
-rails): IK throughput and its sampled constant workspace at 5 mm.
+rails): IK throughput and its constant workspace at 5 mm, exact columns against sampled voxels
+(ratio = sampled time / column time).
 
 Run: .venv/bin/python benchmarks/bench_sixleg.py   (state the load: ``uptime``)
 """
@@ -50,8 +51,11 @@ def main() -> None:
     X = _poses(hx, N_IK, rng)
     t, _ = timed(lambda: hx.inverse(X), 5)
     tw, r = timed(lambda: workspace(hx, "constant", resolution=5.0), 3)
+    ts, s = timed(lambda: workspace(hx, "constant", resolution=5.0, method="sampled"), 3)
     print(f"hexaglide-6pus: IK {N_IK / t / 1e6:6.1f} M poses/s; constant workspace at 5 mm "
-          f"{tw:.2f} s ({r.method}, {r.volume / 1e3:.1f} ± {r.volume_error / 1e3:.1f} cm3)")
+          f"{tw:.3f} s ({r.method}, {r.volume / 1e3:.1f} ± {r.volume_error / 1e3:.1f} cm3), "
+          f"sampled {ts:.3f} s ({s.volume / 1e3:.1f} ± {s.volume_error / 1e3:.1f} cm3; "
+          f"ratio {ts / tw:.1f})")
 
 
 if __name__ == "__main__":

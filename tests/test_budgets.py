@@ -38,7 +38,7 @@ def test_workspace_over_the_time_budget_is_refused_with_a_coarser_resolution_tha
     """Luzi's sampled grid at 5 mm is estimated at ~20 s: refused under a 2 s budget, before
     any work (nothing written), naming --resolution and a spacing that then runs."""
     monkeypatch.setenv(ENV, "2s")
-    pkmlab.load_mechanism(LUZI).nominal_pose    # kernels compiled (a fresh cache) before timing
+    assert pkmlab.load_mechanism(LUZI).nominal_pose is not None   # compiled before timing
     t = time.perf_counter()
     code, _, err = cli(capsys, "workspace", LUZI, "--resolution", "5", "--out", tmp_path / "a")
     line = one_line(code, err, "--resolution", "PKMLAB_TIME_LIMIT", "within 2 s", "try >=",

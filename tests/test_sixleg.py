@@ -152,7 +152,7 @@ def test_rail_generator_conventions():
     assert np.allclose(np.abs(e[:, 0]), 1) and np.allclose(e[:, 0], np.sign(B[:, 0] + 1e-30))
     assert np.allclose(rail_axes(B, math.pi / 2, "inward"), [0, 0, 1])
     m = _hexaglide(20.0)
-    assert np.all(m.branch == 1.0) and m.column_method is None      # struts reach inward
+    assert np.all(m.branch == 1.0) and m.column_method == "slider"  # struts reach inward
     assert np.allclose(m.axes[:, 2], math.sin(math.radians(20)))
     assert _hexaglide(60.0, "outward").branch[0] == -1.0
 
@@ -180,7 +180,7 @@ def _brute_volume(m, h):
 @pytest.mark.parametrize("incl", [0.0, 20.0])
 def test_sampled_workspace_against_a_dense_brute_force(incl):
     m = _hexaglide(incl)
-    r = workspace(m, "constant", resolution=12.0)
+    r = workspace(m, "constant", resolution=12.0, method="sampled")
     assert r.method == "sampled voxels" and r.components == 1
     assert r.volume == pytest.approx(_brute_volume(m, 12.0), rel=1e-12)
     fine = _brute_volume(m, 6.0)                  # the stated error covers a finer count
@@ -290,7 +290,7 @@ def test_contract_on_mixed_and_tilted_legs(make):
     from pkmlab import testing
 
     m = make()
-    assert m.column_method is None
+    assert m.column_method == ("crank" if make is _tilted_cranks else "slider")
     testing.check_round_trip(m, 300)
     # step 1e-5: near-singular poses of the tilted cranks (|J| ~ 40) make the O(h⁴) term of
     # the default 1e-4 step reach 2e-5; at 1e-5 the difference is 2e-9

@@ -167,11 +167,13 @@ class Mechanism:
     #: distance ``d = |(x, y) + w_xy|`` from the leg's column axis, with both ends and the
     #: ``ok`` flag monotone in ``d`` (``ok`` true on ``d <= d_max``): a task region's
     #: containment is then decided exactly from the nearest and farthest ``d`` of its
-    #: footprint (:mod:`pkmlab.requirements.task`). ``psu6`` and ``ups6`` declare it.
+    #: footprint (:mod:`pkmlab.requirements.task`). ``psu6`` and ``ups6`` declare it. Read it
+    #: from the instance: ``sixleg`` turns it (and ``column_leg``) off per instance for cranks.
     column_radial: ClassVar[bool] = False
 
     #: numba per-leg column interval ``leg(x, y, wx, wy, wz, p0, p1, p2) -> (a, b, ok)`` (see
-    #: :func:`._kernels.make_column_kernel`); families with it set ``column_method``.
+    #: :func:`._kernels.make_column_kernel`); families with it set ``column_method``. Test
+    #: ``mech.column_leg is None`` (per instance); kernels are built from ``type(mech)``'s.
     column_leg: ClassVar[Any] = None
 
     def column_params(self) -> np.ndarray:  # pragma: no cover - optional

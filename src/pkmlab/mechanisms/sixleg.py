@@ -28,12 +28,23 @@ All legs share one actuator window (``stroke``), in mm when every leg is prismat
 (the two may be mixed: a slider's ``B`` is where its actuator reads 0) and in rad when every leg
 is a crank. Mixing cranks with linear legs is refused (the protocol has one actuator unit).
 
-Workspace: legs whose feasible z set along an (x, y) column has closed form get the exact
-column method: prismatic legs (the ``ups6`` interval on the working-mode side) and sliders on
-vertical rails (``e = ±ẑ``, the ``psu6`` linear interval). A mechanism with any other leg (an
-inclined or horizontal rail, a crank) has ``column_method = None`` and is sampled by the
-engine. Crank column intervals can be plugged in through the same public hooks
-(``column_method``, ``column_leg``, ``column_params``, ``column_intervals``).
+Workspace: every leg's feasible z set along an (x, y) column has closed form, and the engine
+gets the exact column method (``column_method``):
+
+* ``"linear"`` / ``"quadratic"``: every leg prismatic (the ``ups6`` interval on the
+  working-mode side) or a slider on a vertical rail (``e = ±ẑ``, the ``psu6`` linear
+  interval); single-interval radial legs (``column_leg``, ``column_radial``), so refine, the
+  exact task check and the continuous optima apply as for ``psu6`` / ``ups6``;
+* ``"slider"``: some slider on an inclined or horizontal rail (:mod:`._slider`: on the
+  working-mode side the slider coordinate is monotone along the column, so each leg's set is
+  one interval whose ends are closed-form), mixed with any of the above;
+* ``"crank"``: every leg a crank (the set-valued legs of :mod:`._crank`, as ``rss6``).
+
+The last two are set-valued column legs (:mod:`._set_columns`): such an instance has
+``column_leg = None`` and ``column_radial = False`` (instance values shadowing the class
+ones), so refine, the exact task check and the continuous optima decline it as they decline
+``rss6``. Only a rail within ~0.002° of vertical but not exactly vertical
+(``e_x² + e_y² < _slider.K_MIN``) leaves ``column_method = None`` (sampled).
 """
 
 from __future__ import annotations
@@ -50,6 +61,9 @@ from numba.extending import register_jitable
 from ..errors import ParameterError
 from ..poses import euler_to_matrix
 from . import _kernels
+from ._crank import crank_column_leg, crank_params
+from ._set_columns import set_column_intervals
+from ._slider import K_MIN, slider_interval
 from .base import NO_STROKE, Mechanism, as_points, as_stroke, as_vector3
 from .rss6 import _atan2
 
@@ -119,8 +133,8 @@ def _sixleg_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin
         st[k] = c
 
 
-@njit(inline="always")
-def _sixleg_column_leg(x, y, wx, wy, wz, k, p1, p2):
+@register_jitable
+def _linear_interval(x, y, wx, wy, wz, k, p1, p2):
     """One leg's z interval on the column (x, y) (see :func:`._kernels.make_column_kernel`).
 
     Slider on a vertical rail (``k != 0``): ``|k| = l²``, ``sign(k) = c`` and the interval is
@@ -141,6 +155,29 @@ def _sixleg_column_leg(x, y, wx, wy, wz, k, p1, p2):
     if k == 0.0:
         return (-wz + ri if up else -wz - ro), (-wz + ro if up else -wz - ri), A >= 0.0
     return p1 - wz + c * s, p2 - wz + c * s, h2 >= 0.0
+
+
+#: the single-interval column leg (``column_leg``) of prismatic and vertical-rail legs
+_sixleg_column_leg = njit(inline="always")(_linear_interval)
+
+
+@register_jitable
+def _sixleg_set_leg(x, y, wx, wy, wz, p, zlo, zhi, out_lo, out_hi):
+    """Set-valued column leg (:mod:`._set_columns`) of prismatic and slider legs, one interval
+    each: row ``p = [0, k, p1, p2, ...]`` for :func:`_sixleg_column_leg`, or ``[1, e (3), l, b,
+    side, qmin, qmax]`` for an inclined or horizontal rail (:func:`._slider.slider_interval`)."""
+    if p[0] == 0.0:
+        a, b, ok = _linear_interval(x, y, wx, wy, wz, p[1], p[2], p[3])
+    else:
+        a, b, ok = slider_interval(x + wx, y + wy, wz, p[1], p[2], p[3], p[4], p[5], p[6],
+                                   p[7], p[8])
+    a = max(a, zlo)
+    b = min(b, zhi)
+    if not (ok and a <= b):
+        return 0
+    out_lo[0] = a
+    out_hi[0] = b
+    return 1
 
 
 def _directions(value, field: str, need: np.ndarray) -> np.ndarray:
@@ -272,6 +309,14 @@ class SixLeg(Mechanism):
         for a in (self.kinds, self.axes, self.zero_directions, self.crank_length,
                   self.link_length, self.branch):
             a.setflags(write=False)
+        if self.column_method in ("crank", "slider"):
+            # Set-valued column legs (cranks, inclined rails): no single-interval
+            # ``column_leg`` and no radial intervals for this instance, so refine, the exact
+            # task check and the continuous optima (which need them) decline it as they
+            # decline rss6. The instance values shadow the class ones that the other
+            # instances keep.
+            set_(self, "column_leg", None)
+            set_(self, "column_radial", False)
 
     # ---- conversions -------------------------------------------------------------------------
     @classmethod
@@ -428,11 +473,16 @@ class SixLeg(Mechanism):
     # ---- workspace hooks -------------------------------------------------------------------
     @property
     def column_method(self) -> str | None:     # type: ignore[override]
-        """``"quadratic"`` (any prismatic leg) or ``"linear"`` when every leg is prismatic or a
-        vertical-rail slider, else ``None`` (sampled)."""
+        """``"crank"`` when every leg is a crank (exact set-valued legs, :mod:`._crank`);
+        ``"quadratic"`` (any prismatic leg) or ``"linear"`` when every leg is prismatic or a
+        vertical-rail slider; else ``None`` (sampled)."""
+        if np.all(self._mask("crank")):
+            return "crank"
         prism = self._mask("prismatic")
         if not np.all(prism | self._vertical):
-            return None
+            k = np.sum(self.axes[:, :2] ** 2, axis=1)
+            ok = np.all(prism | self._vertical | (self._mask("slider") & (k >= K_MIN)))
+            return "slider" if ok else None
         return "quadratic" if prism.any() else "linear"
 
     @property
@@ -440,16 +490,43 @@ class SixLeg(Mechanism):
         return bool(np.all(self._vertical))
 
     def column_params(self) -> np.ndarray:
-        """``(6, 3)`` parameters of :func:`_sixleg_column_leg` (only with a column method)."""
-        if self.column_method is None:
+        """``(6, 3)`` parameters of :func:`_sixleg_column_leg`, or for cranks the ``(6, 15)``
+        rows of :func:`._crank.crank_column_leg` (only with a column method)."""
+        method = self.column_method
+        if method is None:
             raise ValueError(f"{self.name or 'this sixleg'} has legs without column intervals")
+        if method == "crank":
+            return crank_params(self.zero_directions, self.v_directions, self.crank_length,
+                                self.link_length, self.branch, self.stroke)
         lo, hi = self.stroke
+        if method == "slider":                 # rows of _sixleg_set_leg
+            linear = self._vertical | self._mask("prismatic")
+            k = self._linear_params(lo, hi)
+            return np.where(linear[:, None], np.column_stack([np.zeros(6), k, np.zeros((6, 5))]),
+                            np.column_stack([np.ones(6), self.axes, self.link_length,
+                                             self.branch, self._slider_sides, np.full(6, lo),
+                                             np.full(6, hi)]))
+        return self._linear_params(lo, hi)
+
+    def _linear_params(self, lo, hi) -> np.ndarray:
+        """``(6, 3)`` rows of :func:`_sixleg_column_leg` (meaningful for prismatic legs and
+        vertical rails)."""
         sigma = self.axes[:, 2]                              # ±1 on vertical rails
         c = -sigma * self.branch
         k = np.where(self._vertical, c * self.link_length**2, 0.0)
         p1 = np.where(self._vertical, np.where(sigma > 0, lo, -hi), self._sides * lo * lo)
         p2 = np.where(self._vertical, np.where(sigma > 0, hi, -lo), self._sides * hi * hi)
         return np.stack([k, p1, p2], axis=1)
+
+    def column_intervals(self, xs, ys, R, mode, allowed=None, K=8):
+        """As :meth:`.base.Mechanism.column_intervals`; crank legs use the exact set-valued
+        legs of :mod:`._crank` (as ``rss6``), whose dexterous sets have up to ``K`` pieces."""
+        method = self.column_method
+        if method in ("crank", "slider"):
+            leg = crank_column_leg if method == "crank" else _sixleg_set_leg
+            return set_column_intervals(leg, self.leg_offsets(R), self.column_params(), xs, ys,
+                                        R, mode, allowed, K)
+        return super().column_intervals(xs, ys, R, mode, allowed, K)
 
     def position_bounds(self, R):
         """Per orientation, the intersection over legs of each leg's reach box ``(M, 2, 3)``:

@@ -264,7 +264,7 @@ def _prepare(mech, orientations: OrientationSet | None, constraints: Constraints
 
 def _check(mech, oset, task, resolution, cons, grow=0.0, surface=False) -> TaskCheck:
     R = oset.rotations()
-    exact = bool(getattr(type(mech), "column_radial", False)) and mech.column_method \
+    exact = bool(getattr(mech, "column_radial", False)) and mech.column_method \
         is not None and not cons.extra
     if exact:
         fail = _exact_fail(mech, R, task, grow)

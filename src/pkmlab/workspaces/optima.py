@@ -106,7 +106,7 @@ class OptimumBracket:
 def supports_continuous(mech, constraints=None) -> bool:
     """True when the continuous search applies: radial column intervals, stroke only."""
     extra = bool(constraints is not None and constraints.extra)
-    return bool(type(mech).column_radial) and mech.column_method is not None and not extra
+    return bool(mech.column_radial) and mech.column_method is not None and not extra
 
 
 def _inputs(mech):

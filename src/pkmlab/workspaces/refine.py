@@ -48,6 +48,9 @@ def refine_columns(mech, xs, ys, oset, lo, hi, iterations: int = 14):
     Returns ``(lo, hi, changed)`` where ``changed`` counts columns whose interval shrank by
     more than 1e-9 mm.
     """
+    if mech.column_leg is None:
+        raise ValueError(f"refine needs single-interval column legs; {mech.family!r} "
+                         f"({mech.column_method}) has none")
     lo, hi = lo.copy(), hi.copy()
     alive = np.nonzero(lo[..., 0] <= hi[..., 0])
     if len(alive[0]) == 0 or oset.kind == "fixed":
