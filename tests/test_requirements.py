@@ -627,6 +627,33 @@ def test_rotary_servo_fit_on_rss6_and_kind_mismatch_is_invalid(tmp_path):
     assert rec["status"] == "invalid" and "rotary actuator" in rec["reason"], rec["reason"]
 
 
+def test_motion_metrics_carry_the_actuators_units(tmp_path):
+    """A rotary family's motion loads are torques (N·mm) and angular speeds (rad/s): they go
+    to the torque metrics, and the force metrics (N, mm/s) stay null with a note; a linear
+    family the other way round. The torque equals the dynamics' own peak."""
+    motion = [{"name": "s", "sinusoid": {"amplitude": {"z": "3 mm"}, "frequency": {"z": "1 Hz"}},
+               "duration": "0.2 s", "rate": "50 Hz"}]
+    for file, rotary, var in (("instructables-servo-6rss.yaml", True, "crank_length"),
+                              ("hopkins-williams-6psu.yaml", False, "link_length")):
+        data = {"study": "units", "mechanism": {"file": str(MECH_DIR / file)},
+                "design": {var: {"low": "20 mm", "high": "300 mm"}},
+                "evaluate": {"motions": motion, "payload": {"mass": "0.2 kg"}},
+                "objectives": [{"minimize": "peak_actuator_power"}],
+                "optimizer": {"method": "grid"}}
+        s = study_from_mapping(data, tmp_path)
+        rec = evaluate_design(s.space, None, s.evaluation, 0)
+        assert rec["status"] == "ok", rec.get("reason")
+        m, notes = rec["metrics"], rec["notes"]
+        mech = s.space.decode(None)
+        dyn = inverse_dynamics(mech, s.evaluation.motions.motions(mech)[0],
+                               s.evaluation.payload.for_mechanism(mech))
+        peak = float(np.max(dyn.summary()["peak_force"]))
+        have, null = (("peak_actuator_torque", "peak_actuator_force") if rotary else
+                      ("peak_actuator_force", "peak_actuator_torque"))
+        assert m[have] == pytest.approx(peak) and m[null] is None and have in notes[null]
+        assert (m["peak_actuator_angular_speed"] is None) != rotary
+
+
 def test_summary_reports_which_catalogue_actuators_fit(tmp_path):
     from pkmlab.study.report import _catalogue_fits
 

@@ -96,8 +96,9 @@ class DynamicsResult:
 
     def summary(self) -> dict:
         """Per actuator (arrays ``(6,)``): ``peak_force`` |f| N, ``rms_force`` N,
-        ``peak_speed`` |q̇| mm/s, ``peak_power`` |f·q̇| W, ``travel`` (min q, max q) mm; over
-        the samples that are ``ok`` (NaN if none)."""
+        ``peak_speed`` |q̇| mm/s, ``peak_power`` |f·q̇| W, ``travel`` (min q, max q) mm (for
+        rotary actuators: torques in N·mm, speeds in rad/s, travel in rad); over the samples
+        that are ``ok`` (NaN if none)."""
         ok = self.ok
         if not np.any(ok):
             nan = np.full(6, np.nan)

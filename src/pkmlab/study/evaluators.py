@@ -291,13 +291,23 @@ def _motions(mech, ctx: Context) -> dict:
     if bad:
         ctx.notes["motions_feasible"] = bad[0]
     sums = [r.summary() for r in ctx.dynamics if np.any(r.ok)]
-    for name, key in (("peak_actuator_force", "peak_force"), ("rms_actuator_force",
-                      "rms_force"), ("peak_actuator_speed", "peak_speed"),
-                      ("peak_actuator_power", "peak_power")):
+    rotary = mech.actuator_unit == "rad"
+    for linear, turning, key in _MOTION_METRICS:
+        name, other = (turning, linear) if rotary else (linear, turning)
         out[name] = float(max(np.max(s[key]) for s in sums)) if sums else None
         if not sums:
             ctx.notes[name] = "no feasible sample in any motion"
+        if other != name:
+            out[other] = None
+            ctx.notes[other] = (f"{'rotary' if rotary else 'linear'} actuators: see {name}")
     return out
+
+
+#: (linear actuators' metric, rotary actuators' metric, DynamicsResult.summary() key)
+_MOTION_METRICS = (("peak_actuator_force", "peak_actuator_torque", "peak_force"),
+                   ("rms_actuator_force", "rms_actuator_torque", "rms_force"),
+                   ("peak_actuator_speed", "peak_actuator_angular_speed", "peak_speed"),
+                   ("peak_actuator_power", "peak_actuator_power", "peak_power"))
 
 
 @_evaluator("payload")

@@ -152,14 +152,26 @@ _ALL = [
            "1 if every sample of every required motion is within the stroke and not singular"),
     Metric("peak_actuator_force", "motions", "N", "worst-case",
            "largest |actuator force| over every sample of every required motion (Newton–Euler "
-           "of platform + payload + legs, f = J⁻ᵀ·w; rotary families: crank torque in N·mm)"),
+           "of platform + payload + legs, f = J⁻ᵀ·w); linear actuators only, null for rotary "
+           "ones (peak_actuator_torque)"),
     Metric("rms_actuator_force", "motions", "N", "worst-case",
-           "largest RMS actuator force (time-weighted, per actuator and motion)"),
+           "largest RMS actuator force (time-weighted, per actuator and motion); linear "
+           "actuators only"),
     Metric("peak_actuator_speed", "motions", "mm/s", "worst-case",
-           "largest |actuator speed| over every sample of every required motion (rotary "
-           "families: rad/s)"),
+           "largest |actuator speed| over every sample of every required motion; linear "
+           "actuators only, null for rotary ones (peak_actuator_angular_speed)"),
+    Metric("peak_actuator_torque", "motions", "N·mm", "worst-case",
+           "largest |servo torque| over every sample of every required motion (τ = J⁻ᵀ·w); "
+           "rotary actuators only, null for linear ones"),
+    Metric("rms_actuator_torque", "motions", "N·mm", "worst-case",
+           "largest RMS servo torque (time-weighted, per actuator and motion); rotary "
+           "actuators only"),
+    Metric("peak_actuator_angular_speed", "motions", "rad/s", "worst-case",
+           "largest |servo angular speed| over every sample of every required motion; rotary "
+           "actuators only"),
     Metric("peak_actuator_power", "motions", "W", "worst-case",
-           "largest |actuator force × speed| over every sample of every required motion"),
+           "largest |actuator force × speed| (rotary: torque × angular speed) over every "
+           "sample of every required motion"),
     # requirements: the payload held at rest over the workspace
     Metric("peak_servo_torque", "payload", "N·mm", "worst-case",
            "largest |servo torque| holding the payload at rest (τ = J⁻ᵀ·w, w the gravity "

@@ -221,6 +221,7 @@ def _summary(study: Study, records, front, baseline) -> str:
 #: requirement metrics that summary.md lists in its margins table (when evaluated)
 REQUIREMENT_MARGINS = ("task_contained", "task_margin", "task_orientation_margin",
                        "motions_feasible", "peak_actuator_force", "peak_actuator_speed",
+                       "peak_actuator_torque", "peak_actuator_angular_speed",
                        "peak_actuator_power", "actuators_fit", "actuator_force_margin",
                        "actuator_speed_margin", "actuator_torque_speed_margin",
                        "actuator_stroke_margin")
