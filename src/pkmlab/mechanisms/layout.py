@@ -22,8 +22,26 @@ import numpy as np
 from ..errors import ParameterError
 from .solvers import bracketed_root
 
-__all__ = ["paired_layout", "equal_leg_base_angle", "build_paired"]
+__all__ = ["paired_layout", "equal_leg_base_angle", "build_paired", "PAIRED_ALIASES"]
 
+
+
+#: study variables of the paired-circle generator (:func:`build_paired`): name → (path in the
+#: mechanism spec, quantity); the families built on it add their own
+PAIRED_ALIASES: dict[str, tuple[str, str]] = {
+    "base_inner_radius": ("generator.base_radii[0]", "length"),
+    "base_outer_radius": ("generator.base_radii[1]", "length"),
+    "platform_inner_radius": ("generator.platform_radii[0]", "length"),
+    "platform_outer_radius": ("generator.platform_radii[1]", "length"),
+    "platform_rotation": ("generator.platform_rotation", "angle"),
+    "base_pair_angle": ("generator.base_pair_angle", "angle"),
+    "base_pair_separation": ("generator.base_pair_separation", "angle"),
+    "platform_pair_separation": ("generator.platform_pair_separation", "angle"),
+    "stroke_min": ("stroke[0]", "length"),
+    "stroke_max": ("stroke[1]", "length"),
+    "tool_offset_z": ("tool_offset[2]", "length"),
+    "pairing": ("generator.pairing", "text"),
+}
 
 def _ring(radii: np.ndarray, angles: np.ndarray, z: float = 0.0) -> np.ndarray:
     return np.stack([radii * np.cos(angles), radii * np.sin(angles), np.full(6, z)], axis=1)

@@ -65,7 +65,9 @@ from ._crank import crank_column_leg, crank_params
 from ._set_columns import set_column_intervals
 from ._slider import K_MIN, slider_interval
 from .base import NO_STROKE, Mechanism, as_points, as_stroke, as_vector3
+from .layout import PAIRED_ALIASES
 from .rss6 import _atan2
+from .ups6 import working_sides
 
 __all__ = ["SixLeg", "KINDS"]
 
@@ -245,18 +247,7 @@ class SixLeg(Mechanism):
     _ik_one = _sixleg_one
     #: named study variables (paths in the generator form of the YAML model)
     design_aliases: ClassVar[dict] = {
-        "base_inner_radius": ("generator.base_radii[0]", "length"),
-        "base_outer_radius": ("generator.base_radii[1]", "length"),
-        "platform_inner_radius": ("generator.platform_radii[0]", "length"),
-        "platform_outer_radius": ("generator.platform_radii[1]", "length"),
-        "platform_rotation": ("generator.platform_rotation", "angle"),
-        "base_pair_angle": ("generator.base_pair_angle", "angle"),
-        "base_pair_separation": ("generator.base_pair_separation", "angle"),
-        "platform_pair_separation": ("generator.platform_pair_separation", "angle"),
-        "pairing": ("generator.pairing", "text"),
-        "tool_offset_z": ("tool_offset[2]", "length"),
-        "stroke_min": ("stroke[0]", "length"),
-        "stroke_max": ("stroke[1]", "length"),
+        **PAIRED_ALIASES,
         "link_length": ("generator.actuator.link_length", "length"),
         "rail_inclination": ("generator.actuator.rail_inclination", "angle"),
         "rail_heading": ("generator.actuator.rail_heading", "text"),
@@ -373,13 +364,8 @@ class SixLeg(Mechanism):
 
     @cached_property
     def _sides(self) -> np.ndarray:
-        """Working-mode side of each prismatic leg (as ``UPS6._sides``)."""
-        if self.nominal is None:
-            return np.ones(6)
-        pose = np.asarray(self.nominal, dtype=float)
-        R = euler_to_matrix(pose[3:])
-        sz = pose[2] + self.tool_points @ R[2] - self.base_points[:, 2]
-        return np.where(sz < 0, -1.0, 1.0)
+        """Working-mode side of each prismatic leg (:func:`.ups6.working_sides`)."""
+        return working_sides(self)
 
     @cached_property
     def _slider_sides(self) -> np.ndarray:

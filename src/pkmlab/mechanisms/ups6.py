@@ -25,7 +25,24 @@ from .base import Mechanism, as_points, as_stroke, as_vector3
 from .layout import build_paired
 from .psu6 import _radii
 
-__all__ = ["UPS6"]
+__all__ = ["UPS6", "working_sides"]
+
+
+def working_sides(mech) -> np.ndarray:
+    """``(6,)`` ±1: the side of its base joint (above/below) each platform joint of ``mech``
+    keeps.
+
+    The working mode: a leg that passes its base joint's height swaps to the mirror assembly
+    mode (with a level platform, through a parallel singularity where all legs are
+    horizontal). Taken from ``mech.nominal`` when given, else +1 (platform above the base,
+    which is also where the mid-stroke nominal pose is searched).
+    """
+    if mech.nominal is None:
+        return np.ones(6)
+    pose = np.asarray(mech.nominal, dtype=float)
+    R = euler_to_matrix(pose[3:])
+    sz = pose[2] + mech.tool_points @ R[2] - mech.base_points[:, 2]
+    return np.where(sz < 0, -1.0, 1.0)
 
 
 @register_jitable(inline="always")
@@ -145,19 +162,8 @@ class UPS6(Mechanism):
 
     @cached_property
     def _sides(self) -> np.ndarray:
-        """``(6,)`` ±1: the side of its base joint (above/below) each platform joint keeps.
-
-        The working mode: a leg that passes its base joint's height swaps to the mirror
-        assembly mode (with a level platform, through a parallel singularity where all legs
-        are horizontal). Taken from ``nominal`` when given, else +1 (platform above the base,
-        which is also where the mid-stroke nominal pose is searched).
-        """
-        if self.nominal is None:
-            return np.ones(6)
-        pose = np.asarray(self.nominal, dtype=float)
-        R = euler_to_matrix(pose[3:])
-        sz = pose[2] + self.tool_points @ R[2] - self.base_points[:, 2]
-        return np.where(sz < 0, -1.0, 1.0)
+        """``(6,)`` ±1 working-mode sides (:func:`working_sides`)."""
+        return working_sides(self)
 
     def _legs(self, p, R):
         r = np.einsum("nij,kj->nki", R, self.tool_points)

@@ -18,6 +18,7 @@ from .. import limits
 from ..config import mechanism_spec, read_yaml, validate_model, workspace_spec
 from ..errors import ParameterError
 from ..mechanisms import REGISTRY
+from ..mechanisms.layout import PAIRED_ALIASES as _PAIRED
 from ..units import parse_angle, parse_length
 from .definition import (
     Constraint,
@@ -33,20 +34,6 @@ from .space import Derived, DesignSpace, Expression, Variable, get_path, parse_p
 
 __all__ = ["load_study", "study_from_mapping", "StudySpec", "study_schema", "DESIGN_ALIASES"]
 
-_PAIRED = {
-    "base_inner_radius": ("generator.base_radii[0]", "length"),
-    "base_outer_radius": ("generator.base_radii[1]", "length"),
-    "platform_inner_radius": ("generator.platform_radii[0]", "length"),
-    "platform_outer_radius": ("generator.platform_radii[1]", "length"),
-    "platform_rotation": ("generator.platform_rotation", "angle"),
-    "base_pair_angle": ("generator.base_pair_angle", "angle"),
-    "base_pair_separation": ("generator.base_pair_separation", "angle"),
-    "platform_pair_separation": ("generator.platform_pair_separation", "angle"),
-    "stroke_min": ("stroke[0]", "length"),
-    "stroke_max": ("stroke[1]", "length"),
-    "tool_offset_z": ("tool_offset[2]", "length"),
-    "pairing": ("generator.pairing", "text"),
-}
 #: named design variables → (path in the mechanism spec, quantity), per family
 DESIGN_ALIASES: dict[str, dict[str, tuple[str, str]]] = {
     "psu6": {**_PAIRED, "link_length": ("link_length", "length")},

@@ -64,7 +64,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ParameterError
-from ..limits import RESOLUTION_MM
 from ..poses import as_frames, matrix_to_euler
 from . import cells as oc
 from .bracket_sets import connected, inside, length, pieces_of, tri_volume, union
@@ -345,14 +344,9 @@ class _Level:
 
 
 def _request(mech, kind, orientations, resolution, constraints):
-    from .engine import KINDS
+    from .engine import check_request
 
-    if kind not in KINDS:
-        raise ParameterError("kind", f"one of {list(KINDS)}", kind)
-    if not (isinstance(resolution, int | float) and math.isfinite(resolution)
-            and RESOLUTION_MM[0] <= resolution <= RESOLUTION_MM[1]):
-        raise ParameterError("resolution", f"a grid spacing in [{RESOLUTION_MM[0]:g}, "
-                             f"{RESOLUTION_MM[1]:g}] mm", resolution)
+    check_request(kind, resolution)
     if not mech.column_radial or mech.column_method is None:
         raise ParameterError("bracket", "a family with radial column kernels (psu6, ups6); "
                              f"family {mech.family!r} has none", mech.family)

@@ -39,7 +39,7 @@ from .result import WorkspaceResult
 
 log = logging.getLogger(__name__)
 
-__all__ = ["workspace", "orientation_convergence", "estimate_bytes", "KINDS"]
+__all__ = ["workspace", "orientation_convergence", "estimate_bytes", "check_request", "KINDS"]
 
 KINDS = ("constant", "reachable", "dexterous")
 _CHUNK = 200_000
@@ -49,6 +49,17 @@ _SLAB = 1_000_000
 SINGULAR_NOTE = "singular at the nominal pose"
 #: interval pieces kept per column (union of orientations, sampled runs)
 _K = 8
+
+
+def check_request(kind: str, resolution) -> None:
+    """Refuse an unknown workspace ``kind`` or a grid spacing outside
+    :data:`~pkmlab.limits.RESOLUTION_MM` (one line naming the field)."""
+    if kind not in KINDS:
+        raise ParameterError("kind", f"one of {list(KINDS)}", kind)
+    if not (isinstance(resolution, int | float) and math.isfinite(resolution)
+            and RESOLUTION_MM[0] <= resolution <= RESOLUTION_MM[1]):
+        raise ParameterError("resolution", f"a grid spacing in [{RESOLUTION_MM[0]:g}, "
+                             f"{RESOLUTION_MM[1]:g}] mm", resolution)
 
 
 def estimate_bytes(nx: int, ny: int, nz: int, M: int, columns: bool, dense: bool) -> float:
@@ -87,12 +98,7 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
         :class:`WorkspaceResult`; an empty workspace is a valid result (``result.empty``).
     """
     t0 = time.perf_counter()
-    if kind not in KINDS:
-        raise ParameterError("kind", f"one of {list(KINDS)}", kind)
-    if not (isinstance(resolution, int | float) and math.isfinite(resolution)
-            and RESOLUTION_MM[0] <= resolution <= RESOLUTION_MM[1]):
-        raise ParameterError("resolution", f"a grid spacing in [{RESOLUTION_MM[0]:g}, "
-                             f"{RESOLUTION_MM[1]:g}] mm", resolution)
+    check_request(kind, resolution)
     if method not in ("auto", "columns", "sampled"):
         raise ParameterError("method", "one of ['auto', 'columns', 'sampled']", method)
     cons = (constraints or Constraints()).resolved(mech)
