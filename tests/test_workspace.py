@@ -127,6 +127,23 @@ def test_mesh_is_watertight_and_matches_volume(hopkins, tmp_path):
         assert path.stat().st_size > 1000
 
 
+def test_stl_written_without_trimesh_equals_trimesh_export(hopkins, tmp_path):
+    """The STL is written straight from the marching-cubes triangles (cold start): it must hold
+    the same triangles, normals and orientation as trimesh's export of the merged mesh."""
+    import trimesh
+
+    from pkmlab.workspaces.mesh import STL_HEADER
+
+    res = workspace(hopkins, "dexterous", BOX15, 2.5)
+    ours = res.save_mesh(tmp_path / "w.stl").read_bytes()
+    theirs = res.mesh().export(file_type="stl")
+    assert ours[:80] == STL_HEADER.ljust(80, b" ")
+    assert len(ours) == len(theirs) and ours[84:] == theirs[84:]      # same bytes after header
+    loaded = trimesh.load(tmp_path / "w.stl")
+    assert loaded.is_watertight and loaded.volume > 0
+    assert abs(loaded.volume - res.volume) <= res.volume_error
+
+
 def test_dexterous_within_reachable_and_nested_sets(hopkins):
     small = workspace(hopkins, "dexterous", OrientationSet.box(np.radians([5] * 3), samples=3),
                       4.0)

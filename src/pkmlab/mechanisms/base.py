@@ -54,7 +54,6 @@ from functools import cached_property
 from typing import Any, ClassVar
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ..errors import ParameterError
 from ..poses import as_frames, log_so3
@@ -475,6 +474,9 @@ class Mechanism:
         rng = np.random.default_rng(seed)
         S = self.scale
         p = rng.uniform(-2 * S, 2 * S, size=(n, 3))         # box about the base centre
+        # lazy: scipy.spatial costs 0.25 s at import, and only forward kinematics needs it
+        from scipy.spatial.transform import Rotation
+
         R = Rotation.random(n, random_state=rng).as_matrix()
         return p, R
 

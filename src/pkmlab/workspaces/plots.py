@@ -75,7 +75,7 @@ def slice_figure(result, window: float | None = None, spacing: float | None = No
             else:
                 ax.plot(poly[:, 0], poly[:, 1], "r-", lw=1)
         ax.set_title(f"z = {z:.1f} mm", fontsize=7)
-    _outer_labels(axes, len(levels))
+    _outer_ticks(axes, len(levels), (cx - half, cx + half), (cy - half, cy + half))
     if im is not None:
         note = {"neither": "", "max": "\n(colours capped at the 99th percentile)",
                 "min": "\n(colours floored at the 1st percentile)",
@@ -94,28 +94,40 @@ def slice_figure(result, window: float | None = None, spacing: float | None = No
 
 
 def _panel_grid(rows: int, cols: int, size: float, top: float, bottom: float = 0.0):
-    """A figure of ``rows × cols`` square panels of ``size`` inches sharing their axes (tick
-    labels on the outer panels only), with fixed margins: ``top`` inches of height for the
-    title and ``bottom`` for a legend. Fixed margins and shared ticks draw about four times
-    faster than a constrained layout with every panel's own tick labels, which dominated the
-    time of a ``pkmlab workspace`` run."""
+    """A figure of ``rows × cols`` square panels of ``size`` inches with fixed margins: ``top``
+    inches of height for the title and ``bottom`` for a legend. Every panel shows the same
+    window; :func:`_outer_ticks` puts ticks on the outer panels only. Fixed margins and outer
+    ticks only draw several times faster than a constrained layout with every panel's own
+    ticks: matplotlib builds every tick as artists, which dominated the time of a
+    ``pkmlab workspace`` run and of a study's design export."""
     from matplotlib.figure import Figure
 
     W, H = size * cols, size * rows + top + bottom
     fig = Figure(figsize=(W, H))
-    axes = fig.subplots(rows, cols, squeeze=False, sharex=True, sharey=True)
+    axes = fig.subplots(rows, cols, squeeze=False)
     fig.subplots_adjust(left=0.45 / W, right=1 - 0.15 / W, bottom=(0.3 + bottom) / H,
                         top=1 - top / H, wspace=0.12, hspace=0.25)
     return fig, axes
 
 
-def _outer_labels(axes, used: int) -> None:
-    """Tick labels on the outside of the used panels only: y labels in the first column, x
-    labels under every used panel that has no used panel below it."""
+def _outer_ticks(axes, used: int, xlim: tuple[float, float], ylim: tuple[float, float]) -> None:
+    """The same window on every used panel, ticks (mm) on the outside of the used panels
+    only: y ticks in the first column, x ticks under every used panel that has no used panel
+    below it; the inner panels have none."""
+    from matplotlib.ticker import MaxNLocator
+
+    def ticks(lo, hi):
+        t = MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10]).tick_values(lo, hi)
+        return t[(t >= lo - 1e-9 * abs(hi - lo)) & (t <= hi + 1e-9 * abs(hi - lo))]
+
+    xt, yt = ticks(*xlim), ticks(*ylim)
     rows, cols = axes.shape
     for a in range(min(used, rows * cols)):
-        axes[a // cols, a % cols].tick_params(labelbottom=a + cols >= used,
-                                              labelleft=a % cols == 0)
+        ax = axes[a // cols, a % cols]
+        ax.set_xticks(xt if a + cols >= used else [])
+        ax.set_yticks(yt if a % cols == 0 else [])
+        ax.set_xlim(*xlim)
+        ax.set_ylim(*ylim)
 
 
 def _colour_range(values: np.ndarray) -> tuple[float, float, str]:
@@ -181,7 +193,7 @@ def overlay_figure(results: list, labels: list[str], layout: str = "auto",
         ax.set_title(f"z = {z:.1f} mm", fontsize=7)
     handles = [Line2D([], [], color=colours[k % len(colours)], label=lab)
                for k, lab in enumerate(labels)]
-    _outer_labels(axes, len(lay.levels))
+    _outer_ticks(axes, len(lay.levels), (cx - half, cx + half), (cy - half, cy + half))
     fig.legend(handles=handles, loc="lower center", ncol=min(len(labels), 4), fontsize=8,
                frameon=False)
     fig.suptitle((title + "\n" if title else "") + lay.describe(), fontsize=9)

@@ -256,10 +256,17 @@ class WorkspaceResult:
         return path
 
     @cached_property
-    def _boundary(self):
-        from .mesh import boundary_mesh
+    def _triangles(self):
+        from .mesh import boundary_triangles
 
-        return boundary_mesh(self)
+        return boundary_triangles(self)
+
+    @cached_property
+    def _boundary(self):
+        import trimesh
+
+        vertices, faces = self._triangles
+        return trimesh.Trimesh(vertices=vertices, faces=faces, process=True)
 
     def mesh(self):
         """Watertight boundary mesh (``trimesh.Trimesh``, mm) by marching cubes on ``field``
@@ -272,13 +279,18 @@ class WorkspaceResult:
         Each format's unit convention: STL in mm (stated in its header), PLY in mm (stated
         in a header comment) with ``values`` — ``{name: (n_vertices,) array}`` for the
         vertices of :meth:`mesh` — as float vertex properties, glTF binary in metres and
-        y up. ``colors``: ``(n_vertices, 4)`` uint8 vertex colours (PLY, GLB).
+        y up. ``colors``: ``(n_vertices, 4)`` uint8 vertex colours (PLY, GLB). An STL is
+        written straight from the marching-cubes triangles (no trimesh import: cold start).
         """
-        from .mesh import write_mesh
+        from ..atomic import write_bytes
+        from .mesh import stl_bytes, write_mesh
 
         path = Path(path)
-        if path.suffix.lower() not in (".stl", ".ply", ".glb"):
+        suffix = path.suffix.lower()
+        if suffix not in (".stl", ".ply", ".glb"):
             raise ParameterError("mesh file", "a .stl, .ply or .glb path", str(path))
+        if suffix == ".stl":
+            return write_bytes(path, stl_bytes(*self._triangles))
         return write_mesh(self.mesh(), path, colors=colors, values=values)
 
     def plot_slices(self, path, window: float | None = None, spacing: float | None = None,
