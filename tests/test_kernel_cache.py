@@ -397,3 +397,33 @@ def test_editing_a_family_recompiles_its_kernels(tmp_path):
     # a helper in another module that only the per-pose function calls
     (tmp_path / "famx_helpers.py").write_text(HELPERS.replace("return 0.0", "return 0.5"))
     assert run() == ([[21.5, 22.5, 23.5, 24.5, 25.5, 26.5], 1.0, 1.0], {"drive_euler"})
+
+
+def test_compiling_a_kernel_shows_no_numba_ir_warning(monkeypatch):
+    """numba's NumbaIRAssumptionWarning ("internal pedantic check", a page of text per
+    kernel) was printed on every first compile of the continuous-search kernels; compiling
+    through cached_kernel keeps it out of the user's terminal, and lets other warnings pass."""
+    import warnings
+
+    from numba import types as nt
+    from numba.core.errors import NumbaIRAssumptionWarning
+
+    from pkmlab import _jit
+
+    real = _jit.njit
+
+    def noisy(*a, **k):
+        warnings.warn("variable 'x.1' is not in scope", NumbaIRAssumptionWarning)
+        warnings.warn("a warning the user should see", RuntimeWarning)
+        return real(*a, **k)
+
+    monkeypatch.setattr(_jit, "njit", noisy)
+
+    def add_one(x):
+        return x + 1.0
+
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        k = _jit.cached_kernel(add_one, nt.float64(nt.float64))
+    assert k(1.0) == 2.0
+    assert [w.category for w in seen] == [RuntimeWarning]

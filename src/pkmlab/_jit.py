@@ -69,6 +69,7 @@ import numba
 from numba import njit
 from numba.core.bytecode import FunctionIdentity
 from numba.core.compiler_lock import global_compiler_lock
+from numba.core.errors import NumbaIRAssumptionWarning
 from numba.extending import register_jitable
 
 from .threads import DEFAULTS as _OPENMP_DEFAULTS  # noqa: F401  (set before any kernel runs)
@@ -207,7 +208,11 @@ def cached_kernel(fn, sig, *, roots=(), extra=(), **options):
     t0 = time.perf_counter()
     try:
         with _uid_namespace(ident) if CACHE_SAFE else contextlib.nullcontext():
-            compiled = njit(sig, cache=CACHE_SAFE, **options)(kernel)
+            with warnings.catch_warnings():
+                # numba's "internal pedantic check" on closures of generated code: a page of
+                # text on every first compile, about numba's IR, not about the user's input
+                warnings.simplefilter("ignore", NumbaIRAssumptionWarning)
+                compiled = njit(sig, cache=CACHE_SAFE, **options)(kernel)
     finally:
         notice.cancel()
     if time.perf_counter() - t0 > COMPILE_NOTICE_S:
