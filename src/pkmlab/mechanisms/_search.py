@@ -312,22 +312,21 @@ _F1, _F2, _F3 = nt.float64[::1], nt.float64[:, ::1], nt.float64[:, :, ::1]
 
 @cache
 def make_branch_bound(leg):
-    """``bb(U (6, 3), Bp (6, 3), P (6, 3), e0 (3,), theta, n, box (4,), h0, min_size, eps,
-    decide, out (8,))``: branch and bound over continuous positions for the ±theta box
-    sampled with n angles per axis (see the module notes); ``out`` gets status (1 feasible, 0
-    empty at every position, -1 undecided), best margin, its x, y, z interval, the global upper
-    bound of the margin and the tile count."""
+    """``bb(W (M, 6, 3), P (6, 3), box (4,), h0, min_size, eps, decide, out (8,))``: branch
+    and bound over continuous positions for the orientation sample whose leg offsets
+    ``w = R·u - b`` are ``W`` (any orientations: a grid of the box, plus the binding ones the
+    caller adds; see the module notes); ``out`` gets status (1 feasible, 0 empty at every
+    position, -1 undecided), best margin, its x, y, z interval, the global upper bound of the
+    margin and the tile count."""
     core = _core(leg)
-    sample, branch_bound = core["sample"], core["branch_bound"]
+    branch_bound = core["branch_bound"]
 
-    def bb(U, Bp, P, e0, theta, n, box, h0, min_size, eps, decide, out):
-        W = np.empty((n * n * n, 6, 3))
-        sample(U, Bp, e0, theta, n, W)
-        branch_bound(W, n * n * n, P, box, h0, min_size, eps, decide, out)
+    def bb(W, P, box, h0, min_size, eps, decide, out):
+        branch_bound(W, W.shape[0], P, box, h0, min_size, eps, decide, out)
 
-    f8, i8 = nt.float64, nt.int64
-    return cached_kernel(bb, nt.void(_F2, _F2, _F2, _F1, f8, i8, _F1, f8, f8, f8, nt.boolean,
-                                     _F1), roots=tuple(_raw(core)))
+    f8 = nt.float64
+    return cached_kernel(bb, nt.void(_F3, _F2, _F1, f8, f8, f8, nt.boolean, _F1),
+                         roots=tuple(_raw(core)))
 
 
 @cache
