@@ -33,9 +33,25 @@ wider than ``tol`` when the sample misses orientations that bind or the cell bou
 
 **Needed stroke** (:func:`stroke_needed`) — for an orientation set (a simultaneous box with
 equal half-ranges), the smallest upper actuator limit ``q_max`` (the lower limit kept) for which
-the dexterous workspace is non-empty: ``lower`` the largest ``q_max`` at which the sample admits
-no continuous position (branch and bound), ``upper`` the smallest at which a point is
-certified for the continuous box; both bisected to ``tol`` (0.01 mm).
+the dexterous workspace is non-empty, bracketed by exchange rounds (the cutting-plane method
+of semi-infinite programming):
+
+* ``lower``: the largest ``q_max`` (bisected to ``tol/4``) at which a finite set ``S`` of
+  orientations of the box admits no continuous position (branch and bound). ``S`` starts as
+  the ``n³`` grid; each round adds the *binding orientations* of the sample's best column
+  (:func:`pkmlab.workspaces.binding.binding_orientations`: for every leg, L-BFGS-B over the
+  continuous box minimises the column's upper end ``b_i`` and maximises its lower end
+  ``a_i``, from the sample's most binding orientations, and keeps the optima that bind harder
+  than the sample). ``S`` stays a subset of the box, so every lower end is a proof; how the
+  added orientations are found only decides how fast it rises.
+* ``upper``: the smallest ``q_max`` (bisected to ``tol/4``) at which the sample's best column,
+  at the middle of its z interval, is certified for the continuous box (``cell_budget`` cells
+  per certification). It is run once the binding search no longer shrinks that column's
+  interval by more than ``tol/4`` (the sample then binds the column as the box does).
+
+Rounds stop when ``upper - lower <= tol``, when no binding orientation is found (the upper end
+is then limited by the certification's cell bounds, which need cells of ~1e-5 rad where
+several legs bind at once), or after ``rounds`` rounds; the note says which.
 
 The grid engine's answers lie below these: a grid column is one continuous position.
 """
@@ -70,10 +86,9 @@ STROKE_TOL_MM = 0.01
 MIN_TILE_MM = 1e-4
 #: first tiles of the branch and bound (mm)
 FIRST_TILE_MM = 40.0
-#: smallest orientation cell half-width of the certification (rad); cell budget of one
-#: certification (stroke) and of all the capability's certifications together
+#: smallest orientation cell half-width of the certification (rad); cell budget of all the
+#: capability's certifications together
 MIN_HALF_RAD = 1e-7
-CELL_BUDGET = 300_000
 #: orientation cells of one certification of the needed stroke (a point whose margin is a
 #: few µm needs cells of ~1e-5 rad near the binding orientations: ~1 s for 3e6 cells)
 STROKE_CELL_BUDGET = 3_000_000
@@ -89,8 +104,11 @@ class OptimumBracket:
     """A continuous optimum and the bracket that contains it.
 
     ``lower`` and ``upper`` bound the true value (method in the module notes), ``sampled``
-    is the value for the orientation sample, ``point`` the certified position (mm, base
-    frame) at ``lower``; ``note`` says why a bracket is wider or open."""
+    is the value for the ``samples³`` grid alone, ``point`` the certified position (mm, base
+    frame) at the certified end (``lower`` for the capability, ``upper`` for the needed
+    stroke); ``note`` says why a bracket is wider or open. ``history`` lists the
+    exchange rounds of :func:`stroke_needed` and ``binding`` the orientations (Euler offsets
+    from the box's centre, rad) they added to the ``samples³`` grid."""
 
     name: str
     unit: str
@@ -103,6 +121,7 @@ class OptimumBracket:
     note: str = ""
     seconds: float = 0.0
     history: tuple = ()
+    binding: tuple = ()
 
     @property
     def width(self) -> float:
@@ -244,7 +263,7 @@ def stroke_needed(mech, orientations: OrientationSet, tol_mm: float = STROKE_TOL
     if empty(hi) is not False:
         raise ParameterError("q_max_limit", "a limit at which the set is non-empty", hi)
     s_lo, c_hi, point, sampled = lo, hi, None, math.nan
-    notes, history, added = [], [], 0
+    notes, history, added, undecided = [], [], 0, 0
     guess = hi                 # a limit with a witness for the current sample
     for rnd in range(rounds + 1):
         # lower end: bisection of the (enlarged) sample's needed limit; s_lo stays proved
@@ -253,9 +272,8 @@ def stroke_needed(mech, orientations: OrientationSet, tol_mm: float = STROKE_TOL
         while s_hi - s_lo > 0.25 * tol_mm:
             mid = 0.5 * (s_lo + s_hi)
             e = empty(mid)
-            if e is None:
-                notes.append(f"branch and bound undecided at {mid:.4f} mm")
-                break
+            if e is None:        # not proved empty: the lower end stays below it
+                undecided += 1
             s_lo, s_hi = (mid, s_hi) if e else (s_lo, mid)
         if rnd == 0:
             sampled = s_hi
@@ -264,8 +282,8 @@ def stroke_needed(mech, orientations: OrientationSet, tol_mm: float = STROKE_TOL
         bb(W, params(s_hi), box, FIRST_TILE_MM, MIN_TILE_MM, WITNESS_EPS_MM, False, r)
         xy = (float(r[2]), float(r[3]))
         new, gain = binding_orientations(mech, params(s_hi), xy[0], xy[1], e0, theta, E) \
-            if rnd < rounds and not notes else (np.empty((0, 3)), 0.0)
-        if gain <= 0.25 * tol_mm or rnd == rounds or notes:
+            if rnd < rounds else (np.empty((0, 3)), 0.0)
+        if gain <= 0.25 * tol_mm or rnd == rounds:
             # the sample binds the column as the box does: certify it (upper end)
             if point is None:
                 point = certified(hi, xy)
@@ -283,7 +301,7 @@ def stroke_needed(mech, orientations: OrientationSet, tol_mm: float = STROKE_TOL
         history.append({"round": rnd, "orientations": len(E), "lower": s_lo,
                         "upper": c_hi if point is not None else None,
                         "binding_gain": gain, "seconds": time.perf_counter() - t0})
-        if (point is not None and c_hi - s_lo <= tol_mm) or notes:
+        if point is not None and c_hi - s_lo <= tol_mm:
             break
         if rnd == rounds:
             notes.append(f"stopped after {rounds} exchange rounds at width "
@@ -303,6 +321,10 @@ def stroke_needed(mech, orientations: OrientationSet, tol_mm: float = STROKE_TOL
         guess = s_hi + gain + tol_mm
         if guess < c_hi and empty(guess) is not False:
             guess = c_hi
+    if undecided:
+        notes.append(f"{undecided} branch and bound(s) undecided (margin within 1e-9 mm of "
+                     f"zero on a {MIN_TILE_MM:g} mm tile), counted as not empty: the lower "
+                     "end stays proved")
     return OptimumBracket(
         "stroke_needed", "mm", s_lo, c_hi, sampled, point, n,
         f"upper actuator limit, lower limit {qmin:g} mm kept: branch and bound over "
@@ -310,4 +332,4 @@ def stroke_needed(mech, orientations: OrientationSet, tol_mm: float = STROKE_TOL
         f"found by local optimisation in {len(history) - 1} exchange rounds, lower end), a "
         f"point certified for the continuous ±{math.degrees(theta):g}° box (upper end), "
         f"bisected to {0.25 * tol_mm:g} mm", "; ".join(notes), time.perf_counter() - t0,
-        tuple(history))
+        tuple(history), tuple(map(tuple, E[n ** 3:].tolist())))
