@@ -241,6 +241,10 @@ def stroke_needed(mech, orientations: OrientationSet, tol_mm: float = STROKE_TOL
         bb(W, params(qmax), box, FIRST_TILE_MM, MIN_TILE_MM, 0.0, True, r)
         return {1.0: False, 0.0: True}.get(float(r[0]))
 
+    def profile(qmax):
+        pr = dataclasses.replace(mech, stroke_window=(qmin, qmax)).column_profile()
+        return _kernels.carray(np.full((6, 2, 3), -1.0) if pr is None else pr)
+
     def certified(qmax, xy):
         """The column ``xy`` at the middle of the sample's z interval, if certified for the
         continuous box at qmax; else None."""
@@ -250,7 +254,7 @@ def stroke_needed(mech, orientations: OrientationSet, tol_mm: float = STROKE_TOL
         if not (ok.all() and zh >= zl):
             return None
         p = (float(xy[0]), float(xy[1]), 0.5 * (zl + zh))
-        cert(U, B, P, e0, theta, *p, MIN_HALF_RAD, cell_budget, c)
+        cert(U, B, P, profile(qmax), e0, theta, *p, MIN_HALF_RAD, cell_budget, c)
         return p if c[0] == 1 else None
 
     lo = float(mech.stroke[1])
