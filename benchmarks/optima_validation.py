@@ -109,6 +109,18 @@ def main() -> None:
         b = orientation_capability(psu, n)
         print(f"  {n:2d} | {a:.3f} (+{br:.3f}) | [{b.lower:.4f}, {b.upper:.4f}] "
               f"({b.sampled:.4f}) | {b.seconds:.2f}  point {np.round(b.point, 4)}")
+    # the study's first Pareto design (rounded printed parameters, docs/validation.md): links
+    # near horizontal at its capability, where the first-order cell bounds are loose
+    pareto = load_mechanism({
+        "name": "pareto-1", "family": "psu6", "link_length": "295.6 mm",
+        "generator": {"base_radii": ["100 mm", "132.9 mm"],
+                      "platform_radii": ["29.2 mm", "48.6 mm"], "base_pair_angle": "auto",
+                      "platform_rotation": "27.8 deg", "pairing": "same"},
+        "stroke": ["0 mm", "4 in"], "tool_offset": ["0 mm", "0 mm", "47 mm"]})
+    for n in (5, 9):
+        b = orientation_capability(pareto, n)
+        print(f"  Pareto design, {n:2d} | [{b.lower:.4f}, {b.upper:.4f}] ({b.sampled:.4f}) | "
+              f"{b.seconds:.2f} | {b.method.split('; ')[-1]} | {b.note}")
     print("stroke needed for the ±30° simultaneous set (mm, stroke [0, q_max]): samples | "
           "rounds | [lower, upper] width (grid alone) | seconds | per round: orientations "
           "[lower, upper] s")
@@ -125,7 +137,7 @@ def main() -> None:
     ups = load_mechanism(ROOT / "studies/mechanisms/gough-stewart-6ups.yaml")
     print("6-UPS stroke needed (legs from 390 mm): box | [lower, upper] width (3^3 grid "
           "alone) | seconds | rounds | note")
-    for a in (5.0, 10.0, 20.0, 30.0):
+    for a in (5.0, 10.0, 20.0, 30.0, 60.0):
         b = stroke_needed(ups, OrientationSet.box(np.radians([a] * 3), samples=3))
         print(f"  ±{a:g}° | [{b.lower:.4f}, {b.upper:.4f}] {b.width:.4f} ({b.sampled:.4f}) | "
               f"{b.seconds:.1f} | {len(b.history) - 1} | {b.note}")

@@ -380,8 +380,9 @@ def make_certify(leg):
 
 @cache
 def make_capability(leg):
-    """``cap(U, Bp, P, e0, n, box, h0, theta_max, tol, min_size, min_half, budget, out (12,))``:
-    the orientation capability in one call (module notes). ``out``: theta_lo (certified),
+    """``cap(U, Bp, P, PR, e0, n, box, h0, theta_max, tol, min_size, min_half, budget,
+    out (12,))``: the orientation capability in one call (module notes; ``PR`` the column
+    profile of the certification, or rows with ``K < 0``). ``out``: theta_lo (certified),
     theta_hi (sample empty at every position), sampled theta (witness), its x, y, z, the
     certified point x, y, z, flags (1: not bounded below theta_max, 2: nominal empty, 4: an
     undecided branch and bound, 8: certification undecided or ``budget`` cells spent; one
@@ -389,9 +390,8 @@ def make_capability(leg):
     core = _core(leg)
     sample, branch_bound, certify = core["sample"], core["branch_bound"], core["certify"]
 
-    def cap(U, Bp, P, e0, n, box, h0, theta_max, tol, min_size, min_half, budget, out):
+    def cap(U, Bp, P, PR, e0, n, box, h0, theta_max, tol, min_size, min_half, budget, out):
         M = n * n * n
-        PR = np.full((6, 2, 3), -1.0)         # first-order cell bounds only
         W = np.empty((M, 6, 3))
         r = np.empty(8)
         for k in range(out.shape[0]):
@@ -505,8 +505,8 @@ def make_capability(leg):
         out[9], out[10], out[11] = flags, calls, cells
 
     f8, i8 = nt.float64, nt.int64
-    return cached_kernel(cap, nt.void(_F2, _F2, _F2, _F1, i8, _F1, f8, f8, f8, f8, f8, i8, _F1),
-                         roots=tuple(_raw(core)))
+    return cached_kernel(cap, nt.void(_F2, _F2, _F2, _F3, _F1, i8, _F1, f8, f8, f8, f8, f8, i8,
+                                      _F1), roots=tuple(_raw(core)))
 
 
 def _raw(core):

@@ -149,6 +149,13 @@ def _inputs(mech):
     return e0, U, B, box
 
 
+def _profile(mech):
+    """The family's ``column_profile()`` for the second-order certification (``K = -1``
+    rows: first order only)."""
+    pr = mech.column_profile()
+    return _kernels.carray(np.full((6, 2, 3), -1.0) if pr is None else pr)
+
+
 def _require(mech, constraints=None):
     if not supports_continuous(mech, constraints):
         raise ParameterError("family", "a family with radial column intervals (psu6, ups6) "
@@ -167,7 +174,7 @@ def orientation_capability(mech, samples: int = 7, tol_deg: float = CAPABILITY_T
     P = _kernels.carray(mech.column_params())
     cap = _search.make_capability(type(mech).column_leg)
     out = np.empty(12)
-    cap(U, B, P, e0, int(samples), box, FIRST_TILE_MM, math.radians(max_deg),
+    cap(U, B, P, _profile(mech), e0, int(samples), box, FIRST_TILE_MM, math.radians(max_deg),
         math.radians(tol_deg), MIN_TILE_MM, MIN_HALF_RAD, CAPABILITY_CELL_BUDGET, out)
     flags = int(out[9])
     notes = []
@@ -242,8 +249,7 @@ def stroke_needed(mech, orientations: OrientationSet, tol_mm: float = STROKE_TOL
         return {1.0: False, 0.0: True}.get(float(r[0]))
 
     def profile(qmax):
-        pr = dataclasses.replace(mech, stroke_window=(qmin, qmax)).column_profile()
-        return _kernels.carray(np.full((6, 2, 3), -1.0) if pr is None else pr)
+        return _profile(dataclasses.replace(mech, stroke_window=(qmin, qmax)))
 
     def certified(qmax, xy):
         """The column ``xy`` at the middle of the sample's z interval, if certified for the
