@@ -218,3 +218,32 @@ def test_study_metric_needed_stroke(hopkins, tmp_path):
         study_from_mapping(bad, tmp_path)
     with pytest.raises(ParameterError, match="evaluate.needed_stroke"):
         study_from_mapping(_study(), tmp_path)       # objective without the block
+
+
+def test_second_order_certification_holds_where_links_are_near_horizontal():
+    """The study's first Pareto design (rounded printed parameters): at its capability the
+    links are near horizontal, where the sphere's curvature term matters. The second-order
+    bounds lift the certified lower end from 43.52° (first order) to ≥ 44.0°; the certified
+    point keeps every leg in stroke at 20,000 random orientations, the corners and local
+    minima of its margin (inverse kinematics)."""
+    from pkmlab.workspaces.optima import orientation_capability
+
+    mech = load_mechanism({
+        "name": "pareto-1", "family": "psu6", "link_length": "295.6 mm",
+        "generator": {"base_radii": ["100 mm", "132.9 mm"],
+                      "platform_radii": ["29.2 mm", "48.6 mm"], "base_pair_angle": "auto",
+                      "platform_rotation": "27.8 deg", "pairing": "same"},
+        "stroke": ["0 mm", "4 in"], "tool_offset": ["0 mm", "0 mm", "47 mm"]})
+    b = orientation_capability(mech, 5)
+    assert 44.0 <= b.lower <= b.upper < 44.2              # measured [44.0726, 44.1156]
+    th = math.radians(b.lower)
+    p = np.asarray(b.point)
+    rng = np.random.default_rng(11)
+    E = np.vstack([rng.uniform(-th, th, (20_000, 3)),
+                   np.array(np.meshgrid(*[[-th, th]] * 3)).reshape(3, -1).T])
+    m = _point_margin(mech, p, E)
+    assert m.min() >= -1e-9
+    for e in E[np.argsort(m)[:4]]:
+        r = minimize(lambda v: _point_margin(mech, p, v)[0], e, method="L-BFGS-B",
+                     bounds=[(-th, th)] * 3)
+        assert r.fun >= -1e-9

@@ -28,7 +28,13 @@ the method; in short:
   leg's axis within ``[d - ρ_r, d + ρ_r + ρ_xy²/(2d)]`` (``ρ_r`` the radial component,
   ``ρ_xy`` the horizontal length of the displacement). ``a`` and ``b`` are monotone in ``d``
   and in ``w_z`` (the leg depends on ``z + w_z``), so their extremes over that range are at
-  its corners: the cell is certified when ``z`` lies inside
+  its corners. That first-order bound loses the correlation of ``d`` and ``w_z``; with the
+  family's closed form ``c + σ·sqrt(K - |v|²) - w_z`` (``column_profile()``, ``v`` the
+  horizontal leg vector) a second bound applies: the end's linearisation ``ℓ = (-σv/g, -1)``
+  is bounded exactly over the linearised cell (``δ·Σ_k |ℓ·J_k| + |ℓ|·|e|``), and the sphere's
+  curvature ``K/(K - r_max²)^{3/2}·|Δv|²/2`` is added only on the side where the end is not
+  concave (σ > 0) or convex (σ < 0), where the cell keeps ``|v| < sqrt(K)``. A leg holds on
+  the cell when either bound shows it. The cell is certified when ``z`` lies inside
   every leg's guaranteed interval, refuted when the centre orientation itself fails, split in
   eight otherwise.
 * :func:`make_capability`: the whole orientation-capability search in one call — bisection on

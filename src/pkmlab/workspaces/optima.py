@@ -19,8 +19,11 @@ dexterous workspace of the continuous box is non-empty). One compiled call
 * ``lower``: a point ``p`` (reported) certified for the continuous box: the box is split into
   cells, and on a cell each leg's offset ``w = R·u - b`` stays within ``|u|·3δ`` of its value
   at the cell's centre (δ the cell's half-width), so the leg's interval is bounded from the
-  interval at the ball's extreme distances and heights; cells are split until every cell is
-  certified (or one's centre orientation fails ``p``). The point is the best one (largest
+  interval at the ball's extreme distances and heights (first order), or, for families
+  with a ``column_profile()`` (closed-form leg ends ``c + σ·sqrt(K - d²) - w_z``), by the
+  end's linearisation over the cell plus the rotation's and the sphere's second-order
+  remainders (whichever certifies); cells are split until every cell is certified (or one's
+  centre orientation fails ``p``). The point is the best one (largest
   margin, to 0.01 mm) within 5 mm of the sample's witness, against the sample at that ``θ``
   plus the orientations that refuted earlier points. ``θ`` steps down from the sampled level
   in doubling steps until a level is certified, then is bisected to ``tol``, within a budget
@@ -50,8 +53,8 @@ of semi-infinite programming):
   interval by more than ``tol/4`` (the sample then binds the column as the box does).
 
 Rounds stop when ``upper - lower <= tol``, when no binding orientation is found (the upper end
-is then limited by the certification's cell bounds, which need cells of ~1e-5 rad where
-several legs bind at once), or after ``rounds`` rounds; the note says which.
+is then limited by the certification's cell bounds), or after ``rounds`` rounds; the note says
+which.
 
 The grid engine's answers lie below these: a grid column is one continuous position.
 """
@@ -90,7 +93,7 @@ FIRST_TILE_MM = 40.0
 #: capability's certifications together
 MIN_HALF_RAD = 1e-7
 #: orientation cells of one certification of the needed stroke (a point whose margin is a
-#: few µm needs cells of ~1e-5 rad near the binding orientations: ~1 s for 3e6 cells)
+#: few µm needs small cells near the binding orientations; 3e6 cells take ~1 s)
 STROKE_CELL_BUDGET = 3_000_000
 #: exchange rounds of the needed stroke (each adds at most 12 binding orientations)
 STROKE_ROUNDS = 8
