@@ -212,6 +212,14 @@ def test_study_metric_needed_stroke(hopkins, tmp_path):
     assert metrics["needed_stroke"] == pytest.approx(ref.upper - hopkins.stroke[0])
     assert metrics["needed_stroke_lower"] == pytest.approx(ref.lower - hopkins.stroke[0])
     assert 0.0 < metrics["needed_stroke_bracket"] <= 0.01
+    # the workspace's own actuator window: its lower limit is the one kept
+    win = _study(needed_stroke=True)
+    win["evaluate"]["workspace"]["constraints"] = {"stroke": ["20 mm", "4 in"]}
+    m2, _ = evaluate_mechanism(hopkins, study_from_mapping(win, tmp_path).evaluation, 1)
+    ref2 = stroke_needed(dataclasses.replace(hopkins, stroke_window=(20.0, 101.6)),
+                         OrientationSet.box(np.radians([10.0] * 3), samples=3))
+    assert m2["needed_stroke"] == pytest.approx(ref2.upper - 20.0)
+    assert m2["needed_stroke"] != pytest.approx(metrics["needed_stroke"], abs=1e-3)
     bad = _study(needed_stroke=True)
     bad["evaluate"]["workspace"]["semantics"] = "single-axis"
     with pytest.raises(ParameterError, match="evaluate.needed_stroke"):

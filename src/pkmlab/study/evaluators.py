@@ -19,6 +19,7 @@ Evaluators never print, plot or write files.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import time
@@ -213,11 +214,15 @@ def _capability(mech, ctx: Context) -> dict:
 @_evaluator("needed_stroke")
 def _needed_stroke(mech, ctx: Context) -> dict:
     """The needed travel over continuous positions (:func:`pkmlab.workspaces.optima.
-    stroke_needed`); null with a note for other families or constraints, or when no upper
-    limit up to the search's cap gives a position."""
+    stroke_needed`), the lower limit of the workspace's actuator window kept; null with a
+    note for other families or constraints, or when no upper limit up to the search's cap
+    gives a position."""
     req = ctx.evaluation.request
     names = metrics_of("needed_stroke")
     why = None
+    cons = req["constraints"].resolved(mech)
+    if cons.stroke is not True:          # the workspace's window: its lower limit is kept
+        mech = dataclasses.replace(mech, stroke_window=cons.stroke)
     if not supports_continuous(mech, req["constraints"]):
         why = (f"no continuous search for family {mech.family!r} or constraints beyond the "
                "stroke")
