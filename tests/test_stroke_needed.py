@@ -176,7 +176,7 @@ def test_stroke_needed_refuses_bad_requests(hopkins):
                       rounds=-1)
 
 
-def test_cli_optimum_stroke_json_text_and_refusals():
+def test_cli_optimum_json_text_and_refusals():
     r = runner.invoke(app, ["optimum", "stroke", str(HOPKINS), "--box", "30deg",
                             "--samples", "3", "--json"])
     assert r.exit_code == 0, r.output
@@ -192,6 +192,12 @@ def test_cli_optimum_stroke_json_text_and_refusals():
     assert "family: must be a family with radial column intervals" in r.stderr
     r = runner.invoke(app, ["optimum", "stroke", str(HOPKINS), "--box", "0"])
     assert r.exit_code == 2 and "--box: must be a half-range in (0, 180] deg" in r.stderr
+    r = runner.invoke(app, ["optimum", "capability", str(HOPKINS), "--json"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert d["unit"] == "deg" and 23.1 < d["lower"] <= d["upper"] < 23.2 and d["width"] <= 0.01
+    r = runner.invoke(app, ["optimum", "capability", str(HOPKINS), "--samples", "1"])
+    assert r.exit_code == 2 and "--samples: must be an integer in [2, 41]" in r.stderr
 
 
 def _study(**evaluate) -> dict:
