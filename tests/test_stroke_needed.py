@@ -19,7 +19,7 @@ from pkmlab.cli import app
 from pkmlab.errors import ParameterError
 from pkmlab.mechanisms import NO_STROKE
 from pkmlab.poses import euler_to_matrix
-from pkmlab.study import study_from_mapping
+from pkmlab.study import SerialRunner, run_study, study_from_mapping
 from pkmlab.study.evaluators import evaluate_mechanism
 from pkmlab.workspaces import OrientationSet
 from pkmlab.workspaces.optima import stroke_needed
@@ -226,6 +226,14 @@ def test_study_metric_needed_stroke(hopkins, tmp_path):
                          OrientationSet.box(np.radians([10.0] * 3), samples=3))
     assert m2["needed_stroke"] == pytest.approx(ref2.upper - 20.0)
     assert m2["needed_stroke"] != pytest.approx(metrics["needed_stroke"], abs=1e-3)
+    # a tiny study run: the metric is stored for every candidate
+    data = _study(needed_stroke=True) | {"output": str(tmp_path / "out")}
+    store = run_study(study_from_mapping(data, tmp_path), SerialRunner())
+    records = store.all()
+    store.close()
+    assert len(records) == 3 and all(r["status"] == "ok" for r in records)
+    assert all(0 < r["metrics"]["needed_stroke_bracket"] <= 0.01 for r in records)
+    assert len({round(r["metrics"]["needed_stroke"], 3) for r in records}) == 3
     bad = _study(needed_stroke=True)
     bad["evaluate"]["workspace"]["semantics"] = "single-axis"
     with pytest.raises(ParameterError, match="evaluate.needed_stroke"):
