@@ -113,17 +113,17 @@ def test_capability_bracket_holds_independently(hopkins):
 
 def test_stroke_needed_bracket(hopkins):
     """The ±30° set of Hopkins & Williams: the stroke (0 to q_max) it needs is bracketed, the
-    certified point holds at dense orientations, and the sample at the lower end admits no
-    position (local search)."""
+    certified point holds at dense orientations, and the search's sample (grid plus binding
+    orientations) at the lower end admits no position (local search)."""
     o = OrientationSet.box(np.radians([30.0] * 3), samples=5)
     b = stroke_needed(hopkins, o)
-    assert b.lower <= b.sampled <= b.upper and 128.0 < b.lower and b.upper < 134.0
+    assert b.sampled <= b.lower <= b.upper and 128.0 < b.lower and b.upper < 134.0
     mech = dataclasses.replace(hopkins, stroke_window=(0.0, b.upper))
     th = math.radians(30.0)
     E = np.random.default_rng(5).uniform(-th, th, (20_000, 3))
     assert _point_margin(mech, np.asarray(b.point), E).min() >= -1e-9
     low = dataclasses.replace(hopkins, stroke_window=(0.0, b.lower))
-    Rs = euler_to_matrix(o.parameters())
+    Rs = euler_to_matrix(np.vstack([o.parameters(), np.asarray(b.binding).reshape(-1, 3)]))
     res = minimize(lambda v: -np.subtract(*_psu_margin_at(low, v[0], v[1], Rs)[::-1]),
                    np.asarray(b.point[:2]), method="Nelder-Mead", options={"xatol": 1e-7})
     assert -res.fun < 0.0

@@ -18,7 +18,7 @@ from typing import Annotated
 
 import typer
 
-from . import analysis, kinematics, study, workspace  # noqa: F401 - registers the commands
+from . import analysis, kinematics, optimum, study, workspace  # noqa: F401 - registers them
 from .common import app
 
 __all__ = ["app", "main"]

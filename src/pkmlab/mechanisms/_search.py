@@ -28,7 +28,13 @@ the method; in short:
   leg's axis within ``[d - ρ_r, d + ρ_r + ρ_xy²/(2d)]`` (``ρ_r`` the radial component,
   ``ρ_xy`` the horizontal length of the displacement). ``a`` and ``b`` are monotone in ``d``
   and in ``w_z`` (the leg depends on ``z + w_z``), so their extremes over that range are at
-  its corners: the cell is certified when ``z`` lies inside
+  its corners. That first-order bound loses the correlation of ``d`` and ``w_z``; with the
+  family's closed form ``c + σ·sqrt(K - |v|²) - w_z`` (``column_profile()``, ``v`` the
+  horizontal leg vector) a second bound applies: the end's linearisation ``ℓ = (-σv/g, -1)``
+  is bounded exactly over the linearised cell (``δ·Σ_k |ℓ·J_k| + |ℓ|·|e|``), and the sphere's
+  curvature ``K/(K - r_max²)^{3/2}·|Δv|²/2`` is added only on the side where the end is not
+  concave (σ > 0) or convex (σ < 0), where the cell keeps ``|v| < sqrt(K)``. A leg holds on
+  the cell when either bound shows it. The cell is certified when ``z`` lies inside
   every leg's guaranteed interval, refuted when the centre orientation itself fails, split in
   eight otherwise.
 * :func:`make_capability`: the whole orientation-capability search in one call — bisection on
@@ -63,6 +69,8 @@ LOCAL_MM = 5.0
 #: per level
 CUTS = 64
 CUTS_PER_LEVEL = 6
+#: padding (mm) of the second-order certification bounds against rounding
+TPAD = 1e-8
 #: initial capacity of the tile and cell stacks (grown when needed)
 STACK = 4096
 
@@ -206,10 +214,12 @@ def _core(leg):
         out[BB_STATUS], out[BB_F], out[BB_X], out[BB_Y] = status, best, bx, by
         out[BB_ZLO], out[BB_ZHI], out[BB_UB], out[BB_TILES] = bzl, bzh, max(gub, best), tiles
 
-    def certify(U, Bp, P, e0, theta, x, y, z, min_half, budget, bad):
+    def certify(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, bad):
         """1: ``(x, y, z)`` holds for every orientation of the box e0 ± theta; 0: refuted (an
         orientation of the box fails it, written to ``bad``); -1: undecided (cells below
-        ``min_half`` rad or more than ``budget`` cells). Returns ``(status, cells)``."""
+        ``min_half`` rad or more than ``budget`` cells). ``PR (6, 2, 3)``: the family's
+        ``column_profile()`` (second-order bounds; ``K < 0`` rows: first order only).
+        Returns ``(status, cells)``."""
         ulen = np.empty(6)
         for s in range(6):
             ulen[s] = math.sqrt(U[s, 0] ** 2 + U[s, 1] ** 2 + U[s, 2] ** 2)
@@ -274,7 +284,35 @@ def _core(leg):
                         amax = np.inf
                     amax = max(amax, a)
                     bmin = min(bmin, b)
-                if not (amax <= z <= bmin):
+                if amax <= z <= bmin:
+                    continue
+                # second order from the closed form c + σ·sqrt(K - |v|²) - w_z, v = s_xy:
+                # linear part exact over the linearised cell, remainder of R·u (r2) through
+                # |ℓ|, and the sphere's curvature on the side where the end is not concave
+                # (σ > 0) / convex (σ < 0); only where |v| stays below sqrt(K) on the cell
+                rmax = d + rho_xy + DPAD
+                ok2 = True
+                for e in range(2):
+                    c0, sg, K = PR[s, e, 0], PR[s, e, 1], PR[s, e, 2]
+                    if not rmax * rmax < K * (1.0 - 1e-12):
+                        ok2 = False
+                        break
+                    g0 = math.sqrt(K - d * d)
+                    lx, ly = -sg * sx / g0, -sg * sy / g0          # ℓ = (lx, ly, -1)
+                    lin = dl * (abs(lx * jxx + ly * jxy - jxz) + abs(lx * jyx + ly * jyy - jyz)
+                                + abs(lx * jzx + ly * jzy - jzz)) \
+                        + math.sqrt(lx * lx + ly * ly + 1.0) * r2
+                    curv = 0.5 * K / (K - rmax * rmax) ** 1.5 * rho_xy * rho_xy
+                    E0 = c0 + sg * g0 - wz
+                    if e == 0:          # lower end: its largest value over the cell
+                        top = E0 + lin + (curv if sg < 0.0 else 0.0) + TPAD
+                        if not top <= z:
+                            ok2 = False
+                    else:               # upper end: its smallest value
+                        bot = E0 - lin - (curv if sg > 0.0 else 0.0) - TPAD
+                        if not z <= bot:
+                            ok2 = False
+                if not ok2:
                     good = False
             if good or dl == 0.0:
                 continue
@@ -312,44 +350,45 @@ _F1, _F2, _F3 = nt.float64[::1], nt.float64[:, ::1], nt.float64[:, :, ::1]
 
 @cache
 def make_branch_bound(leg):
-    """``bb(U (6, 3), Bp (6, 3), P (6, 3), e0 (3,), theta, n, box (4,), h0, min_size, eps,
-    decide, out (8,))``: branch and bound over continuous positions for the ±theta box
-    sampled with n angles per axis (see the module notes); ``out`` gets status (1 feasible, 0
-    empty at every position, -1 undecided), best margin, its x, y, z interval, the global upper
-    bound of the margin and the tile count."""
+    """``bb(W (M, 6, 3), P (6, 3), box (4,), h0, min_size, eps, decide, out (8,))``: branch
+    and bound over continuous positions for the orientation sample whose leg offsets
+    ``w = R·u - b`` are ``W`` (any orientations: a grid of the box, plus the binding ones the
+    caller adds; see the module notes); ``out`` gets status (1 feasible, 0 empty at every
+    position, -1 undecided), best margin, its x, y, z interval, the global upper bound of the
+    margin and the tile count."""
     core = _core(leg)
-    sample, branch_bound = core["sample"], core["branch_bound"]
+    branch_bound = core["branch_bound"]
 
-    def bb(U, Bp, P, e0, theta, n, box, h0, min_size, eps, decide, out):
-        W = np.empty((n * n * n, 6, 3))
-        sample(U, Bp, e0, theta, n, W)
-        branch_bound(W, n * n * n, P, box, h0, min_size, eps, decide, out)
-
-    f8, i8 = nt.float64, nt.int64
-    return cached_kernel(bb, nt.void(_F2, _F2, _F2, _F1, f8, i8, _F1, f8, f8, f8, nt.boolean,
-                                     _F1), roots=tuple(_raw(core)))
-
-
-@cache
-def make_certify(leg):
-    """``cert(U, Bp, P, e0, theta, x, y, z, min_half, budget, out (2,))``: certification of
-    one point over the continuous box (module notes); out = (status, cells)."""
-    core = _core(leg)
-    certify = core["certify"]
-
-    def cert(U, Bp, P, e0, theta, x, y, z, min_half, budget, out):
-        s, c = certify(U, Bp, P, e0, theta, x, y, z, min_half, budget, np.empty(3))
-        out[0], out[1] = s, c
+    def bb(W, P, box, h0, min_size, eps, decide, out):
+        branch_bound(W, W.shape[0], P, box, h0, min_size, eps, decide, out)
 
     f8 = nt.float64
-    return cached_kernel(cert, nt.void(_F2, _F2, _F2, _F1, f8, f8, f8, f8, f8, nt.int64, _F1),
+    return cached_kernel(bb, nt.void(_F3, _F2, _F1, f8, f8, f8, nt.boolean, _F1),
                          roots=tuple(_raw(core)))
 
 
 @cache
+def make_certify(leg):
+    """``cert(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, out (2,))``: certification
+    of one point over the continuous box (module notes; ``PR`` the column profile or rows
+    with ``K < 0``); out = (status, cells)."""
+    core = _core(leg)
+    certify = core["certify"]
+
+    def cert(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, out):
+        s, c = certify(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, np.empty(3))
+        out[0], out[1] = s, c
+
+    f8 = nt.float64
+    return cached_kernel(cert, nt.void(_F2, _F2, _F2, _F3, _F1, f8, f8, f8, f8, f8, nt.int64,
+                                       _F1), roots=tuple(_raw(core)))
+
+
+@cache
 def make_capability(leg):
-    """``cap(U, Bp, P, e0, n, box, h0, theta_max, tol, min_size, min_half, budget, out (12,))``:
-    the orientation capability in one call (module notes). ``out``: theta_lo (certified),
+    """``cap(U, Bp, P, PR, e0, n, box, h0, theta_max, tol, min_size, min_half, budget,
+    out (12,))``: the orientation capability in one call (module notes; ``PR`` the column
+    profile of the certification, or rows with ``K < 0``). ``out``: theta_lo (certified),
     theta_hi (sample empty at every position), sampled theta (witness), its x, y, z, the
     certified point x, y, z, flags (1: not bounded below theta_max, 2: nominal empty, 4: an
     undecided branch and bound, 8: certification undecided or ``budget`` cells spent; one
@@ -357,7 +396,7 @@ def make_capability(leg):
     core = _core(leg)
     sample, branch_bound, certify = core["sample"], core["branch_bound"], core["certify"]
 
-    def cap(U, Bp, P, e0, n, box, h0, theta_max, tol, min_size, min_half, budget, out):
+    def cap(U, Bp, P, PR, e0, n, box, h0, theta_max, tol, min_size, min_half, budget, out):
         M = n * n * n
         W = np.empty((M, 6, 3))
         r = np.empty(8)
@@ -444,7 +483,8 @@ def make_capability(leg):
                 if not r[BB_F] >= 0.0:
                     break
                 px, py, pz = r[BB_X], r[BB_Y], 0.5 * (r[BB_ZLO] + r[BB_ZHI])
-                st, c = certify(U, Bp, P, e0, mid, px, py, pz, min_half, budget // 8, bad)
+                st, c = certify(U, Bp, P, PR, e0, mid, px, py, pz, min_half, budget // 8,
+                                bad)
                 cells += c
                 if st == 1:
                     ok = True
@@ -471,8 +511,8 @@ def make_capability(leg):
         out[9], out[10], out[11] = flags, calls, cells
 
     f8, i8 = nt.float64, nt.int64
-    return cached_kernel(cap, nt.void(_F2, _F2, _F2, _F1, i8, _F1, f8, f8, f8, f8, f8, i8, _F1),
-                         roots=tuple(_raw(core)))
+    return cached_kernel(cap, nt.void(_F2, _F2, _F2, _F3, _F1, i8, _F1, f8, f8, f8, f8, f8, i8,
+                                      _F1), roots=tuple(_raw(core)))
 
 
 def _raw(core):

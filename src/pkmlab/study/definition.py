@@ -51,6 +51,7 @@ class Evaluation:
     payload: object | None = None           # requirements.spec.PayloadPlan
     actuators: object | None = None         # requirements.spec.ActuatorsPlan
     volume_bracket: object | None = None    # spec.VolumeBracketSpec
+    needed_stroke: bool = False
 
     @property
     def evaluators(self) -> tuple[str, ...]:
@@ -58,8 +59,8 @@ class Evaluation:
         names = ["geometry"]
         if self.workspace is not None:
             names.append("workspace")
-            names += [n for n in ("inscribed", "orientation_capability", "volume_bracket")
-                      if getattr(self, n)]
+            names += [n for n in ("inscribed", "orientation_capability", "needed_stroke",
+                                  "volume_bracket") if getattr(self, n)]
             if self.dexterity is not None:
                 names.append("dexterity")
             if self.payload is not None:
@@ -158,6 +159,8 @@ class Study:
                 evaluate[block] = plan.source
         if ev.volume_bracket is not None:
             evaluate["volume_bracket"] = ev.volume_bracket.model_dump()
+        if ev.needed_stroke:
+            evaluate["needed_stroke"] = True
         return {
             "study": self.name, "description": self.description,
             "mechanism": {"inline": to_display(self.space.base_spec)},

@@ -19,6 +19,7 @@ Evaluators never print, plot or write files.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import time
@@ -39,7 +40,7 @@ from ..trajectory import check_trajectory, paper_motion
 from ..workspaces import OrientationSet, workspace
 from ..workspaces.bracket import volume_bracket
 from ..workspaces.engine import SINGULAR_NOTE
-from ..workspaces.optima import orientation_capability, supports_continuous
+from ..workspaces.optima import orientation_capability, stroke_needed, supports_continuous
 from .metrics import metrics_of
 
 log = logging.getLogger(__name__)
@@ -208,6 +209,37 @@ def _capability(mech, ctx: Context) -> dict:
         if out[name] is None:
             ctx.notes[name] = "no upper end: the search's largest box has a dexterous position"
     return out
+
+
+@_evaluator("needed_stroke")
+def _needed_stroke(mech, ctx: Context) -> dict:
+    """The needed travel over continuous positions (:func:`pkmlab.workspaces.optima.
+    stroke_needed`), the lower limit of the workspace's actuator window kept; null with a
+    note for other families or constraints, or when no upper limit up to the search's cap
+    gives a position."""
+    req = ctx.evaluation.request
+    names = metrics_of("needed_stroke")
+    why = None
+    cons = req["constraints"].resolved(mech)
+    if cons.stroke is not True:          # the workspace's window: its lower limit is kept
+        mech = dataclasses.replace(mech, stroke_window=cons.stroke)
+    if not supports_continuous(mech, req["constraints"]):
+        why = (f"no continuous search for family {mech.family!r} or constraints beyond the "
+               "stroke")
+    else:
+        try:
+            b = stroke_needed(mech, req["orientations"])
+        except ParameterError as exc:
+            why = f"no needed stroke: {exc}"
+    if why is not None:
+        for n in names:
+            ctx.notes[n] = why
+        return dict.fromkeys(names)
+    q0 = float(mech.stroke[0])
+    if b.note:
+        ctx.notes["needed_stroke_bracket"] = b.note
+    return {"needed_stroke": b.upper - q0, "needed_stroke_lower": b.lower - q0,
+            "needed_stroke_bracket": b.width}
 
 
 @_evaluator("dexterity")

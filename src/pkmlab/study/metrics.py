@@ -14,6 +14,8 @@ Kinds of number (``statistic``):
   required motion and every actuator;
 * ``bound`` — a bracketed optimum: the value is the largest verified level, the bracket
   (``<name>_bracket``, and ``<name>_upper`` where given) how far above it the truth can be;
+  for a smallest value (``needed_stroke``) the value is the certified level and the truth
+  lies at most the bracket below it (``<name>_lower``);
 * ``sampled`` — a Monte-Carlo statistic over random poses (its name says so, or it carries a
   standard error);
 * ``flag`` — 1 or 0;
@@ -112,6 +114,19 @@ _ALL = [
     Metric("orientation_capability_bracket", "orientation_capability", "deg", "bound",
            "orientation_capability_upper - orientation_capability (the bisections run to "
            "0.01°)"),
+    # needed stroke (continuous optimum, psu6 / ups6)
+    Metric("needed_stroke", "needed_stroke", "mm", "bound",
+           "smallest actuator travel (upper limit − lower limit, the lower limit kept) at "
+           "which the workspace's simultaneous Euler box has a dexterous position: upper end "
+           "of the bracket, a position certified for the continuous box (psu6, ups6, stroke "
+           "only; null with a note otherwise): the one to minimise"),
+    Metric("needed_stroke_lower", "needed_stroke", "mm", "bound",
+           "lower end of the bracket: below it a sample of the box (grid plus binding "
+           "orientations found by local optimisation) admits no position, proved by branch "
+           "and bound over continuous positions"),
+    Metric("needed_stroke_bracket", "needed_stroke", "mm", "bound",
+           "needed_stroke - needed_stroke_lower (the search stops at 0.01 mm, or says in a "
+           "note why it stopped wider)"),
     # dexterity
     Metric("nominal_kappa", "dexterity", "", "exact",
            "κ of the homogenised Jacobian at the nominal pose"),

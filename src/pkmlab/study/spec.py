@@ -119,6 +119,10 @@ class EvaluateSpec(_Model):
                                              "'pkmlab workspace'): kind, box or tilt, ...")
     inscribed: bool = False
     orientation_capability: bool = False
+    needed_stroke: bool = Field(False, description="the smallest actuator travel at which the "
+                                "workspace's simultaneous Euler box (equal half-ranges) has a "
+                                "dexterous position, bracketed (needed_stroke, _lower, "
+                                "_bracket)")
     volume_bracket: VolumeBracketSpec | None = Field(
         None, description="guaranteed volume bracket over the continuous orientation set "
         "(workspace_volume_lower / _upper): budget (s), target (relative width)")
@@ -290,7 +294,7 @@ def _metric(name: Any, where: str, evaluation: Evaluation) -> str:
         raise ParameterError(where, f"a metric the evaluation computes (add evaluate.{need}"
                              + (" and evaluate.workspace" if need in ("inscribed",
                                 "orientation_capability", "dexterity", "payload",
-                                "volume_bracket") else "") + ")", name)
+                                "volume_bracket", "needed_stroke") else "") + ")", name)
     return name
 
 
@@ -301,6 +305,12 @@ def _evaluation(ev: EvaluateSpec, base: Path) -> Evaluation:
         if getattr(ev, block) not in (None, False) and ws is None:
             raise ParameterError(f"evaluate.{block}", "used with an evaluate.workspace block "
                                  "(it is computed over that workspace)", "no workspace")
+    if ev.needed_stroke:
+        o = ws.build()["orientations"]
+        if o.kind != "box" or o.semantics != "simultaneous" or len(set(o.angles)) != 1:
+            raise ParameterError("evaluate.needed_stroke", "used with a simultaneous Euler box "
+                                 "with equal half-ranges in evaluate.workspace",
+                                 o.describe())
     dx = ev.dexterity
     return Evaluation(
         workspace=ws, request=None if ws is None else ws.build(),
@@ -309,7 +319,8 @@ def _evaluation(ev: EvaluateSpec, base: Path) -> Evaluation:
                                                         dx.gci_samples, dx.force_limit),
         trajectory=None if ev.trajectory is None else TrajectoryPlan(
             ev.trajectory.segment_time, ev.trajectory.payload),
-        volume_bracket=ev.volume_bracket, **_requirements(ev, base))
+        volume_bracket=ev.volume_bracket, needed_stroke=ev.needed_stroke,
+        **_requirements(ev, base))
 
 
 def _requirements(ev: EvaluateSpec, base: Path) -> dict:

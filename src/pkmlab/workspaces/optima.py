@@ -19,8 +19,11 @@ dexterous workspace of the continuous box is non-empty). One compiled call
 * ``lower``: a point ``p`` (reported) certified for the continuous box: the box is split into
   cells, and on a cell each leg's offset ``w = R·u - b`` stays within ``|u|·3δ`` of its value
   at the cell's centre (δ the cell's half-width), so the leg's interval is bounded from the
-  interval at the ball's extreme distances and heights; cells are split until every cell is
-  certified (or one's centre orientation fails ``p``). The point is the best one (largest
+  interval at the ball's extreme distances and heights (first order), or, for families
+  with a ``column_profile()`` (closed-form leg ends ``c + σ·sqrt(K - d²) - w_z``), by the
+  end's linearisation over the cell plus the rotation's and the sphere's second-order
+  remainders (whichever certifies); cells are split until every cell is certified (or one's
+  centre orientation fails ``p``). The point is the best one (largest
   margin, to 0.01 mm) within 5 mm of the sample's witness, against the sample at that ``θ``
   plus the orientations that refuted earlier points. ``θ`` steps down from the sampled level
   in doubling steps until a level is certified, then is bisected to ``tol``, within a budget
@@ -33,9 +36,25 @@ wider than ``tol`` when the sample misses orientations that bind or the cell bou
 
 **Needed stroke** (:func:`stroke_needed`) — for an orientation set (a simultaneous box with
 equal half-ranges), the smallest upper actuator limit ``q_max`` (the lower limit kept) for which
-the dexterous workspace is non-empty: ``lower`` the largest ``q_max`` at which the sample admits
-no continuous position (branch and bound), ``upper`` the smallest at which a point is
-certified for the continuous box; both bisected to ``tol`` (0.01 mm).
+the dexterous workspace is non-empty, bracketed by exchange rounds (the cutting-plane method
+of semi-infinite programming):
+
+* ``lower``: the largest ``q_max`` (bisected to ``tol/4``) at which a finite set ``S`` of
+  orientations of the box admits no continuous position (branch and bound). ``S`` starts as
+  the ``n³`` grid; each round adds the *binding orientations* of the sample's best column
+  (:func:`pkmlab.workspaces.binding.binding_orientations`: for every leg, L-BFGS-B over the
+  continuous box minimises the column's upper end ``b_i`` and maximises its lower end
+  ``a_i``, from the sample's most binding orientations, and keeps the optima that bind harder
+  than the sample). ``S`` stays a subset of the box, so every lower end is a proof; how the
+  added orientations are found only decides how fast it rises.
+* ``upper``: the smallest ``q_max`` (bisected to ``tol/4``) at which the sample's best column,
+  at the middle of its z interval, is certified for the continuous box (``cell_budget`` cells
+  per certification). It is run once the binding search no longer shrinks that column's
+  interval by more than ``tol/4`` (the sample then binds the column as the box does).
+
+Rounds stop when ``upper - lower <= tol``, when no binding orientation is found (the upper end
+is then limited by the certification's cell bounds), or after ``rounds`` rounds; the note says
+which.
 
 The grid engine's answers lie below these: a grid column is one continuous position.
 """
@@ -53,7 +72,8 @@ import numpy as np
 from ..errors import ParameterError
 from ..limits import CAPABILITY_MAX_DEG
 from ..mechanisms import _kernels, _search
-from ..poses import as_frames, matrix_to_euler
+from ..poses import as_frames, euler_to_matrix, matrix_to_euler
+from .binding import binding_orientations, column_ends
 from .orientations import OrientationSet
 
 log = logging.getLogger(__name__)
@@ -69,10 +89,16 @@ STROKE_TOL_MM = 0.01
 MIN_TILE_MM = 1e-4
 #: first tiles of the branch and bound (mm)
 FIRST_TILE_MM = 40.0
-#: smallest orientation cell half-width of the certification (rad); cell budget of one
-#: certification (stroke) and of all the capability's certifications together
+#: smallest orientation cell half-width of the certification (rad); cell budget of all the
+#: capability's certifications together
 MIN_HALF_RAD = 1e-7
-CELL_BUDGET = 300_000
+#: orientation cells of one certification of the needed stroke (a point whose margin is a
+#: few µm needs small cells near the binding orientations; 3e6 cells take ~1 s)
+STROKE_CELL_BUDGET = 3_000_000
+#: exchange rounds of the needed stroke (each adds at most 12 binding orientations)
+STROKE_ROUNDS = 8
+#: the witness column of a sample is its best one to this margin (mm)
+WITNESS_EPS_MM = 1e-3
 CAPABILITY_CELL_BUDGET = 600_000
 
 
@@ -81,8 +107,11 @@ class OptimumBracket:
     """A continuous optimum and the bracket that contains it.
 
     ``lower`` and ``upper`` bound the true value (method in the module notes), ``sampled``
-    is the value for the orientation sample, ``point`` the certified position (mm, base
-    frame) at ``lower``; ``note`` says why a bracket is wider or open."""
+    is the value for the ``samples³`` grid alone, ``point`` the certified position (mm, base
+    frame) at the certified end (``lower`` for the capability, ``upper`` for the needed
+    stroke); ``note`` says why a bracket is wider or open. ``history`` lists the
+    exchange rounds of :func:`stroke_needed` and ``binding`` the orientations (Euler offsets
+    from the box's centre, rad) they added to the ``samples³`` grid."""
 
     name: str
     unit: str
@@ -94,6 +123,8 @@ class OptimumBracket:
     method: str
     note: str = ""
     seconds: float = 0.0
+    history: tuple = ()
+    binding: tuple = ()
 
     @property
     def width(self) -> float:
@@ -121,6 +152,13 @@ def _inputs(mech):
     return e0, U, B, box
 
 
+def _profile(mech):
+    """The family's ``column_profile()`` for the second-order certification (``K = -1``
+    rows: first order only)."""
+    pr = mech.column_profile()
+    return _kernels.carray(np.full((6, 2, 3), -1.0) if pr is None else pr)
+
+
 def _require(mech, constraints=None):
     if not supports_continuous(mech, constraints):
         raise ParameterError("family", "a family with radial column intervals (psu6, ups6) "
@@ -139,7 +177,7 @@ def orientation_capability(mech, samples: int = 7, tol_deg: float = CAPABILITY_T
     P = _kernels.carray(mech.column_params())
     cap = _search.make_capability(type(mech).column_leg)
     out = np.empty(12)
-    cap(U, B, P, e0, int(samples), box, FIRST_TILE_MM, math.radians(max_deg),
+    cap(U, B, P, _profile(mech), e0, int(samples), box, FIRST_TILE_MM, math.radians(max_deg),
         math.radians(tol_deg), MIN_TILE_MM, MIN_HALF_RAD, CAPABILITY_CELL_BUDGET, out)
     flags = int(out[9])
     notes = []
@@ -165,52 +203,71 @@ def orientation_capability(mech, samples: int = 7, tol_deg: float = CAPABILITY_T
         "; ".join(notes), time.perf_counter() - t0)
 
 
+def _box_sample(theta: float, n: int) -> np.ndarray:
+    """``(n³, 3)`` Euler offsets of the ±theta box, n angles per axis, corners included."""
+    ax = np.linspace(-theta, theta, n)
+    return np.stack([g.ravel() for g in np.meshgrid(ax, ax, ax, indexing="ij")], axis=1)
+
+
 def stroke_needed(mech, orientations: OrientationSet, tol_mm: float = STROKE_TOL_MM,
-                  q_max_limit: float | None = None) -> OptimumBracket:
+                  q_max_limit: float | None = None,
+                  rounds: int = STROKE_ROUNDS,
+                  cell_budget: int = STROKE_CELL_BUDGET) -> OptimumBracket:
     """The smallest upper actuator limit giving a non-empty dexterous workspace over the
     simultaneous box ``orientations`` (equal half-ranges), the lower limit kept, bracketed
-    (module notes). ``q_max_limit`` caps the search (default: lower limit + 4 × scale)."""
+    (module notes). ``q_max_limit`` caps the search (default: lower limit + 4 × scale);
+    ``rounds`` caps the exchange rounds that add binding orientations to the sample,
+    ``cell_budget`` the orientation cells of one certification."""
     _require(mech)
     if orientations.kind != "box" or orientations.semantics != "simultaneous" or \
             len(set(orientations.angles)) != 1:
         raise ParameterError("orientations", "a simultaneous box with equal half-ranges",
                              orientations.describe())
+    if not (isinstance(rounds, int) and 0 <= rounds <= 100):
+        raise ParameterError("rounds", "an integer in [0, 100]", rounds)
+    if not (isinstance(tol_mm, (int, float)) and 1e-4 <= tol_mm <= 10.0):
+        raise ParameterError("tol_mm", "a tolerance in [1e-4, 10] mm", tol_mm)
     t0 = time.perf_counter()
     theta = float(orientations.angles[0])
     n = int(orientations.samples)
-    e0, U, B, box = _inputs(mech)
+    qmin = float(mech.stroke[0])
+    hi = float(q_max_limit) if q_max_limit is not None else qmin + 4.0 * mech.scale
+    if not hi > qmin:
+        raise ParameterError("q_max_limit", f"a limit above the lower one ({qmin:g} mm)", hi)
+    e0, U, B, box = _inputs(dataclasses.replace(mech, stroke_window=(qmin, hi)))
     if orientations.centre is not None:
         e0 = _kernels.carray(np.array(orientations.centre, dtype=float))
-    qmin = float(mech.stroke[0])
     bb = _search.make_branch_bound(type(mech).column_leg)
     cert = _search.make_certify(type(mech).column_leg)
     r, c = np.empty(8), np.empty(2)
+    E = _box_sample(theta, n)
+    W = _kernels.carray(mech.leg_offsets(euler_to_matrix(e0 + E)))
 
     def params(qmax):
         return _kernels.carray(dataclasses.replace(mech, stroke_window=(qmin, qmax))
                                .column_params())
 
     def empty(qmax):           # True: proved empty at every position; False: a witness
-        bb(U, B, params(qmax), e0, theta, n, box, FIRST_TILE_MM, MIN_TILE_MM, 0.0, True, r)
+        bb(W, params(qmax), box, FIRST_TILE_MM, MIN_TILE_MM, 0.0, True, r)
         return {1.0: False, 0.0: True}.get(float(r[0]))
 
-    def certified(qmax, xy=None):
-        """A point certified at qmax: the sample's best column (searched over the whole box,
-        or the column ``xy``), at the middle of its z interval; None if none."""
+    def profile(qmax):
+        return _profile(dataclasses.replace(mech, stroke_window=(qmin, qmax)))
+
+    def certified(qmax, xy):
+        """The column ``xy`` at the middle of the sample's z interval, if certified for the
+        continuous box at qmax; else None."""
         P = params(qmax)
-        where = box if xy is None else _kernels.carray(np.array(
-            [xy[0] - 1e-9, xy[0] + 1e-9, xy[1] - 1e-9, xy[1] + 1e-9]))
-        bb(U, B, P, e0, theta, n, where, FIRST_TILE_MM, MIN_TILE_MM, _search.MAX_EPS, False, r)
-        if not r[1] >= 0.0:
+        a, b, ok = column_ends(mech, P, xy[0], xy[1], e0, E)
+        zl, zh = float(np.max(a)), float(np.min(b))
+        if not (ok.all() and zh >= zl):
             return None
-        p = (float(r[2]), float(r[3]), 0.5 * float(r[4] + r[5]))
-        cert(U, B, P, e0, theta, *p, MIN_HALF_RAD, CELL_BUDGET, c)
+        p = (float(xy[0]), float(xy[1]), 0.5 * (zl + zh))
+        cert(U, B, P, profile(qmax), e0, theta, *p, MIN_HALF_RAD, cell_budget, c)
         return p if c[0] == 1 else None
 
-    hi = q_max_limit if q_max_limit is not None else qmin + 4.0 * mech.scale
     lo = float(mech.stroke[1])
-    notes = []
-    if not empty(lo):
+    if lo >= hi or not empty(lo):
         # already non-empty: the needed limit lies between qmin and the current one
         lo = qmin + 1e-9
         if empty(lo) is not True:
@@ -218,32 +275,74 @@ def stroke_needed(mech, orientations: OrientationSet, tol_mm: float = STROKE_TOL
                                  "position", mech.stroke)
     if empty(hi) is not False:
         raise ParameterError("q_max_limit", "a limit at which the set is non-empty", hi)
-    s_lo, s_hi = lo, hi                       # s_lo proved empty, s_hi has a witness
-    while s_hi - s_lo > tol_mm:
-        mid = 0.5 * (s_lo + s_hi)
-        e = empty(mid)
-        if e is None:
-            notes.append(f"branch and bound undecided at {mid:.4f} mm")
+    s_lo, c_hi, point, sampled = lo, hi, None, math.nan
+    notes, history, added, undecided = [], [], 0, 0
+    guess = hi                 # a limit with a witness for the current sample
+    for rnd in range(rounds + 1):
+        # lower end: bisection of the (enlarged) sample's needed limit; s_lo stays proved
+        # empty (a larger sample is harder)
+        s_hi = min(guess, c_hi)
+        while s_hi - s_lo > 0.25 * tol_mm:
+            mid = 0.5 * (s_lo + s_hi)
+            e = empty(mid)
+            if e is None:        # not proved empty: the lower end stays below it
+                undecided += 1
+            s_lo, s_hi = (mid, s_hi) if e else (s_lo, mid)
+        if rnd == 0:
+            sampled = s_hi
+        # the sample's best column at its own needed limit, and the orientations of the box
+        # that bind it harder than the sample
+        bb(W, params(s_hi), box, FIRST_TILE_MM, MIN_TILE_MM, WITNESS_EPS_MM, False, r)
+        xy = (float(r[2]), float(r[3]))
+        new, gain = binding_orientations(mech, params(s_hi), xy[0], xy[1], e0, theta, E) \
+            if rnd < rounds else (np.empty((0, 3)), 0.0)
+        if gain <= 0.25 * tol_mm or rnd == rounds:
+            # the sample binds the column as the box does: certify it (upper end)
+            if point is None:
+                point = certified(hi, xy)
+                if point is None:
+                    raise ParameterError("q_max_limit", "a limit at which a point is "
+                                         "certified", hi)
+            c_lo = s_lo
+            while c_hi - c_lo > 0.25 * tol_mm:
+                mid = 0.5 * (c_lo + c_hi)
+                p = certified(mid, xy)
+                if p is None:
+                    c_lo = mid
+                else:
+                    c_hi, point = mid, p
+        history.append({"round": rnd, "orientations": len(E), "lower": s_lo,
+                        "upper": c_hi if point is not None else None,
+                        "binding_gain": gain, "seconds": time.perf_counter() - t0})
+        if point is not None and c_hi - s_lo <= tol_mm:
             break
-        s_lo, s_hi = (mid, s_hi) if e else (s_lo, mid)
-    sampled = s_hi
-    # the column kept from here on: the sample's best one at its own needed limit
-    bb(U, B, params(s_hi), e0, theta, n, box, FIRST_TILE_MM, MIN_TILE_MM, _search.MAX_EPS,
-       False, r)
-    xy = (float(r[2]), float(r[3]))
-    c_lo, c_hi, point = s_lo, hi, certified(hi, xy)
-    if point is None:
-        raise ParameterError("q_max_limit", "a limit at which a point is certified", hi)
-    while c_hi - c_lo > tol_mm:
-        mid = 0.5 * (c_lo + c_hi)
-        p = certified(mid, xy)
-        if p is None:
-            c_lo = mid
-        else:
-            c_hi, point = mid, p
+        if rnd == rounds:
+            notes.append(f"stopped after {rounds} exchange rounds at width "
+                         f"{c_hi - s_lo:.4f} mm")
+            break
+        if len(new) == 0:
+            notes.append(f"no orientation of the box binds the witness column harder than "
+                         f"the sample ({len(E)} orientations): the upper end is limited by "
+                         f"the certification ({cell_budget:,} orientation cells)")
+            break
+        log.debug("stroke_needed round %d: [%.4f, %.4f] mm, +%d orientations (gain %.4f mm)",
+                  rnd, s_lo, c_hi, len(new), gain)
+        E = np.vstack([E, new])
+        added += len(new)
+        W = _kernels.carray(mech.leg_offsets(euler_to_matrix(e0 + E)))
+        # the witness column loses about `gain`: a limit just above that usually has a witness
+        guess = s_hi + gain + tol_mm
+        if guess < c_hi and empty(guess) is not False:
+            guess = c_hi
+    if undecided:
+        notes.append(f"{undecided} branch and bound(s) undecided (margin within 1e-9 mm of "
+                     f"zero on a {MIN_TILE_MM:g} mm tile), counted as not empty: the lower "
+                     "end stays proved")
     return OptimumBracket(
         "stroke_needed", "mm", s_lo, c_hi, sampled, point, n,
         f"upper actuator limit, lower limit {qmin:g} mm kept: branch and bound over "
-        f"continuous positions ({n}^3 orientation samples, lower end), a point certified "
-        f"for the continuous ±{math.degrees(theta):g}° box (upper end), bisected to "
-        f"{tol_mm:g} mm", "; ".join(notes), time.perf_counter() - t0)
+        f"continuous positions ({n}^3 orientation samples + {added} binding orientations "
+        f"found by local optimisation in {len(history) - 1} exchange rounds, lower end), a "
+        f"point certified for the continuous ±{math.degrees(theta):g}° box (upper end), "
+        f"bisected to {0.25 * tol_mm:g} mm", "; ".join(notes), time.perf_counter() - t0,
+        tuple(history), tuple(map(tuple, E[n ** 3:].tolist())))
