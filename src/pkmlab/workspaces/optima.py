@@ -342,7 +342,8 @@ def stroke_needed(mech, orientations: OrientationSet, tol_mm: float = STROKE_TOL
         "stroke_needed", "mm", s_lo, c_hi, sampled, point, n,
         f"upper actuator limit, lower limit {qmin:g} mm kept: branch and bound over "
         f"continuous positions ({n}^3 orientation samples + {added} binding orientations "
-        f"found by local optimisation in {len(history) - 1} exchange rounds, lower end), a "
+        f"found by local optimisation in {len(history) - 1} exchange round"
+        f"{'' if len(history) == 2 else 's'}, lower end), a "
         f"point certified for the continuous ±{math.degrees(theta):g}° box (upper end), "
         f"bisected to {0.25 * tol_mm:g} mm", "; ".join(notes), time.perf_counter() - t0,
         tuple(history), tuple(map(tuple, E[n ** 3:].tolist())))
