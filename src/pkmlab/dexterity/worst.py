@@ -171,11 +171,19 @@ def _units(mech, result, idx, pos):
     Returns ``(unit_pos (U, 3), voxel_unit (V,), shared)``.
     """
     if mech.column_invariant and len(idx):
-        cols, inv = np.unique(idx[:, :2], axis=0, return_inverse=True)
-        inv = inv.ravel()
-        first = np.zeros(len(cols), dtype=np.int64)
-        first[inv[::-1]] = np.arange(len(idx))[::-1]
-        return pos[first], inv, True
+        # voxel indices come from np.argwhere, in lexicographic (i, j, k) order: a column is
+        # a run of equal (i, j), so no sort is needed
+        key = idx[:, 0].astype(np.int64) * (int(idx[:, 1].max()) + 1) + idx[:, 1]
+        new = np.empty(len(key), dtype=bool)
+        new[0] = True
+        np.not_equal(key[1:], key[:-1], out=new[1:])
+        if np.any(key[1:] < key[:-1]):                  # not from argwhere: sort after all
+            cols, inv = np.unique(idx[:, :2], axis=0, return_inverse=True)
+            inv = inv.ravel()
+            first = np.zeros(len(cols), dtype=np.int64)
+            first[inv[::-1]] = np.arange(len(idx))[::-1]
+            return pos[first], inv, True
+        return pos[np.flatnonzero(new)], np.cumsum(new) - 1, True
     return pos, np.arange(len(idx)), False
 
 
@@ -195,7 +203,9 @@ def _spatial_pairs(result, idx, voxel_unit, shared) -> np.ndarray:
         out.append(np.stack([voxel_unit[a[keep]], voxel_unit[b[keep]]], axis=1))
     pairs = np.concatenate(out) if out else np.empty((0, 2), dtype=np.int64)
     if shared and len(pairs):
-        pairs = np.unique(pairs, axis=0)
+        n = int(pairs.max()) + 1                       # unique rows through one int64 key
+        key = np.unique(pairs[:, 0].astype(np.int64) * n + pairs[:, 1])
+        pairs = np.stack([key // n, key % n], axis=1)
     return pairs
 
 
@@ -396,6 +406,15 @@ def _exact_max(mech, unit_pos, Rs, cand, up, L):
     Returns ``(kmax, (unit, orientation), exact evaluations, singular samples)``.
     """
     M = len(Rs)
+    if len(cand):
+        # the exact κ of the largest bound is a lower bound on the maximum: a pose whose bound
+        # is below it (and that cannot be singular) is never the maximum, so it is dropped
+        # before the sort (the sort of every candidate dominated the worst case's time)
+        u0, m0 = divmod(int(cand[int(np.argmax(up))]), M)
+        k0 = float(condition_number(mech.jacobian((unit_pos[[u0]], Rs[[m0]])), L)[0])
+        if math.isfinite(k0):
+            sel = (up >= k0) | (up >= _SINGULAR_BOUND)
+            cand, up = cand[sel], up[sel]
     order = np.argsort(-up, kind="stable")
     cand, up = cand[order], up[order]
     best, arg, exact, n_sing = -math.inf, None, 0, 0
