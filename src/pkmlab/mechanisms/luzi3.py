@@ -228,6 +228,54 @@ class Luzi3(Mechanism):
         hi = (centre + reach).reshape(len(R), 6, 3).min(axis=1)
         return np.stack([lo, hi], axis=1)
 
+    cell_bounds = True
+
+    def leg_cell_bounds(self, p, R, delta, alpha):
+        """Leg lengths at ``(p, R)`` and a bound on their change over a cell (triangle
+        inequalities, no linearisation): for ``|p' - p| <= δ`` and ``angle(R'R^T) <= α``,
+        with ``c = 2 sin(α/2)``,
+
+        * ``|C' - C| <= εC = δ + c·|ρ_i|`` and ``|k' - k| <= c``;
+        * ``w = r × (C - A1)``: ``|w' - w| <= εw = |r|·εC``;
+        * ``n = k × w``: ``|n' - n| <= εn = c·(|w| + εw) + εw``;
+        * when ``|n·r| > εn·|r|`` the sign that makes ``t·r >= 0`` is the same over the cell
+          and ``n`` never vanishes, so the angle between ``n'`` and ``n`` is at most
+          ``asin(εn/|n|)`` and ``|t' - t| <= εt = 2 sin(asin(εn/|n|)/2)``; otherwise ``eps =
+          inf`` (the upper link may flip or be undefined in the cell);
+        * ``|q'_ij - q_ij| <= |B'_ij - B_ij| <= εC + (l/2)·εt``.
+
+        A slack of ``1e-9 mm + 1e-12·scale`` covers floating-point rounding. ``delta`` and
+        ``alpha`` are ``(N,)`` (mm, rad); returns ``(q, eps)`` ``(N, 6)``.
+        """
+        p = np.asarray(p, float).reshape(-1, 3)
+        R = np.asarray(R, float).reshape(-1, 3, 3)
+        delta = np.broadcast_to(np.asarray(delta, float), (len(p),))
+        c = 2 * np.sin(0.5 * np.minimum(np.broadcast_to(np.asarray(alpha, float),
+                                                        (len(p),)), math.pi))
+        A1, A2 = self.base_points[0::2], self.base_points[1::2]
+        r = A2 - A1
+        rn = np.linalg.norm(r, axis=1)                                     # (3,)
+        rho = np.einsum("nij,kj->nki", R, self.tool_points)
+        C = p[:, None, :] + rho
+        k = R[:, None, :, 2]
+        w = np.cross(r, C - A1)
+        n = np.cross(k, w)
+        nn = np.linalg.norm(n, axis=-1)
+        eC = delta[:, None] + c[:, None] * np.linalg.norm(self.tool_points, axis=1)
+        ew = rn * eC
+        en = c[:, None] * (np.linalg.norm(w, axis=-1) + ew) + ew
+        nr = np.einsum("nki,ki->nk", n, r)
+        fixed = np.abs(nr) > en * rn
+        sgn = np.where(nr >= 0, 1.0, -1.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = n * (sgn / nn)[..., None]
+            et = 2 * np.sin(0.5 * np.arcsin(np.minimum(en / nn, 1.0)))
+        half = 0.5 * self.upper_link
+        q = np.stack([np.linalg.norm(C - half * t - A1, axis=-1),
+                      np.linalg.norm(C + half * t - A2, axis=-1)], axis=-1).reshape(-1, 6)
+        e = np.where(fixed, eC + half * et + 1e-9 + 1e-12 * self.scale, np.inf)
+        return q, np.repeat(e, 2, axis=1)
+
     def leg_segments(self, p, R):
         """Actuated legs ``A_ij → B_ij`` as end points ``(N, 6, 3)`` each."""
         rho = np.einsum("nij,kj->nki", R, self.tool_points)
