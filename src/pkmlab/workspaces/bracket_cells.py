@@ -16,13 +16,17 @@ qmin, qmax - q)`` per leg:
   *in* when all its items are in (the items cover the set); the items found in are dropped.
 * reachable (some orientation): a cube is *in* when any sample of it is in, *out* when all its
   items are out; the items found out are dropped.
+* the samples of a cube are its items' centres and the corners of the set's first cells
+  (where leg extremes often lie), re-checked at every step.
 
 ``lower`` is the volume of the cubes in, ``upper`` that of the cubes in or undecided (closed
 cubes: the workspace lies in their union). Every undecided cube is refined each step: the
 orientation cells of its items whose rotation part of ε (``ε(α) - ε(0)``) exceeds the
 position part are split (:func:`.cells.split`); a cube with no such item is split into its 8
 children, which inherit its live items. It stops when ``upper - lower <= target·upper``, or
-the budget (seconds, items of a step, leg evaluations) runs out, and says which.
+the budget (seconds, items of a step, leg evaluations) runs out, and says which; a step
+whose predicted time (the last one's, scaled by the items) would overrun the seconds is not
+started.
 
 **Connected to nominal.** As in :mod:`.bracket`: components of the in cubes and of the in or
 undecided cubes (closed cubes that touch, ``|c_a - c_b|_∞ <= h_a + h_b``, are connected);
@@ -125,6 +129,17 @@ def _first_cubes(lo, hi, resolution):
     return C, np.full(len(C), 0.5 * e)
 
 
+def _corners(C0, H0):
+    """The distinct corners of the first orientation cells that are not a centre (none for
+    a fixed orientation)."""
+    if not np.any(H0 > 0):
+        return np.zeros((0, 3))
+    signs = np.array(np.meshgrid(*[(-1.0, 1.0)] * 3, indexing="ij")).reshape(3, -1).T
+    V = np.unique(np.round((C0[:, None, :] + signs[None] * H0[:, None, :]).reshape(-1, 3),
+                           12), axis=0)
+    return V[~np.any(np.all(np.abs(V[:, None, :] - C0[None]) < 1e-12, axis=2), axis=1)]
+
+
 def _evaluate(mech, oset, P, hP, pid, Oc, Oh):
     """Per item: ``(margin (K, 6), eps over the item, eps of the sample)``."""
     lo_q, hi_q = mech.stroke
@@ -165,6 +180,7 @@ def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
     pid = np.repeat(np.arange(len(P)), L)
     Oc, Oh = np.tile(C0, (len(P), 1)), np.tile(H0, (len(P), 1))
     in_C, in_h = np.zeros((0, 3)), np.zeros(0)
+    V = _corners(C0, H0)
     history: list[dict] = []
     notes: list[str] = []
     evaluations = 0
@@ -178,19 +194,31 @@ def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
             item_in, item_out = np.all(m > e_cell, axis=1), np.any(m < -e_cell, axis=1)
             s_in, s_out = np.all(m > e_s, axis=1), np.any(m < -e_s, axis=1)
         n = len(P)
+        spid = pid
+        if len(V):
+            # the corners of the set as extra samples of every cube (leg extremes lie there)
+            vp = np.repeat(np.arange(n), len(V))
+            vm, _, ve = _evaluate(mech, oset, P, hP, vp, np.tile(V, (n, 1)),
+                                  np.zeros((len(vp), 3)))
+            evaluations += 6 * len(vp)
+            with np.errstate(invalid="ignore"):
+                s_in = np.concatenate([s_in, np.all(vm > ve, axis=1)])
+                s_out = np.concatenate([s_out, np.any(vm < -ve, axis=1)])
+            spid = np.concatenate([pid, vp])
         if kind == "reachable":
             c_in = np.zeros(n, bool)
-            np.logical_or.at(c_in, pid, s_in)
+            np.logical_or.at(c_in, spid, s_in)
             keep = ~item_out & ~c_in[pid]
             c_out = ~c_in & (np.bincount(pid[keep], minlength=n) == 0)
         else:
             c_out = np.zeros(n, bool)
-            np.logical_or.at(c_out, pid, s_out)
+            np.logical_or.at(c_out, spid, s_out)
             keep = ~item_in & ~c_out[pid]
             c_in = ~c_out & (np.bincount(pid[keep], minlength=n) == 0)
         und = ~c_in & ~c_out
         in_C, in_h = np.concatenate([in_C, P[c_in]]), np.concatenate([in_h, hP[c_in]])
-        lo_s, up_s, note = _bounds(in_C, in_h, P[und], hP[und], p_nom, cons.connected)
+        u_C, u_h = P[und], hP[und]
+        lo_s, up_s, note = _bounds(in_C, in_h, u_C, u_h, p_nom, cons.connected)
         lower = max(lower, lo_s)
         upper = up_s if note else min(upper, up_s)
         if note and note not in notes:
@@ -209,20 +237,24 @@ def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
             stop = "budget: evaluations"
         if stop is not None:
             break
+        n_items = len(pid)
         P, hP, pid, Oc, Oh = _refine(P, hP, pid[keep], Oc[keep], Oh[keep], e_cell[keep],
                                      e_s[keep], und)
         if len(pid) > max_cells:
             stop = "budget: cells"
             break
+        # a step costs about in proportion to its items: do not start one that cannot end
+        # within the budget
+        took = elapsed - (history[-2]["seconds"] if len(history) > 1 else 0.0)
+        if elapsed + took * len(pid) / max(n_items, 1) > budget_s:
+            stop = "budget: seconds"
+            break
         step += 1
     if notes:
         lower = 0.0
-    res = float(2 * hP.min()) if len(hP) else float(resolution)
-    boxes = (np.concatenate([in_C, P[und] if stop != "budget: cells" else P]),
-             np.concatenate([in_h, hP[und] if stop != "budget: cells" else hP]),
-             np.concatenate([np.ones(len(in_h), bool),
-                             np.zeros(int(und.sum()) if stop != "budget: cells" else len(hP),
-                                      bool)]))
+    res = float(2 * u_h.min()) if len(u_h) else float(resolution)
+    boxes = (np.concatenate([in_C, u_C]), np.concatenate([in_h, u_h]),
+             np.concatenate([np.ones(len(in_h), bool), np.zeros(len(u_h), bool)]))
     return VolumeBracket(lower, upper, target, stop, history, res, evaluations,
                          time.perf_counter() - t0, notes, boxes=boxes)
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 __all__ = ["VolumeBracket"]
 
@@ -33,9 +34,9 @@ class VolumeBracket:
             workspace inside ``outer``; the x-y second-order volume bounds (constant,
             dexterous) are tighter than their volumes and are not stored as sets.
         boxes: for the cell bracket (:mod:`.bracket_cells`), the last step's cubes ``(centres
-            (n, 3), half-edges (n,), inner (n,) bool)``: the inner cubes lie inside the
-            workspace, and the workspace inside all of them (``cells``/``inner``/``outer`` are
-            then None).
+            (n, 3), half-edges (n,), inner (n,) bool)``, connectivity not applied: the inner
+            cubes lie inside the stroke-feasible set, and it lies inside all of them
+            (``cells``/``inner``/``outer`` are then None).
     """
 
     lower: float
@@ -72,8 +73,10 @@ class VolumeBracket:
             C, hb, inner = self.boxes
             sel = inner if which == "inner" else np.ones(len(hb), bool)
             out = np.zeros(len(P), dtype=bool)
-            for c, hh in zip(C[sel], hb[sel], strict=True):
-                out |= np.all(np.abs(P - c) <= hh, axis=1)
+            for hh in np.unique(hb[sel]):
+                d, _ = cKDTree(C[sel & (hb == hh)]).query(P, p=np.inf,
+                                                          distance_upper_bound=hh * (1 + 1e-12))
+                out |= np.isfinite(d)
             return out
         col, lo, hi = self.inner if which == "inner" else self.outer
         out = np.zeros(len(P), dtype=bool)
