@@ -182,6 +182,10 @@ class Mechanism:
     #: True when the family gives :meth:`leg_cell_bounds` (luzi3): the volume bracket then
     #: works on position cells × orientation cells (:mod:`pkmlab.workspaces.bracket_cells`).
     cell_bounds: ClassVar[bool] = False
+    #: True when the family also gives ``leg_position_curvature(p, R, delta)`` (each leg's
+    #: gradient in the position and a bound on its second derivative over a ball): the cell
+    #: bracket then bounds the volume inside undecided cubes to second order.
+    position_curvature: ClassVar[bool] = False
 
     def leg_cell_bounds(self, p, R, delta, alpha):  # pragma: no cover - optional
         """``(q, eps)``, both ``(N, 6)``: the actuator values at the poses ``(p (N, 3), R (N,

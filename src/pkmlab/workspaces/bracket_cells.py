@@ -51,6 +51,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from . import cells as oc
+from .bracket_partial import sample_fractions, vertices
 from .bracket_result import VolumeBracket
 
 log = logging.getLogger(__name__)
@@ -96,15 +97,15 @@ def touching_components(C: np.ndarray, h: np.ndarray, pairs=None) -> tuple[int, 
     return connected_components(g, directed=False)
 
 
-def _home_volume(C, h, p_nom, pairs):
-    """Volume of the component holding ``p_nom`` (None if no cube holds it)."""
+def _home(C, h, p_nom, pairs):
+    """Mask of the cubes in the component holding ``p_nom`` (None if no cube holds it)."""
     if len(C) == 0:
         return None
     home = np.flatnonzero(np.all(np.abs(C - p_nom) <= h[:, None] * (1 + 1e-9), axis=1))
     if len(home) == 0:
         return None
     _, lab = touching_components(C, h, pairs)
-    return float(((2 * h[lab == lab[home[0]]]) ** 3).sum())
+    return lab == lab[home[0]]
 
 
 def _search_box(mech, oset, C0, H0):
@@ -141,10 +142,10 @@ def _corners(C0, H0):
 
 
 def _evaluate(mech, oset, P, hP, pid, Oc, Oh):
-    """Per item: ``(margin (K, 6), eps over the item, eps of the sample)``."""
+    """Per item: ``(q (K, 6), margin (K, 6), eps over the item, eps of the sample)``."""
     lo_q, hi_q = mech.stroke
     K = len(pid)
-    m = np.empty((K, 6))
+    m, qq = np.empty((K, 6)), np.empty((K, 6))
     e_cell, e_s = np.empty((K, 6)), np.empty((K, 6))
     rotating = bool(np.any(Oh > 0))
     for s in range(0, K, _BATCH):
@@ -157,9 +158,10 @@ def _evaluate(mech, oset, P, hP, pid, Oc, Oh):
                                               oc.angle_bound(oset, Oc[sl], Oh[sl]))[1]
         else:
             e_cell[sl] = e_s[sl]
+        qq[sl] = q
         with np.errstate(invalid="ignore"):
             m[sl] = np.minimum(q - lo_q, hi_q - q)
-    return m, e_cell, e_s
+    return qq, m, e_cell, e_s
 
 
 def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
@@ -188,23 +190,24 @@ def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
     stop = None
     step = 0
     while True:
-        m, e_cell, e_s = _evaluate(mech, oset, P, hP, pid, Oc, Oh)
+        q, m, e_cell, e_s = _evaluate(mech, oset, P, hP, pid, Oc, Oh)
         evaluations += 6 * len(pid) * (2 if np.any(Oh > 0) else 1)
         with np.errstate(invalid="ignore"):
             item_in, item_out = np.all(m > e_cell, axis=1), np.any(m < -e_cell, axis=1)
             s_in, s_out = np.all(m > e_s, axis=1), np.any(m < -e_s, axis=1)
         n = len(P)
-        spid = pid
+        spid, sO, sq = pid, Oc, q
         if len(V):
             # the corners of the set as extra samples of every cube (leg extremes lie there)
             vp = np.repeat(np.arange(n), len(V))
-            vm, _, ve = _evaluate(mech, oset, P, hP, vp, np.tile(V, (n, 1)),
-                                  np.zeros((len(vp), 3)))
+            vO = np.tile(V, (n, 1))
+            vq, vm, _, ve = _evaluate(mech, oset, P, hP, vp, vO, np.zeros((len(vp), 3)))
             evaluations += 6 * len(vp)
             with np.errstate(invalid="ignore"):
                 s_in = np.concatenate([s_in, np.all(vm > ve, axis=1)])
                 s_out = np.concatenate([s_out, np.any(vm < -ve, axis=1)])
-            spid = np.concatenate([pid, vp])
+            spid, sO, sq = np.concatenate([pid, vp]), np.concatenate([Oc, vO]), \
+                np.concatenate([q, vq])
         if kind == "reachable":
             c_in = np.zeros(n, bool)
             np.logical_or.at(c_in, spid, s_in)
@@ -218,7 +221,12 @@ def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
         und = ~c_in & ~c_out
         in_C, in_h = np.concatenate([in_C, P[c_in]]), np.concatenate([in_h, hP[c_in]])
         u_C, u_h = P[und], hP[und]
-        lo_s, up_s, note = _bounds(in_C, in_h, u_C, u_h, p_nom, cons.connected)
+        sets = _components(in_C, in_h, u_C, u_h, p_nom, cons.connected)
+        sel = und[spid]
+        part = (_partial(mech, oset, kind, P, hP, und, spid[sel], sO[sel], sq[sel],
+                         in_C[sets[0]], in_h[sets[0]], cons.connected)
+                if mech.position_curvature else None)
+        lo_s, up_s, note = _volumes(in_h, u_h, sets, part)
         lower = max(lower, lo_s)
         upper = up_s if note else min(upper, up_s)
         if note and note not in notes:
@@ -259,22 +267,70 @@ def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
                          time.perf_counter() - t0, notes, boxes=boxes)
 
 
-def _bounds(in_C, in_h, u_C, u_h, p_nom, connected):
-    """``(lower, upper, note)`` (mm³) of one step; the touching pairs are found once on every
-    cube and restricted to the in cubes for the lower bound."""
-    v_in, v_u = float(((2 * in_h) ** 3).sum()), float(((2 * u_h) ** 3).sum())
+def _components(in_C, in_h, u_C, u_h, p_nom, connected):
+    """``(in cubes kept (n_in,), all cubes kept (n_in + n_u,) or None)``: the components
+    holding the nominal position (every cube without connectivity; None when no cube holds
+    it). The touching pairs are found once and restricted to the in cubes."""
+    n = len(in_h)
     if not connected:
-        return v_in, v_in + v_u, None
+        return np.ones(n, bool), np.ones(n + len(u_h), bool)
     C, h = np.concatenate([in_C, u_C]), np.concatenate([in_h, u_h])
     i, j = touching_pairs(C, h)
-    up = _home_volume(C, h, p_nom, (i, j))
-    if up is None:
-        return 0.0, v_in + v_u, ("the nominal position is outside the workspace: the bracket "
-                                 "covers every component (lower 0)")
-    n = len(in_h)
+    outer = _home(C, h, p_nom, (i, j))
+    if outer is None:
+        return np.zeros(n, bool), None
     both = (i < n) & (j < n)
-    lo = _home_volume(in_C, in_h, p_nom, (i[both], j[both]))
-    return (lo or 0.0), up, None
+    inner = _home(in_C, in_h, p_nom, (i[both], j[both]))
+    return (np.zeros(n, bool) if inner is None else inner), outer
+
+
+def _volumes(in_h, u_h, sets, part):
+    """``(lower, upper, note)`` (mm³) of one step; ``part`` the undecided cubes' fractions
+    ``(inner lower bound, outer upper bound)`` or None (0 and 1)."""
+    v_in, v_u = (2 * in_h) ** 3, (2 * u_h) ** 3
+    f_lo, f_up = part if part is not None else (np.zeros(len(u_h)), np.ones(len(u_h)))
+    inner, outer = sets
+    if outer is None:
+        return 0.0, float(v_in.sum() + (f_up * v_u).sum()), (
+            "the nominal position is outside the workspace: the bracket covers every "
+            "component (lower 0)")
+    n = len(in_h)
+    return (float(v_in[inner].sum() + (f_lo * v_u).sum()),
+            float(v_in[outer[:n]].sum() + (f_up * v_u)[outer[n:]].sum()), None)
+
+
+def _partial(mech, oset, kind, P, hP, und, pid, O, q, keep_C, keep_h, connected):
+    """Second-order fractions of the undecided cubes (:mod:`.bracket_partial`) from their
+    samples: the upper one (constant, dexterous) is the smallest over the samples; the lower
+    one (constant, reachable) the largest over the samples whose inner region has a vertex in
+    a kept in cube (so it joins the kept component; any sample without connectivity)."""
+    ui = np.cumsum(und) - 1
+    nu = int(und.sum())
+    f_lo, f_up = np.zeros(nu), np.ones(nu)
+    if len(pid) == 0:
+        return f_lo, f_up
+    s = hP[pid]
+    g, M = mech.leg_position_curvature(P[pid], oset.rotations_at(O), math.sqrt(3.0) * s)
+    inner, up, vert = sample_fractions(q, g, M, s, mech.stroke)
+    cube = ui[pid]
+    if kind != "reachable":
+        np.minimum.at(f_up, cube, up)
+    if kind != "dexterous":
+        if connected:
+            Vx = vertices(P[pid], s).reshape(-1, 3)
+            vert = vert & _in_cubes(Vx, keep_C, keep_h).reshape(vert.shape)
+        ok = vert.any(axis=1)
+        np.maximum.at(f_lo, cube[ok], inner[ok])
+    return f_lo, f_up
+
+
+def _in_cubes(points, C, h):
+    """``(N,)`` bool: points in any of the closed cubes."""
+    out = np.zeros(len(points), bool)
+    for hh in np.unique(h):
+        d, _ = cKDTree(C[h == hh]).query(points, p=np.inf, distance_upper_bound=hh * (1 + 1e-9))
+        out |= np.isfinite(d)
+    return out
 
 
 def _refine(P, hP, pid, Oc, Oh, e_cell, e_s, und):
