@@ -67,7 +67,15 @@ def bound_check(mech, n=200_000, seed=0):
     q2 = mech.inverse((p2, R2), stroke=NO_STROKE).q
     fin = np.isfinite(eps) & np.isfinite(q2)
     ratio = np.abs(q2 - q)[fin] / eps[fin]
-    return float(ratio.max()), float(np.median(ratio)), float(fin.mean()), int(fin.sum())
+    # second order in the position (rotation fixed): |q(p + dp) - q - g·dp| <= M |dp|² / 2
+    g, M = mech.leg_position_curvature(p, R, delta)
+    dp = u * rad[:, None]
+    q3 = mech.inverse((p + dp, R), stroke=NO_STROKE).q
+    rem = np.abs(q3 - q - np.einsum("nkj,nj->nk", g, dp))
+    ok = np.isfinite(M) & (rad > 1.0)[:, None] & np.isfinite(q3)
+    r2 = rem[ok] / (0.5 * M * (rad**2)[:, None])[ok]
+    return (float(ratio.max()), float(np.median(ratio)), float(fin.mean()), int(fin.sum()),
+            float(r2.max()), float(np.median(r2)), int(ok.sum()))
 
 
 def engine_rows(mech, kind, oset, h, samples):
@@ -83,11 +91,13 @@ def engine_rows(mech, kind, oset, h, samples):
 def main(what):
     print(f"load: {os.getloadavg()}")
     if what in ("all", "bounds"):
-        print("| geometry | pairs with a finite bound | share | max ratio | median |")
-        print("|---|---|---|---|---|")
+        print("| geometry | (cell, leg) pairs bounded | share | max ratio | median | "
+              "2nd order pairs | max ratio | median |")
+        print("|---|---|---|---|---|---|---|---|")
         for name, m in (("paper", paper()), ("own", own())):
-            mx, med, share, k = bound_check(m)
-            print(f"| {name} | {k} | {share:.3f} | {mx:.4f} | {med:.4f} |")
+            mx, med, share, k, mx2, med2, k2 = bound_check(m)
+            print(f"| {name} | {k} | {share:.3f} | {mx:.4f} | {med:.4f} | {k2} | {mx2:.4f} | "
+                  f"{med2:.4f} |")
     if what in ("all", "brackets"):
         box = OrientationSet.box((math.radians(5),) * 3)
         for name, m in (("paper", paper()), ("own", own())):
