@@ -65,8 +65,8 @@ def bound_check(mech, n=200_000, seed=0):
     p2 = p + u * rad[:, None]
     R2 = Rotation.from_rotvec(ax * ang[:, None]).as_matrix() @ R
     q2 = mech.inverse((p2, R2), stroke=NO_STROKE).q
-    fin = np.isfinite(eps) & np.isfinite(q2)
-    ratio = np.abs(q2 - q)[fin] / eps[fin]
+    fin = np.isfinite(eps) & np.isfinite(q2)     # (every bound is finite; the fallback
+    ratio = np.abs(q2 - q)[fin] / eps[fin]      # |C - A| ± (εC + l/2) where the link may flip)
     # second order in the position (rotation fixed): |q(p + dp) - q - g·dp| <= M |dp|² / 2
     g, M = mech.leg_position_curvature(p, R, delta)
     dp = u * rad[:, None]

@@ -43,7 +43,8 @@ def test_leg_bound_holds_on_random_cells(luzi):
     R = Rotation.from_rotvec(rng.normal(size=(n, 3)) * 0.3).as_matrix()
     delta, alpha = rng.uniform(0, 60, n), rng.uniform(0, 0.3, n)
     q, eps = luzi.leg_cell_bounds(p, R, delta, alpha)
-    np.testing.assert_allclose(q, luzi.inverse((p, R), stroke=NO_STROKE).q, atol=1e-9)
+    ik = luzi.inverse((p, R), stroke=NO_STROKE).q
+    centred = np.isclose(q, ik, rtol=0, atol=1e-9)   # elsewhere the link may flip in the cell
     u = rng.normal(size=(n, 3))
     u /= np.linalg.norm(u, axis=1, keepdims=True)
     ax = rng.normal(size=(n, 3))
@@ -53,13 +54,12 @@ def test_leg_bound_holds_on_random_cells(luzi):
     R2 = Rotation.from_rotvec(ax * (np.where(edge, 1.0, rng.uniform(size=n))
                                     * alpha)[:, None]).as_matrix() @ R
     q2 = luzi.inverse((p2, R2), stroke=NO_STROKE).q
-    fin = np.isfinite(eps)
-    assert fin.mean() > 0.9
+    fin = np.isfinite(q2)                       # the link is defined at the point
+    assert centred.mean() > 0.9 and not centred.all() and np.all(np.isfinite(eps))
     ratio = np.abs(q2 - q)[fin] / eps[fin]
     assert np.all(ratio <= 1.0)
-    assert ratio.max() > 0.5                    # the bound is not vacuous
-    # a cell that straddles the flip of the upper link gets no bound
-    assert not np.all(fin)
+    assert ratio[centred[fin]].max() > 0.5      # the bound is not vacuous
+    assert ratio[~centred[fin]].max() > 0.5     # nor is the fallback where the link may flip
 
 
 def test_touching_cubes_are_connected():
@@ -70,7 +70,7 @@ def test_touching_cubes_are_connected():
 
 
 def test_constant_bracket_agrees_with_the_kinematics(luzi):
-    b = volume_bracket(luzi, "constant", None, 10.0, budget_s=60, max_evaluations=1e6)
+    b = volume_bracket(luzi, "constant", None, 10.0, budget_s=60, max_evaluations=7e5)
     assert b.stop_reason == "budget: evaluations" and b.resolution == 20.0
     ref = workspace(luzi, "constant", resolution=10.0)      # an estimate, with its grid error
     assert b.lower - ref.volume_error <= ref.volume <= b.upper + ref.volume_error

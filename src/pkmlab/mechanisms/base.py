@@ -188,10 +188,10 @@ class Mechanism:
     position_curvature: ClassVar[bool] = False
 
     def leg_cell_bounds(self, p, R, delta, alpha):  # pragma: no cover - optional
-        """``(q, eps)``, both ``(N, 6)``: the actuator values at the poses ``(p (N, 3), R (N,
-        3, 3))`` and, for every position within ``delta (N,)`` mm of ``p`` and every rotation
-        within the angle ``alpha (N,)`` rad of ``R``, a bound ``eps`` on how far each value
-        moves (``inf`` where none is guaranteed)."""
+        """``(q, eps)``, both ``(N, 6)``: for every position within ``delta (N,)`` mm of ``p``
+        and every rotation within the angle ``alpha (N,)`` rad of ``R`` (``(p (N, 3), R (N,
+        3, 3))`` the cell centres), each actuator value lies in ``q ± eps``; ``q`` is the value
+        at the centre wherever the family can say so (luzi3: see its docstring)."""
         raise NotImplementedError
 
     def column_params(self) -> np.ndarray:  # pragma: no cover - optional

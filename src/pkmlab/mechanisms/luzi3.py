@@ -241,9 +241,13 @@ class Luzi3(Mechanism):
         * ``n = k × w``: ``|n' - n| <= εn = c·(|w| + εw) + εw``;
         * when ``|n·r| > εn·|r|`` the sign that makes ``t·r >= 0`` is the same over the cell
           and ``n`` never vanishes, so the angle between ``n'`` and ``n`` is at most
-          ``asin(εn/|n|)`` and ``|t' - t| <= εt = 2 sin(asin(εn/|n|)/2)``; otherwise ``eps =
-          inf`` (the upper link may flip or be undefined in the cell);
-        * ``|q'_ij - q_ij| <= |B'_ij - B_ij| <= εC + (l/2)·εt``.
+          ``asin(εn/|n|)`` and ``|t' - t| <= εt = 2 sin(asin(εn/|n|)/2)``, and
+          ``|q'_ij - q_ij| <= |B'_ij - B_ij| <= εC + (l/2)·εt``;
+        * otherwise (the upper link may flip or be undefined in the cell) ``B = C ∓ (l/2)t``
+          with ``|t| = 1`` still gives ``|q' - |C - A_ij|| <= εC + l/2``: the centre returned
+          is then ``|C - A_ij|``, not the leg length (``q`` below is the centre of each bound,
+          equal to the leg length wherever the sign is fixed; a pose where the link is
+          undefined is not in the workspace, so the bound only needs to hold elsewhere).
 
         A slack of ``1e-9 mm + 1e-12·scale`` covers floating-point rounding. ``delta`` and
         ``alpha`` are ``(N,)`` (mm, rad); returns ``(q, eps)`` ``(N, 6)``.
@@ -274,8 +278,11 @@ class Luzi3(Mechanism):
         half = 0.5 * self.upper_link
         q = np.stack([np.linalg.norm(C - half * t - A1, axis=-1),
                       np.linalg.norm(C + half * t - A2, axis=-1)], axis=-1).reshape(-1, 6)
-        e = np.where(fixed, eC + half * et + 1e-9 + 1e-12 * self.scale, np.inf)
-        return q, np.repeat(e, 2, axis=1)
+        slack = 1e-9 + 1e-12 * self.scale
+        e = np.repeat(np.where(fixed, eC + half * et, eC + half) + slack, 2, axis=1)
+        far = np.stack([np.linalg.norm(C - A1, axis=-1), np.linalg.norm(C - A2, axis=-1)],
+                       axis=-1).reshape(-1, 6)
+        return np.where(np.repeat(fixed, 2, axis=1), q, far), e
 
     def leg_position_curvature(self, p, R, delta):
         """Gradient ``g (N, 6, 3)`` of each leg length in the position at ``(p, R)`` and a
