@@ -71,7 +71,8 @@ def bound_check(mech, n=200_000, seed=0):
     g, M = mech.leg_position_curvature(p, R, delta)
     dp = u * rad[:, None]
     q3 = mech.inverse((p + dp, R), stroke=NO_STROKE).q
-    rem = np.abs(q3 - q - np.einsum("nkj,nj->nk", g, dp))
+    q0 = mech.inverse((p, R), stroke=NO_STROKE).q
+    rem = np.abs(q3 - q0 - np.einsum("nkj,nj->nk", g, dp))
     ok = np.isfinite(M) & (rad > 1.0)[:, None] & np.isfinite(q3)
     r2 = rem[ok] / (0.5 * M * (rad**2)[:, None])[ok]
     return (float(ratio.max()), float(np.median(ratio)), float(fin.mean()), int(fin.sum()),
@@ -105,7 +106,7 @@ def main(what):
                                            ("dexterous", box, (3, 5, 7), 10.0),
                                            ("reachable", box, (3, 5, 7), 20.0)):
                 print(f"\n{name} {kind} (litres)")
-                for budget in (2, 8, 30):
+                for budget in (5, 20, 60):
                     sys.stdout.flush()
                     b = volume_bracket(m, kind, oset, resolution=10.0, budget_s=budget,
                                        target=0.01)

@@ -70,14 +70,15 @@ def test_touching_cubes_are_connected():
 
 
 def test_constant_bracket_agrees_with_the_kinematics(luzi):
-    b = volume_bracket(luzi, "constant", None, 10.0, budget_s=60, max_evaluations=7e5)
+    b = volume_bracket(luzi, "constant", None, 10.0, budget_s=60, max_evaluations=4e5)
     assert b.stop_reason == "budget: evaluations" and b.resolution == 20.0
     ref = workspace(luzi, "constant", resolution=10.0)      # an estimate, with its grid error
     assert b.lower - ref.volume_error <= ref.volume <= b.upper + ref.volume_error
-    # every step is a bracket, and they narrow; the second-order lower bound is within 10 %
-    # at 20 mm cubes (first order alone: 27 % low)
+    # every step is a bracket, and they narrow; at 20 mm cubes the second-order bounds are
+    # within 10 % and 5 % (first order alone: 27 % low; the upper bound reaches the mirror
+    # image below the base unless the links' branch is followed)
     lows = [r["lower_mm3"] for r in b.history]
-    assert lows == sorted(lows) and b.lower > 0.9 * ref.volume
+    assert lows == sorted(lows) and b.lower > 0.9 * ref.volume and b.upper < 1.05 * ref.volume
     rng = np.random.default_rng(5)
     p = rng.uniform([-700, -700, 0], [700, 700, 1300], (60_000, 3))
     R = np.broadcast_to(np.eye(3) @ Rotation.from_euler("z", math.pi / 6).as_matrix(),

@@ -231,7 +231,7 @@ class Luzi3(Mechanism):
     cell_bounds = True
     position_curvature = True
 
-    def leg_cell_bounds(self, p, R, delta, alpha):
+    def leg_cell_bounds(self, p, R, delta, alpha, branch: bool = False):
         """Leg lengths at ``(p, R)`` and a bound on their change over a cell (triangle
         inequalities, no linearisation): for ``|p' - p| <= δ`` and ``angle(R'R^T) <= α``,
         with ``c = 2 sin(α/2)``,
@@ -250,7 +250,9 @@ class Luzi3(Mechanism):
           undefined is not in the workspace, so the bound only needs to hold elsewhere).
 
         A slack of ``1e-9 mm + 1e-12·scale`` covers floating-point rounding. ``delta`` and
-        ``alpha`` are ``(N,)`` (mm, rad); returns ``(q, eps)`` ``(N, 6)``.
+        ``alpha`` are ``(N,)`` (mm, rad); returns ``(q, eps)`` ``(N, 6)``, and with
+        ``branch`` also ``(N, 3)`` each chain's sign of ``n·r`` where it is the same over the
+        whole cell (the link's branch; 0 where it may flip or vanish).
         """
         p = np.asarray(p, float).reshape(-1, 3)
         R = np.asarray(R, float).reshape(-1, 3, 3)
@@ -282,7 +284,8 @@ class Luzi3(Mechanism):
         e = np.repeat(np.where(fixed, eC + half * et, eC + half) + slack, 2, axis=1)
         far = np.stack([np.linalg.norm(C - A1, axis=-1), np.linalg.norm(C - A2, axis=-1)],
                        axis=-1).reshape(-1, 6)
-        return np.where(np.repeat(fixed, 2, axis=1), q, far), e
+        out = np.where(np.repeat(fixed, 2, axis=1), q, far), e
+        return (*out, np.where(fixed, sgn, 0.0).astype(np.int8)) if branch else out
 
     def leg_position_curvature(self, p, R, delta):
         """Gradient ``g (N, 6, 3)`` of each leg length in the position at ``(p, R)`` and a
@@ -325,7 +328,7 @@ class Luzi3(Mechanism):
                 De = np.eye(3) + s * half * Dt
                 g.append(np.einsum("nki,nkij->nkj", e / q[..., None], De))
                 emin = q - G * delta
-                ok = (np.abs(nr) > rn**2 * delta) & (nmin > 0) & (emin > 0)
+                ok = (np.abs(nr) > rn**2 * delta * (1 + 1e-9)) & (nmin > 0) & (emin > 0)
                 M.append(np.where(ok, (G**2 / emin + D2e) * (1 + 1e-9) + 1e-12, np.inf))
         g = np.stack(g, axis=2).reshape(-1, 6, 3)
         M = np.stack(M, axis=2).reshape(-1, 6)

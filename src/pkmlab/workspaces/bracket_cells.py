@@ -142,17 +142,20 @@ def _corners(C0, H0):
 
 
 def _evaluate(mech, oset, P, hP, pid, Oc, Oh):
-    """Per item: ``(q (K, 6), margin (K, 6), eps over the item, eps of the sample)``."""
+    """Per item: ``(q (K, 6), margin (K, 6), eps over the item, eps of the sample, branch
+    (K, chains) at the sample)``."""
     lo_q, hi_q = mech.stroke
     K = len(pid)
     m, qq = np.empty((K, 6)), np.empty((K, 6))
+    br = []
     e_cell, e_s = np.empty((K, 6)), np.empty((K, 6))
     rotating = bool(np.any(Oh > 0))
     for s in range(0, K, _BATCH):
         sl = slice(s, s + _BATCH)
         p, R = P[pid[sl]], oset.rotations_at(Oc[sl])
         delta = math.sqrt(3.0) * hP[pid[sl]]
-        q, e_s[sl] = mech.leg_cell_bounds(p, R, delta, 0.0)
+        q, e_s[sl], b = mech.leg_cell_bounds(p, R, delta, 0.0, branch=True)
+        br.append(b)
         if rotating:
             e_cell[sl] = mech.leg_cell_bounds(p, R, delta,
                                               oc.angle_bound(oset, Oc[sl], Oh[sl]))[1]
@@ -161,7 +164,7 @@ def _evaluate(mech, oset, P, hP, pid, Oc, Oh):
         qq[sl] = q
         with np.errstate(invalid="ignore"):
             m[sl] = np.minimum(q - lo_q, hi_q - q)
-    return qq, m, e_cell, e_s
+    return qq, m, e_cell, e_s, (np.concatenate(br) if br else np.zeros((0, 3), np.int8))
 
 
 def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
@@ -183,6 +186,8 @@ def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
     Oc, Oh = np.tile(C0, (len(P), 1)), np.tile(H0, (len(P), 1))
     in_C, in_h = np.zeros((0, 3)), np.zeros(0)
     V = _corners(C0, H0)
+    b_nom = mech.leg_cell_bounds(p_nom[None], oset.rotations_at(C0[:1]), 0.0, 0.0,
+                                 branch=True)[2][0]
     history: list[dict] = []
     notes: list[str] = []
     evaluations = 0
@@ -190,7 +195,7 @@ def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
     stop = None
     step = 0
     while True:
-        q, m, e_cell, e_s = _evaluate(mech, oset, P, hP, pid, Oc, Oh)
+        q, m, e_cell, e_s, br = _evaluate(mech, oset, P, hP, pid, Oc, Oh)
         evaluations += 6 * len(pid) * (2 if np.any(Oh > 0) else 1)
         with np.errstate(invalid="ignore"):
             item_in, item_out = np.all(m > e_cell, axis=1), np.any(m < -e_cell, axis=1)
@@ -201,7 +206,7 @@ def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
             # the corners of the set as extra samples of every cube (leg extremes lie there)
             vp = np.repeat(np.arange(n), len(V))
             vO = np.tile(V, (n, 1))
-            vq, vm, _, ve = _evaluate(mech, oset, P, hP, vp, vO, np.zeros((len(vp), 3)))
+            vq, vm, _, ve, _ = _evaluate(mech, oset, P, hP, vp, vO, np.zeros((len(vp), 3)))
             evaluations += 6 * len(vp)
             with np.errstate(invalid="ignore"):
                 s_in = np.concatenate([s_in, np.all(vm > ve, axis=1)])
@@ -216,6 +221,11 @@ def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
         else:
             c_out = np.zeros(n, bool)
             np.logical_or.at(c_out, spid, s_out)
+            if kind == "constant":
+                # one rotation: the component stays on the nominal branch of every link
+                other = np.any((br != 0) & (br != b_nom), axis=1)
+                c_out[pid[other]] = True
+                item_in &= np.all(br == b_nom, axis=1)
             keep = ~item_in & ~c_out[pid]
             c_in = ~c_out & (np.bincount(pid[keep], minlength=n) == 0)
         und = ~c_in & ~c_out
@@ -303,7 +313,9 @@ def _partial(mech, oset, kind, P, hP, und, pid, O, q, keep_C, keep_h, connected)
     """Second-order fractions of the undecided cubes (:mod:`.bracket_partial`) from their
     samples: the upper one (constant, dexterous) is the smallest over the samples; the lower
     one (constant, reachable) the largest over the samples whose inner region has a vertex in
-    a kept in cube (so it joins the kept component; any sample without connectivity)."""
+    a kept in cube (so it joins the kept component; any sample without connectivity).
+    ``q`` is the family's bound centre at α = 0, the leg length wherever the curvature bound
+    ``M`` is finite (luzi3: both need the link's sign fixed over the cube)."""
     ui = np.cumsum(und) - 1
     nu = int(und.sum())
     f_lo, f_up = np.zeros(nu), np.ones(nu)
