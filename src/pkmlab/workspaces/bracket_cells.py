@@ -62,6 +62,9 @@ __all__ = ["cell_volume_bracket", "touching_pairs", "touching_components"]
 _FIRST = 32
 #: items evaluated per call of the family's bound
 _BATCH = 200_000
+#: split an item's orientation cell when its rotation part of the bound exceeds this many
+#: times the position part (otherwise the cube)
+_TURN = 1.0
 
 
 def touching_pairs(C: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -349,7 +352,8 @@ def _refine(P, hP, pid, Oc, Oh, e_cell, e_s, und):
     """Split the live items' orientation cells where rotation dominates their bound, and the
     cubes where it dominates none (children inherit the items)."""
     with np.errstate(invalid="ignore"):
-        orient = (np.max(e_cell - e_s, axis=1) > np.max(e_s, axis=1)) & np.any(Oh > 0, axis=1)
+        orient = (np.max(e_cell - e_s, axis=1) > _TURN * np.max(e_s, axis=1)) & np.any(Oh > 0,
+                                                                              axis=1)
     n = len(P)
     turn = np.zeros(n, bool)
     np.logical_or.at(turn, pid, orient)
