@@ -166,3 +166,22 @@ def test_cube_fraction_matches_monte_carlo():
     mc = np.array([np.mean((x * s[i]) @ g[i] <= c[i]) for i in range(60)])
     tol = 5 * np.sqrt(0.25 / len(x))
     assert np.all(lo <= mc + tol) and np.all(mc <= hi + tol) and np.all(hi - lo < 3e-3)
+
+
+def test_euler_angle_bound_holds_off_level():
+    """The L2 form of cells.angle_bound (sqrt(1 + sin β)·|half|₂), with the set's centre
+    included in β, against the true rotation angle."""
+    from pkmlab.workspaces import cells as oc
+
+    rng = np.random.default_rng(10)
+    for cy in (0.0, 0.7, 1.5):
+        oset = OrientationSet.box((0.6, 0.6, 0.6)).centred((0.2, cy, -0.4))
+        n = 20_000
+        C = rng.uniform(-0.5, 0.5, (n, 3))
+        H = rng.uniform(0, 0.3, (n, 3))
+        P = C + H * rng.choice([-1.0, 1.0], (n, 3))            # cell corners: the worst case
+        R0, R1 = oset.rotations_at(C), oset.rotations_at(P)
+        angle = Rotation.from_matrix(np.swapaxes(R0, 1, 2) @ R1).magnitude()
+        bound = oc.angle_bound(oset, C, H)
+        assert np.all(angle <= bound * (1 + 1e-12))
+        assert np.median(bound / H.sum(axis=1)) < 0.95     # tighter than the L1 sum
