@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["cube_fraction", "sample_fractions"]
+__all__ = ["cube_fraction", "sample_fractions", "vertices"]
 
 _SIGMA = np.array(np.meshgrid(*[(0.0, 1.0)] * 3, indexing="ij")).reshape(3, -1).T   # (8, 3)
 _VERT = 2 * _SIGMA - 1                                                              # (8, 3)
