@@ -170,9 +170,9 @@ def test_bracket_contains_a_dense_estimate_and_narrows_with_the_budget(psu):
 
 
 def test_bracket_refuses_what_it_cannot_guarantee(psu):
-    luzi = load_mechanism(MECH_DIR / "luzi-3chain.yaml")
+    rss = load_mechanism(MECH_DIR / "instructables-servo-6rss.yaml")
     with pytest.raises(ParameterError, match="bracket"):
-        volume_bracket(luzi, "constant")
+        volume_bracket(rss, "constant")
     with pytest.raises(ParameterError, match="constraints"):
         volume_bracket(psu, "constant", constraints=Constraints(kappa_max=50.0))
 

@@ -58,7 +58,7 @@ def _print_bracket(res, vb) -> None:
     if vb:
         out.print(f"  guaranteed volume bracket [{vb['lower_cm3']:.3f}, {vb['upper_cm3']:.3f}] cm³ "
                   f"over the continuous set (width {100 * vb['relative_width']:.2f} %, "
-                  f"{escape(vb['stop_reason'])}, {vb['seconds']:.1f} s, final x-y cell "
+                  f"{escape(vb['stop_reason'])}, {vb['seconds']:.1f} s, final cell "
                   f"{vb['final_resolution_mm']:g} mm)")
 
 

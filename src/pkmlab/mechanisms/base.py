@@ -23,6 +23,9 @@ method whose name starts with ``_``):
   ``column_intervals(xs, ys, R, mode)`` (and ``column_radial`` when the leg intervals are
   monotone functions of the distance from the leg's column axis, with ``column_profile()``
   giving their closed form for the guaranteed volume bracket, :mod:`pkmlab.workspaces.bracket`);
+  families without column kernels may set ``cell_bounds`` and give ``leg_cell_bounds(p, R,
+  delta, alpha)`` (each leg's length and a bound on its change over a position ball × rotation
+  cell) for the cell bracket, :mod:`pkmlab.workspaces.bracket_cells`;
 * equality and hashing by geometry (two mechanisms with the same family, joints, stroke, tool
   offset and nominal pose are equal, whatever their names).
 
@@ -174,6 +177,23 @@ class Mechanism:
     #: :func:`._kernels.make_column_kernel`); families with it set ``column_method``. Test
     #: ``mech.column_leg is None`` (per instance); kernels are built from ``type(mech)``'s.
     column_leg: ClassVar[Any] = None
+
+    #: True when the family gives :meth:`leg_cell_bounds` (luzi3): the volume bracket then
+    #: works on position cells × orientation cells (:mod:`pkmlab.workspaces.bracket_cells`).
+    cell_bounds: ClassVar[bool] = False
+    #: True when the family also gives ``leg_position_curvature(p, R, delta)`` (each leg's
+    #: gradient in the position and a bound on its second derivative over a ball): the cell
+    #: bracket then bounds the volume inside undecided cubes to second order.
+    position_curvature: ClassVar[bool] = False
+
+    def leg_cell_bounds(self, p, R, delta, alpha, branch=False):  # pragma: no cover
+        """``(q, eps)``, both ``(N, 6)``: for every position within ``delta (N,)`` mm of ``p``
+        and every rotation within the angle ``alpha (N,)`` rad of ``R`` (``(p (N, 3), R (N,
+        3, 3))`` the cell centres), each actuator value lies in ``q ± eps``; ``q`` is the value
+        at the centre wherever the family can say so. With ``branch``, also an int array of
+        the inverse kinematics' branch per chain where it is the same over the cell (0 where
+        it may change); luzi3: see its docstring."""
+        raise NotImplementedError
 
     def column_params(self) -> np.ndarray:  # pragma: no cover - optional
         """``(6, 3)`` per-leg parameters of ``column_leg``."""

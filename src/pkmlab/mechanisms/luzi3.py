@@ -228,6 +228,112 @@ class Luzi3(Mechanism):
         hi = (centre + reach).reshape(len(R), 6, 3).min(axis=1)
         return np.stack([lo, hi], axis=1)
 
+    cell_bounds = True
+    position_curvature = True
+
+    def leg_cell_bounds(self, p, R, delta, alpha, branch: bool = False):
+        """Leg lengths at ``(p, R)`` and a bound on their change over a cell (triangle
+        inequalities, no linearisation): for ``|p' - p| <= δ`` and ``angle(R'R^T) <= α``,
+        with ``c = 2 sin(α/2)``,
+
+        * ``|C' - C| <= εC = δ + c·|ρ_i|`` and ``|k' - k| <= c``;
+        * ``w = r × (C - A1)``: ``|w' - w| <= εw = |r|·εC``;
+        * ``n = k × w``: ``|n' - n| <= εn = c·(|w| + εw) + εw``;
+        * when ``|n·r| > εn·|r|`` the sign that makes ``t·r >= 0`` is the same over the cell
+          and ``n`` never vanishes, so the angle between ``n'`` and ``n`` is at most
+          ``asin(εn/|n|)`` and ``|t' - t| <= εt = 2 sin(asin(εn/|n|)/2)``, and
+          ``|q'_ij - q_ij| <= |B'_ij - B_ij| <= εC + (l/2)·εt``;
+        * otherwise (the upper link may flip or be undefined in the cell) ``B = C ∓ (l/2)t``
+          with ``|t| = 1`` still gives ``|q' - |C - A_ij|| <= εC + l/2``: the centre returned
+          is then ``|C - A_ij|``, not the leg length (``q`` below is the centre of each bound,
+          equal to the leg length wherever the sign is fixed; a pose where the link is
+          undefined is not in the workspace, so the bound only needs to hold elsewhere).
+
+        A slack of ``1e-9 mm + 1e-12·scale`` covers floating-point rounding. ``delta`` and
+        ``alpha`` are ``(N,)`` (mm, rad); returns ``(q, eps)`` ``(N, 6)``, and with
+        ``branch`` also ``(N, 3)`` each chain's sign of ``n·r`` where it is the same over the
+        whole cell (the link's branch; 0 where it may flip or vanish).
+        """
+        p = np.asarray(p, float).reshape(-1, 3)
+        R = np.asarray(R, float).reshape(-1, 3, 3)
+        delta = np.broadcast_to(np.asarray(delta, float), (len(p),))
+        c = 2 * np.sin(0.5 * np.minimum(np.broadcast_to(np.asarray(alpha, float),
+                                                        (len(p),)), math.pi))
+        A1, A2 = self.base_points[0::2], self.base_points[1::2]
+        r = A2 - A1
+        rn = np.linalg.norm(r, axis=1)                                     # (3,)
+        rho = np.einsum("nij,kj->nki", R, self.tool_points)
+        C = p[:, None, :] + rho
+        k = R[:, None, :, 2]
+        w = np.cross(r, C - A1)
+        n = np.cross(k, w)
+        nn = np.linalg.norm(n, axis=-1)
+        eC = delta[:, None] + c[:, None] * np.linalg.norm(self.tool_points, axis=1)
+        ew = rn * eC
+        en = c[:, None] * (np.linalg.norm(w, axis=-1) + ew) + ew
+        nr = np.einsum("nki,ki->nk", n, r)
+        fixed = np.abs(nr) > en * rn
+        sgn = np.where(nr >= 0, 1.0, -1.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = n * (sgn / nn)[..., None]
+            et = 2 * np.sin(0.5 * np.arcsin(np.minimum(en / nn, 1.0)))
+        half = 0.5 * self.upper_link
+        q = np.stack([np.linalg.norm(C - half * t - A1, axis=-1),
+                      np.linalg.norm(C + half * t - A2, axis=-1)], axis=-1).reshape(-1, 6)
+        slack = 1e-9 + 1e-12 * self.scale
+        e = np.repeat(np.where(fixed, eC + half * et, eC + half) + slack, 2, axis=1)
+        far = np.stack([np.linalg.norm(C - A1, axis=-1), np.linalg.norm(C - A2, axis=-1)],
+                       axis=-1).reshape(-1, 6)
+        out = np.where(np.repeat(fixed, 2, axis=1), q, far), e
+        return (*out, np.where(fixed, sgn, 0.0).astype(np.int8)) if branch else out
+
+    def leg_position_curvature(self, p, R, delta):
+        """Gradient ``g (N, 6, 3)`` of each leg length in the position at ``(p, R)`` and a
+        bound ``M (N, 6)`` on its second derivative over the ball ``|p' - p| <= δ`` (rotation
+        fixed), so ``|q(p') - q(p) - g·(p' - p)| <= M·|p' - p|²/2``; ``inf`` where none holds.
+
+        At fixed R, ``n = N·(C - A1)`` is linear with ``N = [k]×[r]×``, ``|N| <= |r|``; the
+        unit vector ``t`` has ``|Dt| <= |r|/|n|`` and ``|D²t| <= (2/√3)·|r|²/|n|²`` (the
+        second derivative of ``x/|x|`` along a unit ``h`` is ``-(2a·h + (1 - 3a²)·x̂)/|x|²``,
+        ``a = x̂·h``, of norm ``sqrt(1 + 2a² - 3a⁴) <= 2/√3``). With ``e = C ∓ (l/2)t - A``:
+        ``|De| <= G = 1 + (l/2)|r|/|n|min``, ``|D²e| <= (l/2)(2/√3)|r|²/|n|min²``, and
+        ``|D²|e|| <= G²/|e|min + |D²e|``, where ``|n|min = |n| - |r|δ`` and ``|e|min = q -
+        G·δ`` must be positive, and the sign of ``t`` fixed (as in :meth:`leg_cell_bounds`).
+        """
+        p = np.asarray(p, float).reshape(-1, 3)
+        R = np.asarray(R, float).reshape(-1, 3, 3)
+        delta = np.broadcast_to(np.asarray(delta, float), (len(p),))[:, None]
+        A1, A2 = self.base_points[0::2], self.base_points[1::2]
+        r = A2 - A1
+        rn = np.linalg.norm(r, axis=1)
+        C = p[:, None, :] + np.einsum("nij,kj->nki", R, self.tool_points)
+        k = R[:, None, :, 2]
+        n = np.cross(k, np.cross(r, C - A1))
+        nn = np.linalg.norm(n, axis=-1)
+        nr = np.einsum("nki,ki->nk", n, r)
+        nmin = nn - rn * delta
+        sgn = np.where(nr >= 0, 1.0, -1.0)
+        half = 0.5 * self.upper_link
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = n * (sgn / nn)[..., None]
+            N = np.einsum("nkij,kjl->nkil", skew(R[:, None, :, 2]), skew(r))   # (N, 3, 3, 3)
+            Dt = (np.eye(3) - t[..., :, None] * t[..., None, :]) @ N * (sgn / nn)[..., None,
+                                                                                  None]
+            G = 1 + half * rn / nmin
+            D2e = half * (2 / math.sqrt(3)) * rn**2 / nmin**2
+            g, M = [], []
+            for s, A in ((-1.0, A1), (1.0, A2)):
+                e = C + s * half * t - A
+                q = np.linalg.norm(e, axis=-1)
+                De = np.eye(3) + s * half * Dt
+                g.append(np.einsum("nki,nkij->nkj", e / q[..., None], De))
+                emin = q - G * delta
+                ok = (np.abs(nr) > rn**2 * delta * (1 + 1e-9)) & (nmin > 0) & (emin > 0)
+                M.append(np.where(ok, (G**2 / emin + D2e) * (1 + 1e-9) + 1e-12, np.inf))
+        g = np.stack(g, axis=2).reshape(-1, 6, 3)
+        M = np.stack(M, axis=2).reshape(-1, 6)
+        return g, M
+
     def leg_segments(self, p, R):
         """Actuated legs ``A_ij → B_ij`` as end points ``(N, 6, 3)`` each."""
         rho = np.einsum("nij,kj->nki", R, self.tool_points)

@@ -121,7 +121,7 @@ def _volume_bracket(mech, ctx: Context) -> dict:
     if b.stop_reason != "converged":
         ctx.notes["workspace_volume_lower"] = (
             f"bracket stopped: {b.stop_reason} at {100 * b.relative_width:.2f} % width "
-            f"(x-y cell {b.resolution:g} mm)")
+            f"(final cell {b.resolution:g} mm)")
     for n in b.notes:
         ctx.notes["workspace_volume_upper"] = n
     return {"workspace_volume_lower": lo, "workspace_volume_upper": hi,

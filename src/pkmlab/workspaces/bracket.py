@@ -51,6 +51,8 @@ set the nominal position is certainly not in the workspace, the engine keeps the
 (lower 0, upper the whole outer set), with a note.
 
 Only the actuator stroke (and connectivity) are bracketed; other constraints are refused.
+Families without column kernels that bound their legs over cells (``cell_bounds``: luzi3)
+are bracketed on position × orientation cells instead (:mod:`.bracket_cells`).
 """
 
 from __future__ import annotations
@@ -59,13 +61,14 @@ import dataclasses
 import logging
 import math
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import ParameterError
 from ..poses import as_frames, matrix_to_euler
 from . import cells as oc
+from .bracket_cells import cell_volume_bracket
+from .bracket_result import VolumeBracket
 from .bracket_sets import connected, inside, length, pieces_of, tri_volume, union
 from .constraints import Constraints
 from .legbounds import Legs
@@ -77,80 +80,6 @@ __all__ = ["VolumeBracket", "volume_bracket"]
 
 #: items (column × orientation cell) evaluated per batch
 _BATCH = 100_000
-
-
-@dataclass(frozen=True, eq=False)
-class VolumeBracket:
-    """A guaranteed volume bracket (mm³) and how it was reached.
-
-    Attributes:
-        lower, upper: the bracket (mm³): the intersection of every step's bracket (each
-            holds; a new x-y level restarts the orientation refinement, so the last step is not
-            always the tightest).
-        target: relative width asked for (``upper - lower <= target·upper``).
-        stop_reason: ``"converged"``, ``"budget: seconds"``, ``"budget: evaluations"``,
-            ``"budget: cells"`` or ``"empty"``.
-        history: one dict per refinement step (level, cell size h, orientation cells, lower,
-            upper, seconds, evaluations).
-        resolution: the x-y cell size of the last level (mm).
-        evaluations: leg-bound evaluations spent.
-        seconds: wall time.
-        notes: remarks (connectivity, nominal position).
-        cells: the last level's column centres ``(n, 2)``; ``inner``/``outer``: its sets as
-            ``(column index, lo, hi)`` piece arrays, connectivity applied. These are the
-            per-cell (first order in x-y) sets: ``inner`` lies inside the workspace and the
-            workspace inside ``outer``; the x-y second-order volume bounds (constant,
-            dexterous) are tighter than their volumes and are not stored as sets.
-    """
-
-    lower: float
-    upper: float
-    target: float
-    stop_reason: str
-    history: list
-    resolution: float
-    evaluations: int
-    seconds: float
-    notes: list = field(default_factory=list)
-    cells: np.ndarray | None = None
-    inner: tuple | None = None
-    outer: tuple | None = None
-
-    @property
-    def estimate(self) -> float:
-        """Midpoint of the bracket (mm³); it is within ``width / 2`` of the true volume."""
-        return 0.5 * (self.lower + self.upper)
-
-    @property
-    def width(self) -> float:
-        return self.upper - self.lower
-
-    @property
-    def relative_width(self) -> float:
-        return self.width / self.upper if self.upper > 0 else 0.0
-
-    def contains(self, points, which: str = "outer") -> np.ndarray:
-        """``(N,)`` bool: points in the final inner or outer set (closed cells)."""
-        P = np.asarray(points, float).reshape(-1, 3)
-        col, lo, hi = self.inner if which == "inner" else self.outer
-        out = np.zeros(len(P), dtype=bool)
-        h = self.resolution
-        for c in np.unique(col):
-            cx, cy = self.cells[c]
-            sel = (np.abs(P[:, 0] - cx) <= h / 2) & (np.abs(P[:, 1] - cy) <= h / 2)
-            for a, b in zip(lo[col == c], hi[col == c], strict=True):
-                out |= sel & (P[:, 2] >= a) & (P[:, 2] <= b)
-        return out
-
-    def describe(self) -> dict:
-        """Plain-dict summary (mm³ and cm³) for JSON."""
-        return {"lower_mm3": self.lower, "upper_mm3": self.upper,
-                "estimate_mm3": self.estimate, "lower_cm3": self.lower / 1e3,
-                "upper_cm3": self.upper / 1e3, "estimate_cm3": self.estimate / 1e3,
-                "relative_width": self.relative_width, "target": self.target,
-                "stop_reason": self.stop_reason, "final_resolution_mm": self.resolution,
-                "evaluations": self.evaluations, "seconds": self.seconds,
-                "history": list(self.history), "notes": list(self.notes)}
 
 
 # ---- one x-y level ------------------------------------------------------------------------------
@@ -347,9 +276,10 @@ def _request(mech, kind, orientations, resolution, constraints):
     from .engine import check_request
 
     check_request(kind, resolution)
-    if not mech.column_radial or mech.column_method is None:
-        raise ParameterError("bracket", "a family with radial column kernels (psu6, ups6); "
-                             f"family {mech.family!r} has none", mech.family)
+    if not mech.cell_bounds and (not mech.column_radial or mech.column_method is None):
+        raise ParameterError("bracket", "a family with radial column kernels (psu6, ups6) or "
+                             f"cell leg bounds (luzi3); family {mech.family!r} has neither",
+                             mech.family)
     cons = constraints or Constraints()
     if cons.extra:
         raise ParameterError("constraints", "the stroke (and connectivity) only: a volume "
@@ -381,6 +311,9 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
     """
     t0 = time.perf_counter()
     mech, oset, cons = _request(mech, kind, orientations, resolution, constraints)
+    if mech.cell_bounds:
+        return cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
+                                   max_cells, max_evaluations)
     legs = Legs(mech, oset)
     p_nom = mech.nominal_pose[:3]
     # every feasible p has |p_xy + w_xy| <= reach_i, |w_xy + b_xy| <= |u_i|

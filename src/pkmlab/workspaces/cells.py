@@ -12,7 +12,10 @@ most the length of any path between them, ``∫ |ω| dt`` along the straight seg
 
 * Euler box: ``R = Rz(θz)·Ry(θy)·Rx(θx)`` (centre angles added), so ``ω = θz'·e_z +
   θy'·Rz·e_y + θx'·Rz·Ry·e_x`` and ``|ω| <= |θx'| + |θy'| + |θz'|``: the angle is at most
-  ``Σ_j |ΔP_j| <= Σ_j half_j``.
+  ``Σ_j |ΔP_j| <= Σ_j half_j``. The axes are orthogonal but for ``e_z·Rz·Ry·e_x = -sin θy``,
+  so ``|ω|² = |θ'|² - 2θz'θx'·sin θy <= (1 + |sin θy|)·|θ'|²`` and the angle is also at most
+  ``sqrt(1 + sin β)·|half|₂`` (β the cell's largest |θy|, the set's centre included, capped
+  at 90°); the smaller of the two is used.
 * tilt-torsion: ``R = R_c·Rz(φ)·Ry(θ)·Rz(σ - φ)``, ``ω = φ'·(e_z - Rz(φ)Ry(θ)e_z) +
   θ'·Rz(φ)e_y + σ'·Rz(φ)Ry(θ)e_z`` with ``|e_z - Rz(φ)Ry(θ)e_z| = 2 sin(θ/2)``: the angle is at
   most ``2 sin(θ_max/2)·half_φ + half_θ + half_σ`` (θ_max the cell's largest tilt), so cells
@@ -112,7 +115,9 @@ def angle_bound(oset, centres: np.ndarray, halves: np.ndarray) -> np.ndarray:
     rotation at its centre (module notes)."""
     H = np.abs(np.asarray(halves, float))
     if oset.kind != "tilt-torsion":
-        return H.sum(axis=1)
+        cy = 0.0 if oset.centre is None else float(oset.centre[1])
+        bmax = np.minimum(np.abs(cy + np.asarray(centres, float)[:, 1]) + H[:, 1], math.pi / 2)
+        return np.minimum(H.sum(axis=1), np.sqrt(1 + np.sin(bmax)) * np.linalg.norm(H, axis=1))
     tmax = np.minimum(np.abs(centres[:, 1]) + H[:, 1], math.pi)
     return 2 * np.sin(0.5 * tmax) * H[:, 0] + H[:, 1] + H[:, 2]
 
