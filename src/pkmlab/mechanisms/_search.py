@@ -54,11 +54,10 @@ from numba import types as nt
 
 from .._jit import cached_kernel, identity, jitable
 from . import _kernels
+from ._tiles import DPAD, tile_distances  # DPAD: padding of distance ranges (mm)
 
 __all__ = ["make_branch_bound", "make_certify", "make_capability", "DPAD"]
 
-#: padding of distance ranges (mm): rounding in a column's distance stays inside the bounds
-DPAD = 1e-6
 #: a tile's upper bound must be below -UB_TOL (mm) to count as empty
 UB_TOL = 1e-9
 #: the best point of a sample is searched to this margin (mm) before it is certified
@@ -122,13 +121,7 @@ def _core(leg):
         for m in range(M):
             for i in range(6):
                 wx, wy, wz = W[m, i, 0], W[m, i, 1], W[m, i, 2]
-                cx, cy = -wx, -wy
-                gx = max(max(x0 - cx, cx - x1), 0.0)
-                gy = max(max(y0 - cy, cy - y1), 0.0)
-                dmin = max(math.sqrt(gx * gx + gy * gy) - DPAD, 0.0)
-                fx = max(abs(x0 - cx), abs(x1 - cx))
-                fy = max(abs(y0 - cy), abs(y1 - cy))
-                dmax = math.sqrt(fx * fx + fy * fy) + DPAD
+                dmin, dmax = tile_distances(x0, x1, y0, y1, -wx, -wy)
                 a1, b1, ok1 = leg(dmin - wx, -wy, wx, wy, wz, P[i, 0], P[i, 1], P[i, 2])
                 if not ok1:
                     return -np.inf

@@ -35,13 +35,13 @@ import math
 from functools import cache
 
 import numpy as np
-from numba import prange
+from numba import njit, prange
 from numba import types as nt
 
 from .._jit import cached_kernel
 from . import _kernels
 
-__all__ = ["MIN_COLUMNS", "TILE", "make_tiled_all"]
+__all__ = ["MIN_COLUMNS", "TILE", "make_tiled_all", "tile_distances"]
 
 #: columns per side of a top-level tile; each tile is split in four down to LEAF
 TILE = 32
@@ -56,6 +56,18 @@ MIN_COLUMNS = 20_000
 DPAD = 1e-6
 #: slack of the pruning comparisons (mm)
 SLACK = 1e-6
+
+
+@njit(inline="always")
+def tile_distances(x0, x1, y0, y1, cx, cy):
+    """Nearest and farthest distance of the rectangle ``[x0, x1] × [y0, y1]`` from the point
+    ``(cx, cy)`` (a leg's column axis), padded outward by :data:`DPAD` against rounding."""
+    gx = max(max(x0 - cx, cx - x1), 0.0)
+    gy = max(max(y0 - cy, cy - y1), 0.0)
+    fx = max(abs(x0 - cx), abs(x1 - cx))
+    fy = max(abs(y0 - cy), abs(y1 - cy))
+    return (max(math.sqrt(gx * gx + gy * gy) - DPAD, 0.0),
+            math.sqrt(fx * fx + fy * fy) + DPAD)
 
 
 @cache
@@ -97,13 +109,7 @@ def make_tiled_all(leg):
                     k = c if lev == 0 else cand[lev - 1, c]
                     m, i = k // 6, k % 6
                     wx, wy, wz = W[m, i, 0], W[m, i, 1], W[m, i, 2]
-                    cx, cy = -wx, -wy
-                    gx = max(max(x0 - cx, cx - x1), 0.0)
-                    gy = max(max(y0 - cy, cy - y1), 0.0)
-                    dmin = max(math.sqrt(gx * gx + gy * gy) - DPAD, 0.0)
-                    fx = max(abs(x0 - cx), abs(x1 - cx))
-                    fy = max(abs(y0 - cy), abs(y1 - cy))
-                    dmax = math.sqrt(fx * fx + fy * fy) + DPAD
+                    dmin, dmax = tile_distances(x0, x1, y0, y1, -wx, -wy)
                     a1, b1, ok1 = leg(dmin - wx, -wy, wx, wy, wz, P[i, 0], P[i, 1], P[i, 2])
                     a2, b2, ok2 = leg(dmax - wx, -wy, wx, wy, wz, P[i, 0], P[i, 1], P[i, 2])
                     if not ok1:
