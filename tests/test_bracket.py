@@ -18,6 +18,7 @@ from pkmlab import load_mechanism
 from pkmlab.cli import app
 from pkmlab.errors import ParameterError
 from pkmlab.mechanisms._kernels import make_leg_eval
+from pkmlab.mechanisms.ups6 import working_sides
 from pkmlab.study import evaluators as ev_mod
 from pkmlab.study import load_study
 from pkmlab.workspaces import OrientationSet, workspace
@@ -167,6 +168,66 @@ def test_bracket_contains_a_dense_estimate_and_narrows_with_the_budget(psu):
         assert [r["h_mm"] for r in b.history] == sorted((r["h_mm"] for r in b.history),
                                                         reverse=True)
     assert widths[1] < 0.2 * widths[0]
+
+
+def test_reachable_bracket_contains_independent_estimates(psu, ups):
+    """Reachable kind (x-y second-order upper bound over pairs of legs, cells' vertices as
+    samples): the bracket contains estimates that lie on known sides of the truth.
+
+    * from below: the engine's union over a dense orientation grid (every sample is in the
+      set; its x-y error is second order and far below the margins here);
+    * from above (6-UPS, whose leg lengths and working-mode sides move by at most the
+      platform points' displacement): the points of a lattice that some cell centre reaches
+      with every leg's stroke and side widened by the cell's chord bound, ``2 sin(α/2)·|u|``:
+      every truly reachable point is among them (up to the lattice's counting error)."""
+    box5 = OrientationSet.box([D5] * 3)
+    b = volume_bracket(psu, "reachable", box5, 5.0, budget_s=2.0)
+    below = workspace(psu, "reachable", box5.with_samples(7), 2.5).volume
+    assert b.lower < below <= b.upper
+
+    tt = OrientationSet.tilt_torsion(math.radians(8), math.radians(5))
+    b = volume_bracket(ups, "reachable", tt, 25.0, budget_s=2.0)
+    below = workspace(ups, "reachable", tt.with_samples(5), 25.0).volume
+    assert below <= b.upper
+    C, H = oc.initial_cells(tt, 1)
+    C, H, _ = oc.split(C, H)
+    R = tt.rotations_at(C)
+    eps = oc.chord(oc.angle_bound(tt, C, H))[:, None] * np.linalg.norm(ups.tool_points, axis=1)
+    side = working_sides(ups)
+    col, zlo, zhi = b.outer
+    g = 40.0
+    axes = [np.arange(b.cells[:, k].min() - g, b.cells[:, k].max() + g, g) for k in (0, 1)]
+    axes.append(np.arange(zlo.min() - g, zhi.max() + g, g))
+    P = np.stack([a.ravel() for a in np.meshgrid(*axes, indexing="ij")], axis=1)
+    lo, hi = ups.stroke
+    reached = np.zeros(len(P), bool)
+    Ru = np.einsum("mij,kj->mki", R, ups.tool_points) - ups.base_points
+    for m in range(len(R)):
+        v = P[:, None, :] + Ru[m]
+        q = np.linalg.norm(v, axis=-1)
+        reached |= np.all((q >= lo - eps[m]) & (q <= hi + eps[m])
+                          & (v[..., 2] * side >= -eps[m]), axis=1)
+    above = reached.sum() * g**3
+    assert b.lower <= above
+    assert below <= above
+
+
+def test_time_budget_is_honoured_within_its_tolerance(psu):
+    """The budget is checked between batches and a step that would pass it is abandoned
+    (the bracket of the last completed step is returned). Before, the step running at the
+    budget completed. The budget is set relative to the first step's time on this machine
+    (so that the load does not move it across step boundaries): 5 first steps, which the
+    old code overran to about 10 (its fourth step)."""
+    box5 = OrientationSet.box([D5] * 3)
+    for _ in range(2):                               # the second call runs warm
+        first = volume_bracket(psu, "reachable", box5, 2.5, budget_s=1e-3)
+        assert len(first.history) == 1               # the first step always completes
+    budget = 5.0 * (first.history[0]["seconds"] - first.setup_seconds)
+    b = volume_bracket(psu, "reachable", box5, 2.5, target=1e-4, budget_s=budget)
+    assert b.stop_reason == "budget: seconds"
+    assert b.seconds - b.setup_seconds <= 1.25 * budget + 1.0
+    assert b.history[-1]["seconds"] <= b.seconds
+    assert b.lower <= b.upper
 
 
 def test_bracket_refuses_what_it_cannot_guarantee(psu):

@@ -66,7 +66,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..poses import as_frames, matrix_to_euler
 from . import cells as oc
-from .bracket_level import Level
+from .bracket_level import BATCH, Level
 from .bracket_sets import connected, length, warm_up
 from .constraints import Constraints
 from .legbounds import Legs
@@ -185,12 +185,21 @@ class _Clock:
     bookkeeping of the step (as last measured) still ends within the budget; the first step
     of a run is always allowed (it gives the first bracket)."""
 
+    #: target duration of one batch (s): the tolerance of the budget
+    BATCH_S = 0.5
+
     def __init__(self, start: float, budget: float):
         self.deadline = start + budget
         self.rate = 0.0          # s per item
         self.post = 0.0          # s of bookkeeping after a step's batches
         self.enforce = False
         self.t = start
+
+    def batch(self) -> int:
+        """Items per batch: about ``BATCH_S`` seconds at the current rate."""
+        if self.rate <= 0:
+            return 5_000
+        return int(min(max(self.BATCH_S / self.rate, 1_000), BATCH))
 
     def allows(self, items: int) -> bool:
         self.t = time.perf_counter()
@@ -216,10 +225,12 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
         target: stop when ``upper - lower <= target·upper``.
         budget_s: wall-time budget (s), counted after the set-up (kernel compilation or
             cache load, reported as ``setup_seconds``). The first refinement step always
-            completes; after it, a step is abandoned before a batch (at most ``BATCH``
-            items) that would end past the budget, and the bracket of the last completed
-            step is returned: the overrun is at most one batch and one step's bookkeeping
-            misjudged (about 0.1–1 s), unless the first step alone is longer.
+            completes; after it, the clock is checked between batches of items sized to
+            take about 0.5 s, and a step is abandoned before a batch that would end past the
+            budget (at the slowest recent rate, plus the last step's bookkeeping): the
+            bracket of the last completed step is returned. The overrun is the misjudged
+            part of one batch and one step's bookkeeping, about 0.5 s (``tests`` allow
+            ``0.25·budget + 1 s``), unless the first step alone is longer.
         max_evaluations: budget of leg-bound evaluations.
         max_cells: largest number of (column × orientation cell) items of one step.
     """
@@ -230,6 +241,7 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
     # every feasible p has |p_xy + w_xy| <= reach_i, |w_xy + b_xy| <= |u_i|
     reach = legs.reach()
     warm_up()
+    legs.warm_up()
     t0 = time.perf_counter()
     setup = t0 - t_call
     clock = _Clock(t0, budget_s)
@@ -253,8 +265,9 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
     stop = None
     final = None                                # (h, cells, kept sets) of the last step
     lower, upper, outside, seen_outside = 0.0, math.inf, False, False
+    seed = None
     while stop is None:
-        lv = Level(legs, kind, cx, cy, h, C0, H0)
+        lv = Level(legs, kind, cx, cy, h, C0, H0, seed)
         while True:
             sets = lv.step(clock)
             if sets is None:
@@ -299,15 +312,19 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
                 more = lv.pl_upper - lv.pl_upper_x
                 g_orient = float(np.sum(more[np.isfinite(more)]))
                 g_all = gap
-            if not np.any(lv.H > 0) or g_orient <= 0.5 * (g_all - g_orient):
+            # (reachable: part of the cells' excess over the samples does not shrink with
+            # the cells, so halve h as soon as the x-y part is as large)
+            share = 1.0 if lv.reach_up is not None else 0.5
+            if not np.any(lv.H > 0) or g_orient <= share * (g_all - g_orient):
                 break                                    # the x-y cells dominate: halve h
-            nxt = len(lv.col) * 8
-            if nxt > max_cells:
-                stop = "budget: cells"
-                break
+            if len(lv.col) * 8 > max_cells:
+                break                                    # too many cells: halve h instead
             lv.split()
         if stop is None:
             alive = np.unique(kept[1][0])
+            # the children start from their parent's best sample rotations
+            seed = np.tile(lv.best_rotations()[alive], (4, 1, 1)) if kind == "reachable" \
+                else None
             cx = np.concatenate([lv.cx[alive] + dx * h / 4 for dx in (-1, 1) for _ in (0, 1)])
             cy = np.concatenate([lv.cy[alive] + dy * h / 4 for _ in (0, 1) for dy in (-1, 1)])
             h *= 0.5

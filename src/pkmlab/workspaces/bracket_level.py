@@ -11,8 +11,9 @@ from .bracket_sets import inside, pieces_of, tri_volume, union
 
 __all__ = ["Level", "BATCH"]
 
-#: items (column × orientation cell) evaluated per batch; the time budget is checked between
-#: batches
+#: items (column × orientation cell) evaluated per batch at most; under a time budget the
+#: batches are sized to take about ``bracket._Clock.BATCH_S`` each, and the budget is checked
+#: between them
 BATCH = 25_000
 
 
@@ -38,7 +39,9 @@ def _vertices(C, H):
 class Level:
     """Columns of one x-y level with their orientation cells (items) and running samples."""
 
-    def __init__(self, legs, kind, cx, cy, h, C0, H0):
+    def __init__(self, legs, kind, cx, cy, h, C0, H0, seed=None):
+        """``seed (n, m, 3)``: rotations (set coordinates, NaN for none) evaluated as samples
+        in the first step (the parent columns' best, :meth:`best_rotations`)."""
         self.legs, self.kind, self.h = legs, kind, h
         self.cx, self.cy = cx, cy
         n, L = len(cx), len(C0)
@@ -60,6 +63,30 @@ class Level:
                        "piece_c": np.full(n, -np.inf), "piece": np.full((n, 4), -np.inf)}
         self.pl_lower = self.pl_upper = self.reach_pl = self.reach_up = None
         self.pending = None
+        self.best = {}
+        if seed is not None:
+            good = ~np.isnan(seed).any(axis=-1)
+            self.pending = (np.nonzero(good)[0], seed[good])
+
+    def best_rotations(self) -> np.ndarray:
+        """``(n, m, 3)``: per column, the sample rotations that gave its best top and bottom
+        (inner set, plane and piece), NaN where none."""
+        n = len(self.cx)
+        out = [self.best[k][1] for k in sorted(self.best)]
+        return np.stack(out, axis=1) if out else np.full((n, 0, 3), np.nan)
+
+    def _track(self, key, value, scol, sP, larger):
+        """Keep per column the sample rotation with the largest (or smallest) ``value``."""
+        n = len(self.cx)
+        if key not in self.best:
+            self.best[key] = (np.full(n, -np.inf if larger else np.inf), np.full((n, 3), np.nan))
+        v0, P = self.best[key]
+        v = np.where(np.isnan(value), -np.inf if larger else np.inf, value)
+        best = v0.copy()
+        (np.maximum if larger else np.minimum).at(best, scol, v)
+        win = ((v > v0[scol]) if larger else (v < v0[scol])) & (v == best[scol])
+        P[scol[win]] = sP[win]
+        self.best[key] = (best, P)
 
     def step(self, clock=None):
         """Evaluate the items; update the samples; keep the live items. Returns the column
@@ -69,32 +96,37 @@ class Level:
         the budget: the level is then left as it was before the step."""
         n = len(self.cx)
         reach = self.kind == "reachable"
-        jobs = [(self.cx[self.col[s:s + BATCH]], self.cy[self.col[s:s + BATCH]],
-                 self.C[s:s + BATCH], self.H[s:s + BATCH], True)
-                for s in range(0, max(len(self.col), 1), BATCH)]
+        # (column of each item, rotation cells or points, halves or None for samples)
+        groups = [(self.col, self.C, self.H)]
         if self.corners is not None:
             # the vertices of the first cells (where leg extremes often lie) as samples
             V = self.corners
             vc = np.repeat(np.arange(n), len(V))
             VV = np.tile(V, (n, 1))
-            jobs += [(self.cx[vc[s:s + BATCH]], self.cy[vc[s:s + BATCH]], VV[s:s + BATCH],
-                      None, False) for s in range(0, len(vc), BATCH)]
+            groups.append((vc, VV, None))
         if self.pending is not None:
             # the previous step's live cells' most promising vertices as samples
             pc, PV = self.pending
             vc = np.concatenate([vc, pc]) if self.corners is not None else pc
-            jobs += [(self.cx[pc[s:s + BATCH]], self.cy[pc[s:s + BATCH]], PV[s:s + BATCH],
-                      None, False) for s in range(0, len(pc), BATCH)]
+            groups.append((pc, PV, None))
         parts, vparts = [], []
-        for x, y, C, H, cells in jobs:
-            if clock is not None and not clock.allows(len(x)):
-                return None
-            b = self.legs.bounds(x, y, 0.5 * self.h, C, H, with_cells=cells, reachable=reach)
-            if clock is not None:
-                clock.done(len(x))
-            (parts if cells else vparts).append(b)
+        for gcol, C, H in groups:
+            s = 0
+            while s < max(len(gcol), 1 if H is not None else 0):
+                size = clock.batch() if clock is not None else BATCH
+                if clock is not None and not clock.allows(len(gcol[s:s + size])):
+                    return None
+                sl = slice(s, s + size)
+                b = self.legs.bounds(self.cx[gcol[sl]], self.cy[gcol[sl]], 0.5 * self.h, C[sl],
+                                     None if H is None else H[sl], with_cells=H is not None,
+                                     reachable=reach)
+                if clock is not None:
+                    clock.done(len(gcol[sl]))
+                (parts if H is not None else vparts).append(b)
+                s += size
         ev = _collect(parts)
         col = scol = self.col
+        sP = self.C
         T = ev.pop("toward")[0] if "toward" in ev else None
         if vparts:
             b = _collect(vparts)
@@ -102,14 +134,25 @@ class Level:
                 if k in b:
                     ev[k] = _collect([{k: ev[k]}, {k: b[k]}])[k] if k in ev else b[k]
             scol = np.concatenate([col, vc])
+            sP = np.concatenate([self.C] + ([VV] if self.corners is not None else [])
+                                + ([PV] if self.pending is not None else []))
             self.corners = self.pending = None
         if self.kind == "reachable":
             # lower: union of the samples' x-y inner sets; upper: union of the samples' x-y
             # outer sets and of the outer sets of the cells that still reach beyond them
             lo, hi, ok = ev["in0"]
             self.samples = union(n, self.samples[:3], (scol[ok], lo[ok], hi[ok]))
+            self._track("in_hi", np.where(ok, hi, np.nan), scol, sP, True)
+            self._track("in_lo", np.where(ok, lo, np.nan), scol, sP, False)
             if "pl_sample" in ev:
                 self._reach_planar(ev["pl_sample"], lo, hi, ok, scol)
+                pl = ev["pl_sample"]
+                good = ev["out0"][2]
+                with np.errstate(invalid="ignore"):
+                    self._track("plane", np.where(good, pl["plane"].mean(axis=1), np.nan), scol,
+                                sP, True)
+                    self._track("piece", np.where(good, pl["piece"].mean(axis=1), np.nan),
+                                scol, sP, False)
             lo, hi, ok = ev["out0"]
             self.samples_out = union(n, self.samples_out[:3], (scol[ok], lo[ok], hi[ok]))
             pcol, plo, phi, starts = self.samples_out

@@ -36,6 +36,12 @@ class Legs:
         self.profile = mech.column_profile()                         # (6, 2, 3) or None
         self.count = 0
 
+    @staticmethod
+    def warm_up() -> None:
+        """Load (or compile) the kernels of the bounds, so that a time budget does not pay
+        for them."""
+        _pair(np.zeros((1, 6)), np.zeros((1, 6, 3)), np.zeros((1, 3)))
+
     def ends(self, d):
         """``A(d), B(d), ok(d)`` per leg for ``d (..., 6)``."""
         shape = d.shape
