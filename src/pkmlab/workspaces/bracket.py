@@ -40,6 +40,30 @@ the search restarts on the children of the columns still in the outer set. It st
 ``upper - lower <= target·upper`` or the budget (seconds or leg evaluations) runs out, and
 says which.
 
+**Reachable, second order in x-y** (:meth:`.bracket_level.Level._reach_upper`, families with
+:attr:`.legbounds.Legs.planar`). Over a square, the top of the union over a cell is below an
+affine function of x-y: any convex combination of the legs' upper ends is above the top, each
+end is concave in x-y (below its tangent plane; beyond its sphere the leg is unreachable), and
+the rotation moves the plane by at most the linearised cell plus the remainder. The weights
+are chosen on one leg or a pair so that opposite slopes over the cell cancel (first order in
+the cell otherwise, at every ridge of the minimum over legs). The maximum of these affine
+functions over the cells is convex, so at most its corner interpolation; symmetrically the
+bottom is above a concave function (a convex combination of lower ends whose spheres cover
+the moved square, minimised over the cell), at least its corner interpolation. The column's
+volume is at most the integral of the interpolated difference's positive part. The samples'
+own planes and pieces are kept in those extremes, and a cell whose corner values do not pass
+them is dropped (its outer set joins a per-column hull, for connectivity). The cells' most
+promising vertices (by the linear model) are evaluated as samples in the next step, and a new
+x-y level starts from each parent column's best sample rotations.
+
+**Time budget.** ``budget_s`` counts from the end of the set-up (kernels loaded or
+compiled, legs' reach), reported as ``setup_seconds``. The first step always completes; then
+items are evaluated in batches sized to take about 0.5 s, the clock is checked before each, and
+a step whose remaining items (at the slowest recent rate, plus the last step's bookkeeping)
+would end past the budget is abandoned: the result is the bracket of the last completed step,
+returned early when the next step cannot fit. Overrun: about one misjudged batch
+(``tests/test_bracket.py`` allows ``0.25·budget + 1 s``).
+
 **Connected to nominal.** Components are taken on the inner and outer sets separately (cells
 8-adjacent, z sets touching). The component of the inner set that contains the nominal
 position is a connected subset of the workspace through it, so it lies in the kept component;
@@ -180,9 +204,9 @@ def _request(mech, kind, orientations, resolution, constraints):
 
 
 class _Clock:
-    """The time budget, counted from ``start`` (after the set-up). A batch of items is
-    allowed while the time it is expected to take (at the slowest recent rate) plus the
-    bookkeeping of the step (as last measured) still ends within the budget; the first step
+    """The time budget, counted from ``start`` (after the set-up). The rest of a step is
+    allowed while the time it is expected to take (its items at the slowest recent rate, plus
+    the bookkeeping of a step as last measured) still ends within the budget; the first step
     of a run is always allowed (it gives the first bracket)."""
 
     #: target duration of one batch (s): the tolerance of the budget
@@ -226,11 +250,12 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
         budget_s: wall-time budget (s), counted after the set-up (kernel compilation or
             cache load, reported as ``setup_seconds``). The first refinement step always
             completes; after it, the clock is checked between batches of items sized to
-            take about 0.5 s, and a step is abandoned before a batch that would end past the
-            budget (at the slowest recent rate, plus the last step's bookkeeping): the
-            bracket of the last completed step is returned. The overrun is the misjudged
-            part of one batch and one step's bookkeeping, about 0.5 s (``tests`` allow
-            ``0.25·budget + 1 s``), unless the first step alone is longer.
+            take about 0.5 s, and a step is abandoned as soon as its remaining items (at the
+            slowest recent rate, plus the last step's bookkeeping) would end past the budget:
+            the bracket of the last completed step is returned, possibly well before the
+            budget. The overrun is the misjudged part of one batch and one step's
+            bookkeeping, about 0.5 s (``tests`` allow ``0.25·budget + 1 s``), unless the first
+            step alone is longer.
         max_evaluations: budget of leg-bound evaluations.
         max_cells: largest number of (column × orientation cell) items of one step.
     """

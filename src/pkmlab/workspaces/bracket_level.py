@@ -92,8 +92,8 @@ class Level:
         """Evaluate the items; update the samples; keep the live items. Returns the column
         sets ``(inner, outer, inner_if_exact, outer_if_exact)`` as piece arrays (the last two
         estimate the gap with the orientation part removed), or ``None`` when ``clock`` (the
-        driver's time budget: ``allows(items)``, ``done(items)``) says a batch would end past
-        the budget: the level is then left as it was before the step."""
+        driver's time budget: ``batch()``, ``allows(items)``, ``done(items)``) says the rest of
+        the step would end past the budget: the level is then left as it was before it."""
         n = len(self.cx)
         reach = self.kind == "reachable"
         # (column of each item, rotation cells or points, halves or None for samples)
@@ -110,12 +110,14 @@ class Level:
             vc = np.concatenate([vc, pc]) if self.corners is not None else pc
             groups.append((pc, PV, None))
         parts, vparts = [], []
+        left = sum(len(g[0]) for g in groups)
         for gcol, C, H in groups:
             s = 0
             while s < max(len(gcol), 1 if H is not None else 0):
                 size = clock.batch() if clock is not None else BATCH
-                if clock is not None and not clock.allows(len(gcol[s:s + size])):
-                    return None
+                if clock is not None and not clock.allows(left):
+                    return None                          # the rest of the step would not fit
+                left -= len(gcol[s:s + size])
                 sl = slice(s, s + size)
                 b = self.legs.bounds(self.cx[gcol[sl]], self.cy[gcol[sl]], 0.5 * self.h, C[sl],
                                      None if H is None else H[sl], with_cells=H is not None,
