@@ -59,10 +59,10 @@ x-y level starts from each parent column's best sample rotations.
 **Time budget.** ``budget_s`` counts from the end of the set-up (kernels loaded or
 compiled, legs' reach), reported as ``setup_seconds``. The first step always completes; then
 items are evaluated in batches sized to take about 0.5 s, the clock is checked before each, and
-a step whose remaining items (at the slowest recent rate, plus the last step's bookkeeping)
-would end past the budget is abandoned: the result is the bracket of the last completed step,
-returned early when the next step cannot fit. Overrun: about one misjudged batch
-(``tests/test_bracket.py`` allows ``0.25·budget + 1 s``).
+a step whose next batch, or whose remaining items at twice the recent speed (plus the last
+step's bookkeeping), would end past the budget is abandoned: the result is the bracket of the
+last completed step, returned early when the next step clearly cannot fit. Overrun: about
+one misjudged batch (``tests/test_bracket.py`` allows ``0.25·budget + 1 s``).
 
 **Connected to nominal.** Components are taken on the inner and outer sets separately (cells
 8-adjacent, z sets touching). The component of the inner set that contains the nominal
@@ -205,33 +205,42 @@ def _request(mech, kind, orientations, resolution, constraints):
 
 class _Clock:
     """The time budget, counted from ``start`` (after the set-up). The rest of a step is
-    allowed while the time it is expected to take (its items at the slowest recent rate, plus
-    the bookkeeping of a step as last measured) still ends within the budget; the first step
-    of a run is always allowed (it gives the first bracket)."""
+    allowed while the time it is expected to take (its cell and sample items at their recent
+    rates, plus the bookkeeping of a step as last measured) still ends within the budget; the
+    first step of a run is always allowed (it gives the first bracket). An optimistic estimate
+    costs wasted work, never an overrun: the check repeats before every batch."""
 
     #: target duration of one batch (s): the tolerance of the budget
     BATCH_S = 0.5
+    #: share of the predicted time of the rest of a step that must fit
+    OPTIMISM = 0.5
 
     def __init__(self, start: float, budget: float):
         self.deadline = start + budget
-        self.rate = 0.0          # s per item
+        self.rate = {True: 0.0, False: 0.0}     # s per item: cells, samples
         self.post = 0.0          # s of bookkeeping after a step's batches
         self.enforce = False
         self.t = start
 
-    def batch(self) -> int:
+    def batch(self, cells: bool) -> int:
         """Items per batch: about ``BATCH_S`` seconds at the current rate."""
-        if self.rate <= 0:
-            return 5_000
-        return int(min(max(self.BATCH_S / self.rate, 1_000), BATCH))
+        r = self.rate[cells] or self.rate[not cells]
+        return int(min(max(self.BATCH_S / r, 1_000), BATCH)) if r > 0 else 5_000
 
-    def allows(self, items: int) -> bool:
+    def allows(self, cells: int, samples: int) -> bool:
         self.t = time.perf_counter()
-        return not self.enforce or self.t + items * self.rate + self.post <= self.deadline
+        need = cells * (self.rate[True] or self.rate[False]) \
+            + samples * (self.rate[False] or self.rate[True])
+        # the rates are noisy on a shared machine: give up on the step only when it would not
+        # fit even at twice the measured speed (or its next batch would not fit at all)
+        nxt = min(cells + samples, BATCH) * max(self.rate.values())
+        return not self.enforce or (self.t + self.OPTIMISM * need + self.post <= self.deadline
+                                    and self.t + nxt <= self.deadline)
 
-    def done(self, items: int) -> None:
+    def done(self, items: int, cells: bool) -> None:
         r = (time.perf_counter() - self.t) / max(items, 1)
-        self.rate = max(r, 0.7 * self.rate)
+        old = self.rate[cells]
+        self.rate[cells] = r if old == 0 else 0.5 * (old + r)
 
     def passed(self) -> bool:
         return time.perf_counter() >= self.deadline
@@ -250,8 +259,8 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
         budget_s: wall-time budget (s), counted after the set-up (kernel compilation or
             cache load, reported as ``setup_seconds``). The first refinement step always
             completes; after it, the clock is checked between batches of items sized to
-            take about 0.5 s, and a step is abandoned as soon as its remaining items (at the
-            slowest recent rate, plus the last step's bookkeeping) would end past the budget:
+            take about 0.5 s, and a step is abandoned as soon as its next batch, or its
+            remaining items at twice the recent speed, would end past the budget:
             the bracket of the last completed step is returned, possibly well before the
             budget. The overrun is the misjudged part of one batch and one step's
             bookkeeping, about 0.5 s (``tests`` allow ``0.25·budget + 1 s``), unless the first

@@ -92,7 +92,7 @@ class Level:
         """Evaluate the items; update the samples; keep the live items. Returns the column
         sets ``(inner, outer, inner_if_exact, outer_if_exact)`` as piece arrays (the last two
         estimate the gap with the orientation part removed), or ``None`` when ``clock`` (the
-        driver's time budget: ``batch()``, ``allows(items)``, ``done(items)``) says the rest of
+        driver's time budget: ``batch``, ``allows``, ``done``) says the rest of
         the step would end past the budget: the level is then left as it was before it."""
         n = len(self.cx)
         reach = self.kind == "reachable"
@@ -110,20 +110,21 @@ class Level:
             vc = np.concatenate([vc, pc]) if self.corners is not None else pc
             groups.append((pc, PV, None))
         parts, vparts = [], []
-        left = sum(len(g[0]) for g in groups)
+        left = {True: len(self.col), False: sum(len(g[0]) for g in groups[1:])}
         for gcol, C, H in groups:
             s = 0
-            while s < max(len(gcol), 1 if H is not None else 0):
-                size = clock.batch() if clock is not None else BATCH
-                if clock is not None and not clock.allows(left):
+            cells = H is not None
+            while s < max(len(gcol), 1 if cells else 0):
+                size = clock.batch(cells) if clock is not None else BATCH
+                if clock is not None and not clock.allows(left[True], left[False]):
                     return None                          # the rest of the step would not fit
-                left -= len(gcol[s:s + size])
+                left[cells] -= len(gcol[s:s + size])
                 sl = slice(s, s + size)
                 b = self.legs.bounds(self.cx[gcol[sl]], self.cy[gcol[sl]], 0.5 * self.h, C[sl],
                                      None if H is None else H[sl], with_cells=H is not None,
                                      reachable=reach)
                 if clock is not None:
-                    clock.done(len(gcol[sl]))
+                    clock.done(len(gcol[sl]), cells)
                 (parts if H is not None else vparts).append(b)
                 s += size
         ev = _collect(parts)
