@@ -110,7 +110,8 @@ class VolumeBracket:
             always the tightest).
         target: relative width asked for (``upper - lower <= target·upper``).
         stop_reason: ``"converged"``, ``"budget: seconds"``, ``"budget: evaluations"``,
-            ``"budget: cells"`` or ``"empty"``.
+            ``"budget: cells"`` (the next x-y level would pass ``max_cells``; a split that
+            would pass it halves the x-y cells instead) or ``"empty"``.
         history: one dict per refinement step (level, cell size h, orientation cells, lower,
             upper, seconds, evaluations).
         resolution: the x-y cell size of the last level (mm).
@@ -266,7 +267,8 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
             bookkeeping, about 0.5 s (``tests`` allow ``0.25·budget + 1 s``), unless the first
             step alone is longer.
         max_evaluations: budget of leg-bound evaluations.
-        max_cells: largest number of (column × orientation cell) items of one step.
+        max_cells: largest number of (column × orientation cell) items of one step (an
+            orientation split that would pass it halves the x-y cells instead).
     """
     t_call = time.perf_counter()
     mech, oset, cons = _request(mech, kind, orientations, resolution, constraints)
