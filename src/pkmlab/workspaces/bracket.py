@@ -221,7 +221,7 @@ class _Clock:
         self.rate = {True: 0.0, False: 0.0}     # s per item: cells, samples
         self.post = 0.0          # s of bookkeeping after a step's batches
         self.enforce = False
-        self.t = start
+        self.t = self.t_end = start
 
     def batch(self, cells: bool) -> int:
         """Items per batch: about ``BATCH_S`` seconds at the current rate."""
@@ -239,7 +239,8 @@ class _Clock:
                                     and self.t + nxt <= self.deadline)
 
     def done(self, items: int, cells: bool) -> None:
-        r = (time.perf_counter() - self.t) / max(items, 1)
+        self.t_end = time.perf_counter()
+        r = (self.t_end - self.t) / max(items, 1)
         old = self.rate[cells]
         self.rate[cells] = r if old == 0 else 0.5 * (old + r)
 
@@ -309,7 +310,7 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
             if sets is None:
                 stop = "budget: seconds"
                 break
-            t_post = clock.t
+            t_post = clock.t_end                         # the end of the step's last batch
             inner, outer, inner_x, outer_x = sets
             lo_s, up_s, note, kept = _volumes(inner, outer, cons, lv, p_nom)
             final = (lv.h, np.stack([lv.cx, lv.cy], axis=1), kept)
