@@ -18,12 +18,15 @@ from pkmlab import load_mechanism
 from pkmlab.cli import app
 from pkmlab.errors import ParameterError
 from pkmlab.mechanisms._kernels import make_leg_eval
+from pkmlab.mechanisms.ups6 import working_sides
 from pkmlab.study import evaluators as ev_mod
 from pkmlab.study import load_study
 from pkmlab.workspaces import OrientationSet, workspace
 from pkmlab.workspaces import cells as oc
 from pkmlab.workspaces.bracket import volume_bracket
+from pkmlab.workspaces.bracket_level import Level
 from pkmlab.workspaces.constraints import Constraints
+from pkmlab.workspaces.legbounds import Legs
 
 HOPKINS = MECH_DIR / "hopkins-williams-6psu.yaml"
 UPS = MECH_DIR / "gough-stewart-6ups.yaml"
@@ -167,6 +170,142 @@ def test_bracket_contains_a_dense_estimate_and_narrows_with_the_budget(psu):
         assert [r["h_mm"] for r in b.history] == sorted((r["h_mm"] for r in b.history),
                                                         reverse=True)
     assert widths[1] < 0.2 * widths[0]
+
+
+def test_reachable_bracket_contains_independent_estimates(psu, ups):
+    """Reachable kind (x-y second-order upper bound over pairs of legs, cells' vertices as
+    samples): the bracket contains estimates that lie on known sides of the truth.
+
+    * from below: the engine's union over a dense orientation grid (every sample is in the
+      set; its x-y error is second order and far below the margins here);
+    * from above (6-UPS, whose leg lengths and working-mode sides move by at most the
+      platform points' displacement): the points of a lattice that some cell centre reaches
+      with every leg's stroke and side widened by the cell's chord bound, ``2 sin(α/2)·|u|``:
+      every truly reachable point is among them (up to the lattice's counting error)."""
+    box5 = OrientationSet.box([D5] * 3)
+    b = volume_bracket(psu, "reachable", box5, 5.0, budget_s=2.0)
+    below = workspace(psu, "reachable", box5.with_samples(7), 2.5).volume
+    assert b.lower < below <= b.upper
+
+    tt = OrientationSet.tilt_torsion(math.radians(8), math.radians(5))
+    b = volume_bracket(ups, "reachable", tt, 25.0, budget_s=2.0)
+    below = workspace(ups, "reachable", tt.with_samples(5), 25.0).volume
+    assert below <= b.upper
+    C, H = oc.initial_cells(tt, 1)
+    C, H, _ = oc.split(C, H)
+    R = tt.rotations_at(C)
+    eps = oc.chord(oc.angle_bound(tt, C, H))[:, None] * np.linalg.norm(ups.tool_points, axis=1)
+    side = working_sides(ups)
+    col, zlo, zhi = b.outer
+    g = 40.0
+    axes = [np.arange(b.cells[:, k].min() - g, b.cells[:, k].max() + g, g) for k in (0, 1)]
+    axes.append(np.arange(zlo.min() - g, zhi.max() + g, g))
+    P = np.stack([a.ravel() for a in np.meshgrid(*axes, indexing="ij")], axis=1)
+    lo, hi = ups.stroke
+    reached = np.zeros(len(P), bool)
+    Ru = np.einsum("mij,kj->mki", R, ups.tool_points) - ups.base_points
+    for m in range(len(R)):
+        v = P[:, None, :] + Ru[m]
+        q = np.linalg.norm(v, axis=-1)
+        reached |= np.all((q >= lo - eps[m]) & (q <= hi + eps[m])
+                          & (v[..., 2] * side >= -eps[m]), axis=1)
+    above = reached.sum() * g**3
+    assert b.lower <= above
+    assert below <= above
+
+
+@pytest.mark.parametrize("name", ["psu", "ups"])
+def test_reachable_cell_bounds_hold_pointwise(name, request):
+    """The cells' x-y bounds of the reachable upper bound, at random points of the square and
+    random rotations of the cell (the column kernel at one exact rotation): the top is below
+    the affine function through the corner values, and the bottom above their interpolation on
+    either triangulation of the square."""
+    mech = request.getfixturevalue(name)
+    oset = (OrientationSet.box([D5] * 3) if name == "psu"
+            else OrientationSet.tilt_torsion(math.radians(10), math.radians(5)))
+    legs = Legs(mech, oset)
+    rng = np.random.default_rng(7)
+    C, H = oc.initial_cells(oset, 1)
+    for _ in range(3):                                    # small cells: tight bounds
+        C, H, _ = oc.split(C, H)
+    n, s = 4000, (0.5 if name == "psu" else 2.0)
+    ext = 120.0 if name == "psu" else 600.0
+    k = rng.integers(0, len(C), n)
+    cx, cy = rng.uniform(-ext, ext, (2, n))
+    b = legs.bounds(cx, cy, s, C[k], H[k], reachable=True)["pl_out"]
+    top, bot = b["top"], b["bot"]
+    P = C[k] + rng.uniform(-1, 1, (n, 3)) * H[k]
+    R = oset.rotations_at(P)
+    u, v = rng.uniform(-1, 1, (2, n))                      # the point in square coordinates
+    checked = 0
+    for q in range(n):
+        lo, hi, _ = mech.column_intervals(np.array([cx[q] + u[q] * s]),
+                                          np.array([cy[q] + v[q] * s]), R[q:q + 1], "all")
+        lo, hi = lo[0, 0, 0], hi[0, 0, 0]
+        if not hi >= lo:
+            continue
+        checked += 1
+        t = top[q]                                        # corners (-1,-1), (1,-1), (1,1), (-1,1)
+        a = 0.25 * ((1 - u[q]) * (1 - v[q]) * t[0] + (1 + u[q]) * (1 - v[q]) * t[1]
+                    + (1 + u[q]) * (1 + v[q]) * t[2] + (1 - u[q]) * (1 + v[q]) * t[3])
+        assert hi <= a + 1e-6, q
+        g = bot[q]
+        x, y = 0.5 * (u[q] + 1), 0.5 * (v[q] + 1)         # in [0, 1]²
+        # diagonal 0-2: triangles (0,1,2) below y = x, (0,2,3) above
+        d1 = (g[0] + x * (g[1] - g[0]) + y * (g[2] - g[1]) if y <= x
+              else g[0] + y * (g[3] - g[0]) + x * (g[2] - g[3]))
+        # diagonal 1-3: triangles (0,1,3) below x + y = 1, (1,2,3) above
+        d2 = (g[0] + x * (g[1] - g[0]) + y * (g[3] - g[0]) if x + y <= 1
+              else g[2] + (1 - x) * (g[3] - g[2]) + (1 - y) * (g[1] - g[2]))
+        assert lo >= max(d1, d2) - 1e-6, q
+    assert checked > 200
+
+
+def test_reachable_upper_bound_holds_column_by_column(psu):
+    """The x-y second-order upper bound of each column (affine tops and concave bottoms over
+    pairs of legs, 3 refinement steps) is above the column's volume estimated from below by
+    a dense union: 7³ rotations of the set at 6 × 6 points of the column's square (measured
+    margin at 9³ and 8 × 8: at least 1.3 % of the column, over 300 columns)."""
+    oset = OrientationSet.box([D5] * 3)              # the nominal orientation is the identity
+    legs = Legs(psu, oset)
+    h = 5.0
+    g = np.arange(-150.0, 150.01, h)
+    cx, cy = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
+    C0, H0 = oc.initial_cells(oset, 1)
+    lv = Level(legs, "reachable", cx, cy, h, C0, H0)
+    for k in range(3):
+        _, outer, _, _ = lv.step()
+        if k < 2:
+            lv.split()
+    box = np.bincount(outer[0], outer[2] - outer[1], minlength=len(cx)) * h * h
+    up = np.minimum(box, lv.pl_upper)
+    assert np.all(np.isfinite(lv.pl_upper))
+    R = oset.rotations_at(oset.with_samples(7).parameters())
+    off = (np.arange(6) + 0.5) / 6 * h - h / 2
+    rng = np.random.default_rng(5)
+    cols = rng.choice(np.nonzero(up > 0)[0], 80, replace=False)
+    for c in cols:
+        lo, hi, _ = psu.column_intervals(cx[c] + off, cy[c] + off, R, "any")
+        est = np.where(hi >= lo, hi - lo, 0.0).sum(axis=-1).mean() * h * h
+        assert est <= up[c] * (1 + 1e-9) + 1e-9, c
+
+
+def test_time_budget_is_honoured_within_its_tolerance(psu):
+    """The budget is checked between batches and a step that would pass it is abandoned
+    (the bracket of the last completed step is returned). Before, the step running at the
+    budget completed. The budget is set relative to the first step's time on this machine
+    (so that the load does not move it across step boundaries): 5 first steps, which the
+    old code overran to about 10 (its fourth step)."""
+    box5 = OrientationSet.box([D5] * 3)
+    for _ in range(2):                               # the second call runs warm
+        first = volume_bracket(psu, "reachable", box5, 2.5, budget_s=1e-3)
+        assert len(first.history) == 1               # the first step always completes
+    budget = 5.0 * (first.history[0]["seconds"] - first.setup_seconds)
+    b = volume_bracket(psu, "reachable", box5, 2.5, target=1e-4, budget_s=budget)
+    assert b.stop_reason == "budget: seconds"
+    assert b.seconds - b.setup_seconds <= 1.25 * budget + 1.0
+    assert b.history[-1]["seconds"] <= b.seconds
+    assert b.lower <= b.upper
 
 
 def test_bracket_refuses_what_it_cannot_guarantee(psu):

@@ -413,8 +413,8 @@ def test_compiling_a_kernel_shows_no_numba_ir_warning(monkeypatch):
     real = _jit.njit
 
     def noisy(*a, **k):
-        warnings.warn("variable 'x.1' is not in scope", NumbaIRAssumptionWarning)
-        warnings.warn("a warning the user should see", RuntimeWarning)
+        warnings.warn("variable 'x.1' is not in scope", NumbaIRAssumptionWarning, stacklevel=2)
+        warnings.warn("a warning the user should see", RuntimeWarning, stacklevel=2)
         return real(*a, **k)
 
     monkeypatch.setattr(_jit, "njit", noisy)

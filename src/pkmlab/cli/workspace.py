@@ -58,7 +58,8 @@ def _print_bracket(res, vb) -> None:
     if vb:
         out.print(f"  guaranteed volume bracket [{vb['lower_cm3']:.3f}, {vb['upper_cm3']:.3f}] cm³ "
                   f"over the continuous set (width {100 * vb['relative_width']:.2f} %, "
-                  f"{escape(vb['stop_reason'])}, {vb['seconds']:.1f} s, final cell "
+                  f"{escape(vb['stop_reason'])}, {vb['seconds']:.1f} s of which set-up "
+                  f"{vb['setup_seconds']:.1f} s, final cell "
                   f"{vb['final_resolution_mm']:g} mm)")
 
 
@@ -140,8 +141,10 @@ def workspace(
                           "x-y plane: guaranteed [lower, upper] (psu6, ups6; stroke only)")]
     = False,
     bracket_budget: Annotated[float, typer.Option(
-        help="--bracket: wall-time budget in s (the bracket stops there if not yet at "
-             "--bracket-target)")] = 20.0,
+        help="--bracket: wall-time budget in s, counted after loading the kernels (the "
+             "first refinement step always completes; later steps that would pass the "
+             "budget are abandoned, about 0.5 s tolerance; the bracket of the last completed "
+             "step is reported)")] = 20.0,
     bracket_target: Annotated[float, typer.Option(
         help="--bracket: relative width to reach, (upper - lower) / upper")] = 0.01,
     mesh: Annotated[str, typer.Option(

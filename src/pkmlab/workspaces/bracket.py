@@ -40,6 +40,30 @@ the search restarts on the children of the columns still in the outer set. It st
 ``upper - lower <= target·upper`` or the budget (seconds or leg evaluations) runs out, and
 says which.
 
+**Reachable, second order in x-y** (:meth:`.bracket_level.Level._reach_upper`, families with
+:attr:`.legbounds.Legs.planar`). Over a square, the top of the union over a cell is below an
+affine function of x-y: any convex combination of the legs' upper ends is above the top, each
+end is concave in x-y (below its tangent plane; beyond its sphere the leg is unreachable), and
+the rotation moves the plane by at most the linearised cell plus the remainder. The weights
+are chosen on one leg or a pair so that opposite slopes over the cell cancel (first order in
+the cell otherwise, at every ridge of the minimum over legs). The maximum of these affine
+functions over the cells is convex, so at most its corner interpolation; symmetrically the
+bottom is above a concave function (a convex combination of lower ends whose spheres cover
+the moved square, minimised over the cell), at least its corner interpolation. The column's
+volume is at most the integral of the interpolated difference's positive part. The samples'
+own planes and pieces are kept in those extremes, and a cell whose corner values do not pass
+them is dropped (its outer set joins a per-column hull, for connectivity). The cells' most
+promising vertices (by the linear model) are evaluated as samples in the next step, and a new
+x-y level starts from each parent column's best sample rotations.
+
+**Time budget.** ``budget_s`` counts from the end of the set-up (kernels loaded or
+compiled, legs' reach), reported as ``setup_seconds``. The first step always completes; then
+items are evaluated in batches sized to take about 0.5 s, the clock is checked before each, and
+a step whose next batch, or whose remaining items at twice the recent speed (plus the last
+step's bookkeeping), would end past the budget is abandoned: the result is the bracket of the
+last completed step, returned early when the next step clearly cannot fit. Overrun: about
+one misjudged batch (``tests/test_bracket.py`` allows ``0.25·budget + 1 s``).
+
 **Connected to nominal.** Components are taken on the inner and outer sets separately (cells
 8-adjacent, z sets touching). The component of the inner set that contains the nominal
 position is a connected subset of the workspace through it, so it lies in the kept component;
@@ -68,8 +92,9 @@ from ..errors import ParameterError
 from ..poses import as_frames, matrix_to_euler
 from . import cells as oc
 from .bracket_cells import cell_volume_bracket
+from .bracket_level import BATCH, Level
 from .bracket_result import VolumeBracket
-from .bracket_sets import connected, inside, length, pieces_of, tri_volume, union
+from .bracket_sets import connected, length, warm_up
 from .constraints import Constraints
 from .legbounds import Legs
 from .orientations import OrientationSet
@@ -77,197 +102,6 @@ from .orientations import OrientationSet
 log = logging.getLogger(__name__)
 
 __all__ = ["VolumeBracket", "volume_bracket"]
-
-#: items (column × orientation cell) evaluated per batch
-_BATCH = 100_000
-
-
-# ---- one x-y level ------------------------------------------------------------------------------
-
-
-def _collect(parts):
-    """Concatenate per-batch outputs of :meth:`Legs.bounds` (tuples and dicts of arrays)."""
-    out = {}
-    for k in parts[0] if parts else ():
-        v = parts[0][k]
-        if isinstance(v, dict):
-            out[k] = {f: np.concatenate([p[k][f] for p in parts]) for f in v}
-        else:
-            out[k] = tuple(np.concatenate([p[k][i] for p in parts]) for i in range(len(v)))
-    return out
-
-
-def _vertices(C, H):
-    """The distinct vertices of the cells ``C ± H``."""
-    signs = np.array(np.meshgrid(*[(-1.0, 1.0)] * 3, indexing="ij")).reshape(3, -1).T
-    V = (C[:, None, :] + signs[None] * H[:, None, :]).reshape(-1, 3)
-    return np.unique(np.round(V, 12), axis=0)
-
-
-class _Level:
-    """Columns of one x-y level with their orientation cells (items) and running samples."""
-
-    def __init__(self, legs, kind, cx, cy, h, C0, H0):
-        self.legs, self.kind, self.h = legs, kind, h
-        self.cx, self.cy = cx, cy
-        n, L = len(cx), len(C0)
-        self.col = np.repeat(np.arange(n), L)
-        self.C = np.tile(C0, (n, 1))
-        self.H = np.tile(H0, (n, 1))
-        self.corners = _vertices(C0, H0)
-        if kind == "reachable":
-            e = np.empty(0)
-            self.samples = (np.empty(0, np.int64), e, e, np.zeros(n + 1, np.int64))
-            self.samples_out = self.samples
-        else:
-            self.s_in = [np.full(n, -np.inf), np.full(n, np.inf), np.ones(n, bool)]
-            self.s_out = [np.full(n, -np.inf), np.full(n, np.inf), np.ones(n, bool)]
-            # x-y second order: samples' ends at the corners, best upper-volume pieces
-            self.pl = {"top": np.full((n, 4), np.inf), "bot": np.full((n, 4), -np.inf),
-                       "plane_c": np.full(n, np.inf), "plane": np.full((n, 4), np.inf),
-                       "piece_c": np.full(n, -np.inf), "piece": np.full((n, 4), -np.inf)}
-        self.pl_lower = self.pl_upper = self.reach_pl = None
-
-    def step(self):
-        """Evaluate the items; update the samples; keep the live items. Returns the column
-        sets ``(inner, outer, inner_if_exact, outer_if_exact)`` as piece arrays (the last two
-        estimate the gap with the orientation part removed)."""
-        n = len(self.cx)
-        parts = [self.legs.bounds(self.cx[self.col[s:s + _BATCH]],
-                                  self.cy[self.col[s:s + _BATCH]], 0.5 * self.h,
-                                  self.C[s:s + _BATCH], self.H[s:s + _BATCH])
-                 for s in range(0, max(len(self.col), 1), _BATCH)]
-        ev = _collect(parts)
-        col = scol = self.col
-        if self.corners is not None:
-            # the vertices of the first cells (where leg extremes often lie) as samples
-            V = self.corners
-            vc = np.repeat(np.arange(n), len(V))
-            b = self.legs.bounds(self.cx[vc], self.cy[vc], 0.5 * self.h, np.tile(V, (n, 1)),
-                                 None, with_cells=False)
-            for k in ("in0", "out0", "pl_sample"):
-                if k in b:
-                    ev[k] = _collect([{k: ev[k]}, {k: b[k]}])[k] if k in ev else b[k]
-            scol = np.concatenate([col, vc])
-            self.corners = None
-        if self.kind == "reachable":
-            # lower: union of the samples' x-y inner sets; upper: union of the samples' x-y
-            # outer sets and of the outer sets of the cells that still reach beyond them
-            lo, hi, ok = ev["in0"]
-            self.samples = union(n, self.samples[:3], (scol[ok], lo[ok], hi[ok]))
-            if "pl_sample" in ev:
-                self._reach_planar(ev["pl_sample"], lo, hi, ok, scol)
-            lo, hi, ok = ev["out0"]
-            self.samples_out = union(n, self.samples_out[:3], (scol[ok], lo[ok], hi[ok]))
-            pcol, plo, phi, starts = self.samples_out
-            lo, hi, ok = ev["outr"]
-            live = ok.copy()
-            live[ok] = ~inside(col[ok], lo[ok], hi[ok], starts, plo, phi)
-            outer_x = (pcol, plo, phi)
-            outer = union(n, outer_x, (col[live], lo[live], hi[live]))[:3]
-            inner = self.samples[:3]
-            self._keep(live)
-            return inner, outer, inner, outer_x
-        for st, key in ((self.s_in, "in0"), (self.s_out, "out0")):
-            lo, hi, ok = ev[key]
-            np.maximum.at(st[0], scol, lo)
-            np.minimum.at(st[1], scol, hi)
-            np.logical_and.at(st[2], scol, ok)
-        sin_ok = self.s_in[2] & (self.s_in[0] <= self.s_in[1])
-        sout_ok = self.s_out[2] & (self.s_out[0] <= self.s_out[1])
-        ref_lo = np.where(sin_ok, self.s_in[0], self.s_out[0])
-        ref_hi = np.where(sin_ok, self.s_in[1], self.s_out[1])
-        lo, hi, ok = ev["inr"]
-        live = sout_ok[col] & (~ok | (lo > ref_lo[col]) | (hi < ref_hi[col]))
-        if "pl_cell" in ev:
-            live |= self._planar(ev["pl_sample"], ev["pl_cell"], ok, scol, col, live, sout_ok)
-        ilo, ihi, iok = self.s_in[0].copy(), self.s_in[1].copy(), sin_ok.copy()
-        lc = col[live]
-        np.maximum.at(ilo, lc, lo[live])
-        np.minimum.at(ihi, lc, hi[live])
-        np.logical_and.at(iok, lc, ok[live])
-        inner = pieces_of(ilo, ihi, iok & sout_ok)
-        outer = pieces_of(self.s_out[0], self.s_out[1], sout_ok)
-        inner_x = pieces_of(self.s_in[0], self.s_in[1], sin_ok & sout_ok)
-        self._keep(live)
-        return inner, outer, inner_x, outer
-
-    def _planar(self, sample, cell, ok, scol, col, live, sout_ok):
-        """x-y second order (dexterous): update the samples' corner values and upper-volume
-        pieces, mark the cells that could still move a corner bound live, and set the
-        per-column volume bounds ``pl_lower`` / ``pl_upper`` (mm³)."""
-        pl, n = self.pl, len(self.cx)
-        np.minimum.at(pl["top"], scol, sample["top"])
-        np.maximum.at(pl["bot"], scol, sample["bot"])
-        for key, better in (("plane", np.less), ("piece", np.greater)):
-            best = pl[key + "_c"].copy()
-            (np.minimum if key == "plane" else np.maximum).at(best, scol, sample[key + "_c"])
-            win = better(sample[key + "_c"], pl[key + "_c"][scol]) \
-                & (sample[key + "_c"] == best[scol])
-            pl[key][scol[win]] = sample[key][win]
-            pl[key + "_c"] = best
-        grow = ~ok | np.any(cell["bot"] > pl["bot"][col], axis=1) \
-            | np.any(cell["top"] < pl["top"][col], axis=1)
-        grow &= sout_ok[col]
-        keep = live | grow
-        bot, top = pl["bot"].copy(), pl["top"].copy()
-        np.maximum.at(bot, col[keep], cell["bot"][keep])
-        np.minimum.at(top, col[keep], cell["top"][keep])
-        fine = np.ones(n, bool)
-        np.logical_and.at(fine, col[keep], ok[keep])
-        a = 0.5 * self.h * self.h
-        low = tri_volume(top - bot, a, np.maximum)
-        self.pl_lower_x = tri_volume(pl["top"] - pl["bot"], a, np.maximum)
-        self.pl_lower = np.where(fine & sout_ok, low, 0.0)
-        self.pl_centre = (0.5 * (bot[:, 0] + bot[:, 2]), 0.5 * (top[:, 0] + top[:, 2]),
-                          0.5 * (bot[:, 1] + bot[:, 3]), 0.5 * (top[:, 1] + top[:, 3]))
-        A = pl["plane"] - pl["piece"]
-        self.pl_upper = np.where(np.isfinite(A).all(axis=1),
-                                 tri_volume(np.where(np.isfinite(A), A, 0.0), a, np.minimum),
-                                 np.inf)
-        return grow
-
-    def _reach_planar(self, sample, lo, hi, ok, scol):
-        """x-y second order (reachable), for columns whose union of samples is one interval
-        ``[L, U]``: the sample ``a`` with the lowest inner end and ``b`` with the highest meet
-        it at every point of the square, so the column holds ``[min(bottom_a, L),
-        max(top_b, U)]`` everywhere; ``top_b`` is concave (at least its corner interpolation)
-        and ``bottom_a`` below a convex bound (at most its corner interpolation)."""
-        n = len(self.cx)
-        if self.reach_pl is None:
-            self.reach_pl = {"L": np.full(n, np.inf), "gbot": np.full((n, 4), np.inf),
-                             "U": np.full(n, -np.inf), "top": np.full((n, 4), -np.inf)}
-        st = self.reach_pl
-        for end, val, key, better in (("L", lo, "gbot", np.less), ("U", hi, "top", np.greater)):
-            v = np.where(ok, val, np.inf if end == "L" else -np.inf)
-            best = st[end].copy()
-            (np.minimum if end == "L" else np.maximum).at(best, scol, v)
-            win = ok & better(v, st[end][scol]) & (v == best[scol])
-            st[key][scol[win]] = sample[key][win]
-            st[end] = best
-        pcol, plo, phi, starts = self.samples
-        one = np.diff(starts) == 1
-        A = self.h * self.h
-        t, g = st["top"], np.where(np.isfinite(st["gbot"]), st["gbot"], 1e12)
-        int_t = A * np.maximum(2 * t[:, 0] + t[:, 1] + 2 * t[:, 2] + t[:, 3],
-                               t[:, 0] + 2 * t[:, 1] + t[:, 2] + 2 * t[:, 3]) / 6
-        int_g = A * np.minimum(2 * g[:, 0] + g[:, 1] + 2 * g[:, 2] + g[:, 3],
-                               g[:, 0] + 2 * g[:, 1] + g[:, 2] + 2 * g[:, 3]) / 6
-        with np.errstate(invalid="ignore"):
-            vol = np.maximum(int_t, st["U"] * A) - np.minimum(int_g, st["L"] * A)
-        self.pl_lower = np.where(one & np.isfinite(vol), np.maximum(vol, 0.0), 0.0)
-        self.pl_upper = np.full(n, np.inf)
-        self.pl_centre = (st["L"], st["U"])
-
-    def _keep(self, live):
-        self.col, self.C, self.H = self.col[live], self.C[live], self.H[live]
-
-    def split(self):
-        C, H, parent = oc.split(self.C, self.H)
-        col = self.col[parent]
-        order = np.argsort(col, kind="stable")
-        self.col, self.C, self.H = col[order], C[order], H[order]
-
 
 # ---- driver -------------------------------------------------------------------------------------
 
@@ -295,6 +129,50 @@ def _request(mech, kind, orientations, resolution, constraints):
     return mech, oset.centred(tuple(matrix_to_euler(Rn[0]))), cons
 
 
+class _Clock:
+    """The time budget, counted from ``start`` (after the set-up). The rest of a step is
+    allowed while the time it is expected to take (its cell and sample items at their recent
+    rates, plus the bookkeeping of a step as last measured) still ends within the budget; the
+    first step of a run is always allowed (it gives the first bracket). An optimistic estimate
+    costs wasted work, never an overrun: the check repeats before every batch."""
+
+    #: target duration of one batch (s): the tolerance of the budget
+    BATCH_S = 0.5
+    #: share of the predicted time of the rest of a step that must fit
+    OPTIMISM = 0.5
+
+    def __init__(self, start: float, budget: float):
+        self.deadline = start + budget
+        self.rate = {True: 0.0, False: 0.0}     # s per item: cells, samples
+        self.post = 0.0          # s of bookkeeping after a step's batches
+        self.enforce = False
+        self.t = self.t_end = start
+
+    def batch(self, cells: bool) -> int:
+        """Items per batch: about ``BATCH_S`` seconds at the current rate."""
+        r = self.rate[cells] or self.rate[not cells]
+        return int(min(max(self.BATCH_S / r, 1_000), BATCH)) if r > 0 else 5_000
+
+    def allows(self, cells: int, samples: int) -> bool:
+        self.t = time.perf_counter()
+        need = cells * (self.rate[True] or self.rate[False]) \
+            + samples * (self.rate[False] or self.rate[True])
+        # the rates are noisy on a shared machine: give up on the step only when it would not
+        # fit even at twice the measured speed (or its next batch would not fit at all)
+        nxt = min(cells + samples, BATCH) * max(self.rate.values())
+        return not self.enforce or (self.t + self.OPTIMISM * need + self.post <= self.deadline
+                                    and self.t + nxt <= self.deadline)
+
+    def done(self, items: int, cells: bool) -> None:
+        self.t_end = time.perf_counter()
+        r = (self.t_end - self.t) / max(items, 1)
+        old = self.rate[cells]
+        self.rate[cells] = r if old == 0 else 0.5 * (old + r)
+
+    def passed(self) -> bool:
+        return time.perf_counter() >= self.deadline
+
+
 def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | None = None,
                    resolution: float = 2.5, constraints: Constraints | None = None,
                    target: float = 0.01, budget_s: float = 30.0,
@@ -305,11 +183,20 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
         mech, kind, orientations, resolution, constraints: as for :func:`pkmlab.workspace`;
             ``resolution`` is the first x-y cell size (halved as needed).
         target: stop when ``upper - lower <= target·upper``.
-        budget_s: wall-time budget (s); the step running when it runs out completes.
+        budget_s: wall-time budget (s), counted after the set-up (kernel compilation or
+            cache load, reported as ``setup_seconds``). The first refinement step always
+            completes; after it, the clock is checked between batches of items sized to
+            take about 0.5 s, and a step is abandoned as soon as its next batch, or its
+            remaining items at twice the recent speed, would end past the budget:
+            the bracket of the last completed step is returned, possibly well before the
+            budget. The overrun is the misjudged part of one batch and one step's
+            bookkeeping, about 0.5 s (``tests`` allow ``0.25·budget + 1 s``), unless the first
+            step alone is longer.
         max_evaluations: budget of leg-bound evaluations.
-        max_cells: largest number of (column × orientation cell) items of one step.
+        max_cells: largest number of (column × orientation cell) items of one step (an
+            orientation split that would pass it halves the x-y cells instead).
     """
-    t0 = time.perf_counter()
+    t_call = time.perf_counter()
     mech, oset, cons = _request(mech, kind, orientations, resolution, constraints)
     if mech.cell_bounds:
         return cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
@@ -318,6 +205,11 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
     p_nom = mech.nominal_pose[:3]
     # every feasible p has |p_xy + w_xy| <= reach_i, |w_xy + b_xy| <= |u_i|
     reach = legs.reach()
+    warm_up()
+    legs.warm_up()
+    t0 = time.perf_counter()
+    setup = t0 - t_call
+    clock = _Clock(t0, budget_s)
     rad = reach + legs.unorm
     B = mech.base_points[:, :2]
     box_lo = np.max(B - rad[:, None], axis=0)
@@ -328,23 +220,31 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
     C0, H0 = oc.initial_cells(oset, 1)
     if np.any(box_lo > box_hi):
         return VolumeBracket(0.0, 0.0, target, "empty", history, h, legs.count,
-                             time.perf_counter() - t0, ["no position is within every leg's "
-                                                        "reach"])
+                             time.perf_counter() - t_call, ["no position is within every leg's "
+                                                            "reach"], setup_seconds=setup)
     gx = np.arange(math.floor(box_lo[0] / h), math.ceil(box_hi[0] / h) + 1) * h
     gy = np.arange(math.floor(box_lo[1] / h), math.ceil(box_hi[1] / h) + 1) * h
     X, Y = np.meshgrid(gx, gy, indexing="ij")
     cx, cy = X.ravel(), Y.ravel()
     level = 0
     stop = None
+    final = None                                # (h, cells, kept sets) of the last step
     lower, upper, outside, seen_outside = 0.0, math.inf, False, False
+    seed = None
     while stop is None:
-        lv = _Level(legs, kind, cx, cy, h, C0, H0)
+        lv = Level(legs, kind, cx, cy, h, C0, H0, seed)
         while True:
-            inner, outer, inner_x, outer_x = lv.step()
+            sets = lv.step(clock)
+            if sets is None:
+                stop = "budget: seconds"
+                break
+            t_post = clock.t_end                         # the end of the step's last batch
+            inner, outer, inner_x, outer_x = sets
             lo_s, up_s, note, kept = _volumes(inner, outer, cons, lv, p_nom)
-            elapsed = time.perf_counter() - t0
+            final = (lv.h, np.stack([lv.cx, lv.cy], axis=1), kept)
             history.append({"level": level, "h_mm": h, "items": int(len(lv.col)),
-                            "lower_mm3": lo_s, "upper_mm3": up_s, "seconds": elapsed,
+                            "lower_mm3": lo_s, "upper_mm3": up_s,
+                            "seconds": time.perf_counter() - t_call,
                             "evaluations": legs.count})
             log.debug("bracket %s", history[-1])
             # every step's bracket holds, so their intersection does (after the nominal
@@ -357,9 +257,11 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
                 upper = min(upper, up_s)
             seen_outside = outside
             gap = upper - lower
+            clock.post = max(0.0, time.perf_counter() - t_post)
+            clock.enforce = True
             if upper <= 0 or gap <= target * upper:
                 stop = "converged" if upper > 0 else "empty"
-            elif elapsed >= budget_s:
+            elif clock.passed():
                 stop = "budget: seconds"
             elif legs.count >= max_evaluations:
                 stop = "budget: evaluations"
@@ -371,15 +273,23 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
             if lv.pl_lower is not None and kind != "reachable":
                 g_orient = max(0.0, float(lv.pl_lower_x.sum() - lv.pl_lower.sum()))
                 g_all = gap
-            if not np.any(lv.H > 0) or g_orient <= 0.5 * (g_all - g_orient):
+            elif lv.reach_up is not None:
+                more = lv.pl_upper - lv.pl_upper_x
+                g_orient = float(np.sum(more[np.isfinite(more)]))
+                g_all = gap
+            # (reachable: part of the cells' excess over the samples does not shrink with
+            # the cells, so halve h as soon as the x-y part is as large)
+            share = 1.0 if lv.reach_up is not None else 0.5
+            if not np.any(lv.H > 0) or g_orient <= share * (g_all - g_orient):
                 break                                    # the x-y cells dominate: halve h
-            nxt = len(lv.col) * 8
-            if nxt > max_cells:
-                stop = "budget: cells"
-                break
+            if len(lv.col) * 8 > max_cells:
+                break                                    # too many cells: halve h instead
             lv.split()
         if stop is None:
             alive = np.unique(kept[1][0])
+            # the children start from their parent's best sample rotations
+            seed = np.tile(lv.best_rotations()[alive], (4, 1, 1)) if kind == "reachable" \
+                else None
             cx = np.concatenate([lv.cx[alive] + dx * h / 4 for dx in (-1, 1) for _ in (0, 1)])
             cy = np.concatenate([lv.cy[alive] + dy * h / 4 for _ in (0, 1) for dy in (-1, 1)])
             h *= 0.5
@@ -389,9 +299,10 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
     if outside:
         notes.append("the nominal position is outside the workspace: the bracket covers every "
                      "component (lower 0)")
-    return VolumeBracket(lower, upper, target, stop, history, lv.h, legs.count,
-                         time.perf_counter() - t0, notes,
-                         np.stack([lv.cx, lv.cy], axis=1), kept[0], kept[1])
+    h_f, cells_f, kept_f = final
+    return VolumeBracket(lower, upper, target, stop, history, h_f, legs.count,
+                         time.perf_counter() - t_call, notes, cells_f, kept_f[0], kept_f[1],
+                         setup_seconds=setup)
 
 
 def _volumes(inner, outer, cons, lv, p_nom):

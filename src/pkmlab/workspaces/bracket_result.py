@@ -6,7 +6,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 __all__ = ["VolumeBracket"]
 
@@ -21,12 +20,15 @@ class VolumeBracket:
             always the tightest).
         target: relative width asked for (``upper - lower <= target·upper``).
         stop_reason: ``"converged"``, ``"budget: seconds"``, ``"budget: evaluations"``,
-            ``"budget: cells"`` or ``"empty"``.
+            ``"budget: cells"`` (the next x-y level would pass ``max_cells``; a split that
+            would pass it halves the x-y cells instead) or ``"empty"``.
         history: one dict per refinement step (level, cell size h, orientation cells, lower,
             upper, seconds, evaluations).
         resolution: the x-y cell size of the last level (mm).
         evaluations: leg-bound evaluations spent.
-        seconds: wall time.
+        seconds: wall time of the call, set-up included.
+        setup_seconds: the set-up before the budget's clock starts (loading or compiling
+            the kernels, the legs' reach; 0 for the cell bracket, which has none).
         notes: remarks (connectivity, nominal position).
         cells: the last level's column centres ``(n, 2)``; ``inner``/``outer``: its sets as
             ``(column index, lo, hi)`` piece arrays, connectivity applied. These are the
@@ -52,6 +54,7 @@ class VolumeBracket:
     inner: tuple | None = None
     outer: tuple | None = None
     boxes: tuple | None = None
+    setup_seconds: float = 0.0
 
     @property
     def estimate(self) -> float:
@@ -70,6 +73,8 @@ class VolumeBracket:
         """``(N,)`` bool: points in the final inner or outer set (closed cells)."""
         P = np.asarray(points, float).reshape(-1, 3)
         if self.boxes is not None:
+            from scipy.spatial import cKDTree  # lazy: 0.25 s at import
+
             C, hb, inner = self.boxes
             sel = inner if which == "inner" else np.ones(len(hb), bool)
             out = np.zeros(len(P), dtype=bool)
@@ -96,4 +101,5 @@ class VolumeBracket:
                 "relative_width": self.relative_width, "target": self.target,
                 "stop_reason": self.stop_reason, "final_resolution_mm": self.resolution,
                 "evaluations": self.evaluations, "seconds": self.seconds,
+                "setup_seconds": self.setup_seconds,
                 "history": list(self.history), "notes": list(self.notes)}

@@ -9,7 +9,8 @@ from numba import njit
 
 from .._intervals import label_pieces
 
-__all__ = ["union", "inside", "pieces_of", "length", "tri_positive", "tri_volume", "connected"]
+__all__ = ["union", "inside", "pieces_of", "length", "tri_positive", "tri_volume", "connected",
+           "warm_up"]
 
 
 # ---- interval helpers ---------------------------------------------------------------------------
@@ -134,3 +135,12 @@ def connected(pieces, cx, cy, h, p_nom):
         return pieces, False
     keep = lab == lab[np.argmax(near)]
     return (pcol[keep], plo[keep], phi[keep]), True
+
+
+def warm_up() -> None:
+    """Load (or compile) the numba kernels used here, so that a time budget does not pay
+    for them."""
+    one, z = np.ones(1), np.zeros(1)
+    pcs = union(1, (np.zeros(1, np.int64), z, one))
+    inside(pcs[0], z, one, pcs[3], pcs[1], pcs[2])
+    connected(pcs[:3], z, z, 1.0, np.array([0.0, 0.0, 0.5]))

@@ -29,7 +29,10 @@ R·u`` with the axes ``a_k`` of the parametrisation: ``(Rz·Ry·e_x, Rz·e_y, e_
 angles, ``R_c·(e_z - Rz(φ)Ry(θ)e_z, Rz(φ)e_y, Rz(φ)Ry(θ)e_z)`` for tilt-torsion. Along the
 straight segment to any point of the cell, ``f(t) = R(t)·u`` has ``f'' = ω'×f + ω×(ω×f)``;
 the axes turn at most as fast as the rotation built before them, which gives ``|ω'| <= S²/2``
-for Euler angles and ``|ω'| <= S²`` for tilt-torsion (``S`` the sum of the half-widths), so
+for Euler angles (``S`` the sum of the half-widths). For tilt-torsion, with ``q =
+Rz(φ)Ry(θ)e_z``, ``|q'| <= |φ'| sin θ + |θ'|`` and ``Rz(φ)e_y`` turns at ``|φ'|``, so
+``|ω'| <= (|φ'| + |σ'|)(|φ'| sin θ_max + |θ'|) + |θ'||φ'|`` (θ_max capped at π/2; the
+azimuth's width is scaled by the tilt, as in the angle bound). So
 the linearisation ``R0·u + Σ_k a_k × R0·u · ΔP_k`` is within ``½(|ω'| + |ω|²)·|u|`` of
 ``R·u``: :func:`remainder` returns that factor of ``|u|``.
 
@@ -163,5 +166,10 @@ def remainder(oset, centres: np.ndarray, halves: np.ndarray) -> np.ndarray:
     H = np.abs(np.asarray(halves, float))
     S = H.sum(axis=1)
     w = np.minimum(angle_bound(oset, centres, halves), S)
-    dw = 0.5 * S**2 if oset.kind != "tilt-torsion" else S**2
+    if oset.kind != "tilt-torsion":
+        dw = 0.5 * S**2
+    else:
+        tmax = np.minimum(np.abs(np.asarray(centres, float)[:, 1]) + H[:, 1], 0.5 * math.pi)
+        dw = np.minimum((H[:, 0] + H[:, 2]) * (H[:, 0] * np.sin(tmax) + H[:, 1])
+                        + H[:, 1] * H[:, 0], S**2)
     return 0.5 * (dw + w**2)

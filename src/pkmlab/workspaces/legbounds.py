@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 from ..mechanisms._kernels import make_leg_eval
 from . import cells as oc
@@ -35,6 +36,12 @@ class Legs:
         self.profile = mech.column_profile()                         # (6, 2, 3) or None
         self.count = 0
 
+    @staticmethod
+    def warm_up() -> None:
+        """Load (or compile) the kernels of the bounds, so that a time budget does not pay
+        for them."""
+        _pair(np.zeros((1, 6)), np.zeros((1, 6, 3)), np.zeros((1, 3)))
+
     def ends(self, d):
         """``A(d), B(d), ok(d)`` per leg for ``d (..., 6)``."""
         shape = d.shape
@@ -57,10 +64,12 @@ class Legs:
             hi = np.where(~ok[0] & fin, mid, hi)
         return hi
 
-    def bounds(self, cx, cy, s, C, H, with_cells=True):
+    def bounds(self, cx, cy, s, C, H, with_cells=True, reachable=False):
         """Per item: the column intervals ``(lo, hi, ok)`` intersected over the legs:
         ``in0, out0`` (x-y cell at the centre rotation) and, ``with_cells``, ``inr, outr``
-        (x-y cell × orientation cell)."""
+        (x-y cell × orientation cell). With the x-y second order (:attr:`planar`), also the
+        samples' corner values ``pl_sample`` and the cells' ``pl_cell`` (dexterous: bounds
+        from inside) or, ``reachable``, ``pl_out`` (bounds from outside)."""
         R = self.oset.rotations_at(C)
         W = self.mech.leg_offsets(R)                                 # (n, 6, 3)
         ax = np.abs(cx[:, None] + W[..., 0])
@@ -101,7 +110,10 @@ class Legs:
         if self.planar:
             corner = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], float) * s   # (4, 2)
             out["pl_sample"] = self._sample_corners(cx, cy, W, corner)
-            if with_cells:
+            if with_cells and reachable:
+                out["pl_out"] = _outer_corners(second, out["outr"], corner)
+                out["toward"] = _toward(second)
+            elif with_cells:
                 out["pl_cell"] = _cell_corners(second, legs["inr"], corner)
         return out
 
@@ -188,7 +200,9 @@ class Legs:
             lin_th = lin - (np.abs(ell[..., 0]) + np.abs(ell[..., 1])) * s
             out.append((np.where(inside, lo, -np.inf), np.where(inside, hi, np.inf),
                         {"E0": E0, "g": grad, "lin_th": lin_th, "flat": flat, "lz": lz,
-                         "curv": curv, "inside": inside, "v": v}))
+                         "curv": curv, "inside": inside, "v": v,
+                         "slope": np.einsum("nlkj,nlj->nlk", J, ell), "J": J, "rho": rho,
+                         "r": r, "H": H, "K": K}))
         return out
 
 
@@ -210,3 +224,138 @@ def _cell_corners(second, box, corner):
     pt = np.where(hi_end["inside"][..., None], pt, -np.inf)
     top = np.maximum(pt, box_hi[..., None]).min(axis=1) - EPS
     return {"bot": bot, "top": top}
+
+
+def _outer_corners(second, box, corner):
+    """Per item, at the x-y square's corners (reachable upper bound, see :mod:`.bracket`):
+
+    * ``top``: an affine function of x-y above the top over the square × orientation cell:
+      one leg's upper end is concave in x-y, so below its tangent plane at the square's centre
+      (its points beyond the sphere are not reachable); over the cell the plane moves by at
+      most the linearised rotation plus the remainder (``lin_th``). The leg with the lowest
+      plane, or the cell's constant outer bound where that is lower on average;
+    * ``bot``: lower bounds at the corners of a function that is concave in x-y and below the
+      bottom over the cell: one leg's lower end minimised over the cell (a minimum of concave
+      functions) where its sphere covers the moved square, bounded at each corner by the
+      second-order expansion with curvature; or the cell's constant outer bound.
+
+    Items whose outer set is empty get ``top = -inf``, ``bot = +inf`` (they reach nothing)."""
+    (_, _, lo_end), (_, _, hi_end) = second
+    box_lo, box_hi, ok = box                                     # (n,)
+    Aj = _top_plane(hi_end, corner)
+    top = np.where((Aj.mean(axis=-1) < box_hi)[:, None], Aj, box_hi[:, None]) + EPS
+    bk = _bottom_corners(lo_end, corner)
+    bot = np.where((bk.mean(axis=-1) > box_lo)[:, None], bk, box_lo[:, None]) - EPS
+    return {"top": np.where(ok[:, None], top, -np.inf),
+            "bot": np.where(ok[:, None], bot, np.inf)}
+
+
+@njit(cache=True)
+def _pair_kernel(a, sl, H, oi, oj, ow, ov):
+    n = a.shape[0]
+    for q in range(n):
+        best, bi, bj, bw = np.inf, 0, 1, 1.0
+        for i in range(6):
+            for j in range(i + 1, 6):
+                for c in range(5):
+                    if c == 0:
+                        t = 0.0
+                    elif c == 1:
+                        t = 1.0
+                    else:
+                        den = sl[q, j, c - 2] - sl[q, i, c - 2]
+                        if den == 0.0:
+                            continue
+                        t = sl[q, j, c - 2] / den
+                        if not (0.0 < t < 1.0):
+                            continue
+                    v = 0.0
+                    if t > 0.0:
+                        v += t * a[q, i]
+                    if t < 1.0:
+                        v += (1.0 - t) * a[q, j]
+                    for k in range(3):
+                        v += abs(t * sl[q, i, k] + (1.0 - t) * sl[q, j, k]) * H[q, k]
+                    if v < best:
+                        best, bi, bj, bw = v, i, j, t
+        oi[q], oj[q], ow[q], ov[q] = bi, bj, bw, best
+
+
+def _pair(a, sl, H):
+    """The weights ``λ`` on one leg or two minimising ``Σ λ_i·a_i + Σ_k |Σ λ_i·sl_ik|·H_k``
+    (``a (n, 6)``, ``inf`` for a leg that cannot be used; ``sl (n, 6, 3)``; ``H (n, 3)``):
+    ``(i, j, w, value)`` with weight ``w`` on leg ``i`` and ``1 - w`` on leg ``j``. The
+    objective is convex and piecewise linear in ``w``: its minimum is at 0, 1 or where a
+    coordinate's combined slope cancels."""
+    n = len(a)
+    oi, oj = np.empty(n, np.int64), np.empty(n, np.int64)
+    ow, ov = np.empty(n), np.empty(n)
+    _pair_kernel(np.ascontiguousarray(a, dtype=float), np.ascontiguousarray(sl, dtype=float),
+                 np.ascontiguousarray(H, dtype=float), oi, oj, ow, ov)
+    return oi, oj, ow, ov
+
+
+def _mix(w, x, y):
+    """``w·x + (1 - w)·y`` with a zero weight silencing an infinite term."""
+    w = w.reshape(w.shape + (1,) * (x.ndim - w.ndim))
+    with np.errstate(invalid="ignore"):
+        return np.where(w > 0, w * x, 0.0) + np.where(w < 1, (1 - w) * y, 0.0)
+
+
+def _top_plane(hi_end, corner):
+    """``(n, 4)``: at the square's corners, an affine upper bound of the top over the square
+    × cell: ``Σ λ_i·(tangent plane of leg i's upper end, moved over the cell)`` for the best
+    weights on one leg or two (:func:`_pair`): the top is below every convex combination of
+    the legs' upper ends, and two legs whose ends slope oppositely over the cell cancel
+    their first-order terms."""
+    sl, H = hi_end["slope"], hi_end["H"]
+    rest = hi_end["lin_th"] - (np.abs(sl) * H[:, None, :]).sum(axis=-1)      # |ell|·rho
+    a = np.where(hi_end["inside"], hi_end["E0"] + rest, np.inf)
+    i, j, w, val = _pair(a, sl, H)
+    n = np.arange(len(a))
+    return val[:, None] + _mix(w, hi_end["g"][n, i], hi_end["g"][n, j]) @ corner.T
+
+
+def _bottom_corners(lo_end, corner):
+    """``(n, 4)``: at the square's corners, lower bounds of ``min over the cell of Σ λ_i·(leg
+    i's lower end)`` (below the bottom, concave in x-y when every leg used has its sphere
+    covering the moved square), for the best weights on one leg or two; each end is expanded
+    about each corner point (curvature over the rotation's reach only)."""
+    cover = lo_end["inside"] & np.isfinite(lo_end["curv"])               # (n, 6)
+    K = lo_end["K"][None, :, None]
+    vk = lo_end["v"][:, :, None, :] + corner                            # (n, 6, 4, 2)
+    r = np.broadcast_to(lo_end["r"], cover.shape)[..., None]
+    d2 = np.sum(vk**2, axis=-1)
+    g0 = np.sqrt(np.maximum(K - d2, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ell = np.concatenate([-vk / g0[..., None], -np.ones(d2.shape + (1,))], axis=-1)
+        slope = np.einsum("nlmj,nlcj->nlcm", lo_end["J"], ell)          # (n, 6, 4, 3)
+        rm = np.sqrt(d2) + r
+        curv = np.where(rm**2 < K, 0.5 * K / (K - rm**2) ** 1.5 * r**2, np.inf)
+    base = lo_end["flat"][..., None] + g0 - np.linalg.norm(ell, axis=-1) \
+        * lo_end["rho"][..., None] - curv
+    base = np.where(cover[..., None] & (d2 < K), base, -np.inf)
+    H = lo_end["H"]
+    # the weights from the centre's expansion, then exact corner values for them
+    sl0 = lo_end["slope"]
+    rest = lo_end["lin_th"] - (np.abs(sl0) * H[:, None, :]).sum(axis=-1) + lo_end["curv"]
+    a = np.where(cover, -(lo_end["E0"] - rest), np.inf)
+    i, j, w, _ = _pair(a, -sl0, H)
+    n = np.arange(len(a))
+    b = _mix(w, base[n, i], base[n, j]) - (np.abs(_mix(w, slope[n, i], slope[n, j]))
+                                           * H[:, None, :]).sum(axis=-1)
+    return np.where(np.isnan(b), -np.inf, b)
+
+
+def _toward(second):
+    """``((n, 2, 3),)`` signs per item: the cell vertex (centre + sign·half) where the linear
+    model of the leg with the lowest upper end is highest (``[:, 0]``) and that of the leg
+    with the highest lower end lowest (``[:, 1]``): candidate rotations for the top and the
+    bottom of the union, used as extra samples by the reachable bracket."""
+    (lo_lo, _, lo_end), (_, hi_hi, hi_end) = second
+    n = np.arange(len(lo_lo))
+    j = np.argmin(hi_hi, axis=1)
+    k = np.argmax(np.where(np.isfinite(lo_lo), lo_end["E0"] - lo_end["lin_th"], -np.inf),
+                  axis=1)
+    return (np.stack([np.sign(hi_end["slope"][n, j]), -np.sign(lo_end["slope"][n, k])],
+                     axis=1),)
