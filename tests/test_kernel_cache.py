@@ -427,3 +427,31 @@ def test_compiling_a_kernel_shows_no_numba_ir_warning(monkeypatch):
         k = _jit.cached_kernel(add_one, nt.float64(nt.float64))
     assert k(1.0) == 2.0
     assert [w.category for w in seen] == [RuntimeWarning]
+
+
+_RELOAD = """
+from pkmlab.mechanisms import _kernels, _search, _tiles, psu6, ups6
+
+missed = []
+for fam in (psu6.PSU6, ups6.UPS6):
+    leg = fam.column_leg
+    for k in (_search.make_capability(leg), _search.make_branch_bound(leg),
+              _search.make_certify(leg), _tiles.make_tiled_all(leg),
+              _kernels.make_column_kernel(leg, "all"), _kernels.make_column_kernel(leg, "any")):
+        if sum(k.stats.cache_misses.values()) or not sum(k.stats.cache_hits.values()):
+            missed.append(k.py_func.__name__)
+print(len(missed), " ".join(missed))
+"""
+
+
+def test_search_and_tile_kernels_load_from_the_cache_in_a_fresh_process():
+    """numba keys its on-disk cache by the kernel's pickled closure; a closure (or a jitable in
+    it, pickled by value with its globals) that reaches an ``njit`` dispatcher pickles
+    differently in every process, so the cache never hits. That happened to the continuous
+    search (a shared tile-distance helper written as ``njit``): every fresh study worker spent
+    14 s recompiling the capability kernel. After one process has compiled them, a second
+    must load every kernel from the cache."""
+    for _ in range(2):          # the first may compile (a cold cache); the second must not
+        r = subprocess.run([sys.executable, "-c", _RELOAD], capture_output=True, text=True,
+                           check=True)
+    assert r.stdout.split()[0] == "0", r.stdout

@@ -35,8 +35,9 @@ import math
 from functools import cache
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 from numba import types as nt
+from numba.extending import register_jitable
 
 from .._jit import cached_kernel
 from . import _kernels
@@ -58,10 +59,14 @@ DPAD = 1e-6
 SLACK = 1e-6
 
 
-@njit(inline="always")
+@register_jitable(inline="always")
 def tile_distances(x0, x1, y0, y1, cx, cy):
     """Nearest and farthest distance of the rectangle ``[x0, x1] × [y0, y1]`` from the point
-    ``(cx, cy)`` (a leg's column axis), padded outward by :data:`DPAD` against rounding."""
+    ``(cx, cy)`` (a leg's column axis), padded outward by :data:`DPAD` against rounding.
+
+    A plain function registered for numba, not an ``njit`` dispatcher: the continuous search's
+    kernels pickle their closures (by value, globals included) into numba's cache key, and a
+    dispatcher pickles differently in every process, so its cache would never hit."""
     gx = max(max(x0 - cx, cx - x1), 0.0)
     gy = max(max(y0 - cy, cy - y1), 0.0)
     fx = max(abs(x0 - cx), abs(x1 - cx))
