@@ -20,7 +20,6 @@ from __future__ import annotations
 import logging
 
 import numpy as np
-from scipy.optimize import minimize
 
 from ..mechanisms._kernels import make_leg_eval
 from ..poses import euler_to_matrix
@@ -49,6 +48,8 @@ def binding_orientations(mech, P, x, y, e0, theta, E, starts: int = 2) -> tuple:
     ``(x, y)`` harder than every orientation of the sample ``E (M, 3)`` → ``(new (K, 3),
     gain)``; ``gain`` (mm) is how much they shrink the column's interval ``min b - max a``
     (0 when none binds harder)."""
+    from scipy.optimize import minimize  # lazy: 0.07 s at import, only when used
+
     E = np.asarray(E, dtype=float)
     a, b, ok = column_ends(mech, P, x, y, e0, E)
     if not ok.all():

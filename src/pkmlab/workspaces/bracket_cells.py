@@ -46,9 +46,6 @@ import math
 import time
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import cKDTree
 
 from . import cells as oc
 from .bracket_partial import sample_fractions, vertices
@@ -70,6 +67,8 @@ _TURN = 1.0
 def touching_pairs(C: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Pairs ``(i, j)`` of closed cubes (centres ``C (n, 3)``, half-edges ``h (n,)``) that
     touch, ``|c_i - c_j|_∞ <= h_i + h_j``: a k-d tree in the maximum norm per cube size."""
+    from scipy.spatial import cKDTree  # lazy (0.25 s at import): a study imports this module
+
     sizes, inv = np.unique(h, return_inverse=True)
     idx = [np.flatnonzero(inv == k) for k in range(len(sizes))]
     trees = [cKDTree(C[i]) for i in idx]
@@ -95,6 +94,9 @@ def touching_components(C: np.ndarray, h: np.ndarray, pairs=None) -> tuple[int, 
     n = len(C)
     if n == 0:
         return 0, np.zeros(0, np.int64)
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
     i, j = touching_pairs(C, h) if pairs is None else pairs
     g = coo_matrix((np.ones(len(i), np.int8), (i, j)), shape=(n, n))
     return connected_components(g, directed=False)
@@ -341,6 +343,8 @@ def _partial(mech, oset, kind, P, hP, und, pid, O, q, keep_C, keep_h, connected)
 
 def _in_cubes(points, C, h):
     """``(N,)`` bool: points in any of the closed cubes."""
+    from scipy.spatial import cKDTree
+
     out = np.zeros(len(points), bool)
     for hh in np.unique(h):
         d, _ = cKDTree(C[h == hh]).query(points, p=np.inf, distance_upper_bound=hh * (1 + 1e-9))
