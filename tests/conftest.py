@@ -4,10 +4,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
+from scipy.optimize import minimize
 
 import pkmlab
-from pkmlab.mechanisms import REGISTRY, Luzi3
+from pkmlab.mechanisms import NO_STROKE, REGISTRY, Luzi3
+from pkmlab.poses import euler_to_matrix
 from pkmlab.testing import random_valid_poses  # noqa: F401 (used by the test modules)
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -69,3 +72,27 @@ def tiny_report(tmp_path_factory):
     r = CliRunner().invoke(app, ["run", str(path), "--json"])
     assert r.exit_code == 0, r.output
     return d / "out", r
+
+
+def point_margin(mech, p, euler) -> np.ndarray:
+    """Smallest stroke margin (mm) of ``mech``'s legs at position ``p`` and each Euler
+    orientation of ``euler (n, 3)``, by the inverse kinematics; -1e9 where unreachable."""
+    R = euler_to_matrix(np.atleast_2d(euler))
+    ik = mech.inverse((np.tile(p, (len(R), 1)), R), stroke=NO_STROKE)
+    lo, hi = mech.stroke
+    m = np.min(np.minimum(ik.q - lo, hi - ik.q), axis=1)
+    return np.where(np.isfinite(m), m, -1e9)
+
+
+def assert_point_holds(mech, p, th, rng, minima=3) -> None:
+    """A point certified for the continuous ±``th`` (rad) Euler box keeps every leg in stroke
+    at 20,000 random orientations of ``rng``, at the box's corners, and at the local minima of
+    its margin (L-BFGS-B) started from the ``minima`` worst of them."""
+    E = np.vstack([rng.uniform(-th, th, (20_000, 3)),
+                   np.array(np.meshgrid(*[[-th, th]] * 3)).reshape(3, -1).T])
+    m = point_margin(mech, p, E)
+    assert m.min() >= -1e-9
+    for e in E[np.argsort(m)[:minima]]:
+        r = minimize(lambda v: point_margin(mech, p, v)[0], e, method="L-BFGS-B",
+                     bounds=[(-th, th)] * 3)
+        assert r.fun >= -1e-9

@@ -13,6 +13,7 @@ import math
 import numpy as np
 import pytest
 from conftest import MECH_DIR as STUDIES
+from conftest import assert_point_holds
 from scipy.optimize import minimize
 
 from pkmlab import UPS6, load_mechanism
@@ -69,14 +70,6 @@ def _psu_margin_at(mech, x, y, R):
     return float(np.max(lo - q0)), float(np.min(hi - q0))
 
 
-def _point_margin(mech, p, euler):
-    R = euler_to_matrix(np.atleast_2d(euler))
-    ik = mech.inverse((np.tile(p, (len(R), 1)), R), stroke=NO_STROKE)
-    lo, hi = mech.stroke
-    m = np.min(np.minimum(ik.q - lo, hi - ik.q), axis=1)
-    return np.where(np.isfinite(m), m, -1e9)
-
-
 def test_capability_bracket_holds_independently(hopkins):
     """Lower end: the certified point keeps every leg in stroke at 20,000 random orientations
     of the continuous box and at local minima of its margin found from the worst of them.
@@ -88,15 +81,7 @@ def test_capability_bracket_holds_independently(hopkins):
     p = np.asarray(b.point)
     th = math.radians(b.lower)
     rng = np.random.default_rng(3)
-    E = rng.uniform(-th, th, (20_000, 3))
-    corners = np.array(np.meshgrid(*[[-th, th]] * 3)).reshape(3, -1).T
-    E = np.vstack([E, corners])
-    m = _point_margin(hopkins, p, E)
-    assert m.min() >= -1e-9
-    for e in E[np.argsort(m)[:3]]:
-        res = minimize(lambda v: _point_margin(hopkins, p, v)[0], e, method="L-BFGS-B",
-                       bounds=[(-th, th)] * 3)
-        assert res.fun >= -1e-9
+    assert_point_holds(hopkins, p, th, rng)
     # upper end: no continuous position for the sample
     Rs = euler_to_matrix(OrientationSet.box(np.radians([b.upper] * 3), samples=5)
                          .parameters())
@@ -120,8 +105,7 @@ def test_stroke_needed_bracket(hopkins):
     assert b.sampled <= b.lower <= b.upper and 128.0 < b.lower and b.upper < 134.0
     mech = dataclasses.replace(hopkins, stroke_window=(0.0, b.upper))
     th = math.radians(30.0)
-    E = np.random.default_rng(5).uniform(-th, th, (20_000, 3))
-    assert _point_margin(mech, np.asarray(b.point), E).min() >= -1e-9
+    assert_point_holds(mech, np.asarray(b.point), th, np.random.default_rng(5), minima=0)
     low = dataclasses.replace(hopkins, stroke_window=(0.0, b.lower))
     Rs = euler_to_matrix(np.vstack([o.parameters(), np.asarray(b.binding).reshape(-1, 3)]))
     res = minimize(lambda v: -np.subtract(*_psu_margin_at(low, v[0], v[1], Rs)[::-1]),
@@ -146,5 +130,4 @@ def test_capability_on_a_6ups_is_bracketed():
     assert b.lower <= b.sampled <= b.upper and b.width <= 0.05 and b.lower > 1.0
     p = np.asarray(b.point)
     th = math.radians(b.lower)
-    E = np.random.default_rng(1).uniform(-th, th, (20_000, 3))
-    assert _point_margin(mech, p, E).min() >= -1e-9
+    assert_point_holds(mech, p, th, np.random.default_rng(1), minima=0)

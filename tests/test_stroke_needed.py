@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import MECH_DIR
+from conftest import MECH_DIR, assert_point_holds
 from scipy.optimize import minimize
 from typer.testing import CliRunner
 
@@ -49,14 +49,6 @@ def _q_at_z0(mech, x, y, euler):
     return np.where(np.isfinite(ik.q), ik.q, np.nan)
 
 
-def _point_margin(mech, p, euler):
-    R = euler_to_matrix(np.atleast_2d(euler))
-    ik = mech.inverse((np.tile(p, (len(R), 1)), R), stroke=NO_STROKE)
-    lo, hi = mech.stroke
-    m = np.min(np.minimum(ik.q - lo, hi - ik.q), axis=1)
-    return np.where(np.isfinite(m), m, -1e9)
-
-
 def test_hopkins_bracket_is_closed_and_holds_independently(hopkins, hopkins30):
     """Width ≤ 0.01 mm from a 3³ grid. Upper end: the certified point keeps every leg in
     stroke at 20,000 random orientations, the corners and local minima of its margin. Lower
@@ -74,14 +66,7 @@ def test_hopkins_bracket_is_closed_and_holds_independently(hopkins, hopkins30):
     mech = dataclasses.replace(hopkins, stroke_window=(qmin, b.upper))
     p = np.asarray(b.point)
     rng = np.random.default_rng(5)
-    E = np.vstack([rng.uniform(-th, th, (20_000, 3)),
-                   np.array(np.meshgrid(*[[-th, th]] * 3)).reshape(3, -1).T])
-    m = _point_margin(mech, p, E)
-    assert m.min() >= -1e-9
-    for e in E[np.argsort(m)[:3]]:
-        res = minimize(lambda v: _point_margin(mech, p, v)[0], e, method="L-BFGS-B",
-                       bounds=[(-th, th)] * 3)
-        assert res.fun >= -1e-9
+    assert_point_holds(mech, p, th, rng)
     # lower end: the search's own sample (grid + binding orientations) admits no column
     S = np.vstack([OrientationSet.box(np.radians([30.0] * 3), samples=3).parameters(),
                    np.asarray(b.binding)])
@@ -134,13 +119,7 @@ def test_6ups_bracket_is_closed_and_holds_independently():
     assert 493.9 < b.lower < 494.1                     # measured [494.0305, 494.0319]
     qmin = ups.stroke[0]
     mech = dataclasses.replace(ups, stroke_window=(qmin, b.upper))
-    E = np.random.default_rng(2).uniform(-th, th, (20_000, 3))
-    m = _point_margin(mech, np.asarray(b.point), E)
-    assert m.min() >= -1e-9
-    for e in E[np.argsort(m)[:3]]:
-        r = minimize(lambda v: _point_margin(mech, np.asarray(b.point), v)[0], e,
-                     method="L-BFGS-B", bounds=[(-th, th)] * 3)
-        assert r.fun >= -1e-9
+    assert_point_holds(mech, np.asarray(b.point), th, np.random.default_rng(2))
     D = OrientationSet.box(np.full(3, th), samples=9).parameters()
 
     def longest(p):
@@ -260,12 +239,4 @@ def test_second_order_certification_holds_where_links_are_near_horizontal():
     assert 44.0 <= b.lower <= b.upper < 44.2              # measured [44.0726, 44.1156]
     th = math.radians(b.lower)
     p = np.asarray(b.point)
-    rng = np.random.default_rng(11)
-    E = np.vstack([rng.uniform(-th, th, (20_000, 3)),
-                   np.array(np.meshgrid(*[[-th, th]] * 3)).reshape(3, -1).T])
-    m = _point_margin(mech, p, E)
-    assert m.min() >= -1e-9
-    for e in E[np.argsort(m)[:4]]:
-        r = minimize(lambda v: _point_margin(mech, p, v)[0], e, method="L-BFGS-B",
-                     bounds=[(-th, th)] * 3)
-        assert r.fun >= -1e-9
+    assert_point_holds(mech, p, th, np.random.default_rng(11), minima=4)
