@@ -171,18 +171,11 @@ def _units(mech, result, idx, pos):
     Returns ``(unit_pos (U, 3), voxel_unit (V,), shared)``.
     """
     if mech.column_invariant and len(idx):
-        # voxel indices come from np.argwhere, in lexicographic (i, j, k) order: a column is
-        # a run of equal (i, j), so no sort is needed
-        key = idx[:, 0].astype(np.int64) * (int(idx[:, 1].max()) + 1) + idx[:, 1]
-        new = np.empty(len(key), dtype=bool)
+        # idx comes from np.argwhere (aggregate._voxels), in lexicographic (i, j, k) order: a
+        # column is a run of equal (i, j), so no sort is needed
+        new = np.empty(len(idx), dtype=bool)
         new[0] = True
-        np.not_equal(key[1:], key[:-1], out=new[1:])
-        if np.any(key[1:] < key[:-1]):                  # not from argwhere: sort after all
-            cols, inv = np.unique(idx[:, :2], axis=0, return_inverse=True)
-            inv = inv.ravel()
-            first = np.zeros(len(cols), dtype=np.int64)
-            first[inv[::-1]] = np.arange(len(idx))[::-1]
-            return pos[first], inv, True
+        np.any(idx[1:, :2] != idx[:-1, :2], axis=1, out=new[1:])
         return pos[np.flatnonzero(new)], np.cumsum(new) - 1, True
     return pos, np.arange(len(idx)), False
 

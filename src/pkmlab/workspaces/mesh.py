@@ -9,7 +9,7 @@ import numpy as np
 
 from ..atomic import write_bytes
 
-__all__ = ["boundary_mesh", "boundary_triangles", "stl_bytes", "write_mesh", "write_scene",
+__all__ = ["merged_mesh", "boundary_triangles", "stl_bytes", "write_mesh", "write_scene",
            "STL_HEADER"]
 
 #: voxels per marching-cubes slab
@@ -19,7 +19,7 @@ _MESH_SLAB = 4_000_000
 def boundary_triangles(result) -> tuple[np.ndarray, np.ndarray]:
     """Vertices ``(n, 3)`` (mm) and faces ``(m, 3)`` of ``result``'s kept workspace boundary,
     oriented outward (positive enclosed volume); vertices shared between the marching-cubes
-    slabs are not merged (:func:`boundary_mesh` merges them).
+    slabs are not merged (:func:`merged_mesh` merges them).
 
     The field is padded by one outside layer so that every surface closes. Marching cubes
     places the surface at the field's zero crossing: exactly at the column interval ends in z
@@ -69,12 +69,11 @@ def _signed_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
     return float(np.einsum("ij,ij->", a, np.cross(b, c)) / 6.0)
 
 
-def boundary_mesh(result):
-    """Watertight triangle mesh (``trimesh.Trimesh``, mm) of ``result``'s kept workspace:
-    :func:`boundary_triangles` with the slabs' shared vertices merged."""
+def merged_mesh(vertices: np.ndarray, faces: np.ndarray):
+    """Watertight ``trimesh.Trimesh`` (mm) of :func:`boundary_triangles`' output, the slabs'
+    shared vertices merged."""
     import trimesh
 
-    vertices, faces = boundary_triangles(result)
     return trimesh.Trimesh(vertices=vertices, faces=faces, process=True)
 
 

@@ -51,8 +51,6 @@ def slice_figure(result, window: float | None = None, spacing: float | None = No
     if values is not None:
         vmin, vmax, extend = _colour_range(values)
     for a, ax in enumerate(axes.ravel()):
-        ax.set_xlim(cx - half, cx + half)
-        ax.set_ylim(cy - half, cy + half)
         ax.set_aspect("equal")
         ax.tick_params(labelsize=6)
         if a >= len(levels):
@@ -111,9 +109,9 @@ def _panel_grid(rows: int, cols: int, size: float, top: float, bottom: float = 0
 
 
 def _outer_ticks(axes, used: int, xlim: tuple[float, float], ylim: tuple[float, float]) -> None:
-    """The same window on every used panel, ticks (mm) on the outside of the used panels
-    only: y ticks in the first column, x ticks under every used panel that has no used panel
-    below it; the inner panels have none."""
+    """The same window (mm) on every used panel, set after drawing, and ticks on the outside
+    of the used panels only: y ticks in the first column, x ticks under every used panel that
+    has no used panel below it; the inner panels have none."""
     from matplotlib.ticker import MaxNLocator
 
     def ticks(lo, hi):
@@ -175,8 +173,6 @@ def overlay_figure(results: list, labels: list[str], layout: str = "auto",
     cx, cy = lay.centre
     half = lay.window / 2
     for a, ax in enumerate(axes.ravel()):
-        ax.set_xlim(cx - half, cx + half)
-        ax.set_ylim(cy - half, cy + half)
         ax.set_aspect("equal")
         ax.tick_params(labelsize=6)
         if a >= len(lay.levels):

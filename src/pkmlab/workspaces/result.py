@@ -263,10 +263,9 @@ class WorkspaceResult:
 
     @cached_property
     def _boundary(self):
-        import trimesh
+        from .mesh import merged_mesh
 
-        vertices, faces = self._triangles
-        return trimesh.Trimesh(vertices=vertices, faces=faces, process=True)
+        return merged_mesh(*self._triangles)
 
     def mesh(self):
         """Watertight boundary mesh (``trimesh.Trimesh``, mm) by marching cubes on ``field``
