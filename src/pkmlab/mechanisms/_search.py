@@ -18,6 +18,9 @@ the method; in short:
   grid, are bounded as above, split in four while their bound exceeds the best centre value
   (decision mode: while it is ``>= 0``; a centre with ``f >= 0`` is a witness), down to
   ``min_size`` mm. An empty tile list proves ``f < 0`` at every continuous position.
+  Hardest orientations first: a bound stops as soon as it falls below the pruning threshold
+  (it is still a bound), and the orientation that stopped it is tried first on the next
+  tile; the decisions and the best margin are those of the full evaluation.
 * :func:`make_certify`: whether one point ``p`` keeps every leg within its stroke for *every*
   orientation of the continuous Euler box ``centre ± θ`` (not a sample). The box is split into
   cells of half-width ``δ``; over a cell ``w_i = R·u_i - b_i`` moves from its value at the
@@ -102,32 +105,46 @@ def _core(leg):
                         W[m, s, 2] = r[6] * ux + r[7] * uy + r[8] * uz - Bp[s, 2]
                     m += 1
 
-    def margin(x, y, W, M, P):
-        """``(f, max a, min b)`` of the column (x, y) over the first M orientations of W."""
+    def margin(x, y, W, M, P, thr, order):
+        """``(f, max a, min b)`` of the column (x, y) over the first M orientations of W,
+        exact when ``f >= thr``; otherwise some value below ``thr`` (the pairs are visited in
+        ``order`` and stop once the running margin is below it; the orientation that stopped
+        them moves to the front of ``order``)."""
         lo, hi = -np.inf, np.inf
-        for m in range(M):
+        for k in range(M):
+            m = order[k]
             for i in range(6):
                 a, b, ok = leg(x, y, W[m, i, 0], W[m, i, 1], W[m, i, 2],
                                P[i, 0], P[i, 1], P[i, 2])
                 if not ok:
+                    order[k], order[0] = order[0], m
                     return -np.inf, np.inf, -np.inf
                 lo = max(lo, a)
                 hi = min(hi, b)
+            if hi - lo < thr:
+                order[k], order[0] = order[0], m
+                return hi - lo, lo, hi
         return hi - lo, lo, hi
 
-    def tile_ub(x0, x1, y0, y1, W, M, P):
-        """Upper bound of the margin over the continuous tile."""
+    def tile_ub(x0, x1, y0, y1, W, M, P, thr, order):
+        """Upper bound of the margin over the continuous tile; once it is below ``thr`` it may
+        stop early (the value returned is still an upper bound; ``order`` as in margin)."""
         La, Ub = -np.inf, np.inf
-        for m in range(M):
+        for k in range(M):
+            m = order[k]
             for i in range(6):
                 wx, wy, wz = W[m, i, 0], W[m, i, 1], W[m, i, 2]
                 dmin, dmax = tile_distances(x0, x1, y0, y1, -wx, -wy)
                 a1, b1, ok1 = leg(dmin - wx, -wy, wx, wy, wz, P[i, 0], P[i, 1], P[i, 2])
                 if not ok1:
+                    order[k], order[0] = order[0], m
                     return -np.inf
                 a2, b2, ok2 = leg(dmax - wx, -wy, wx, wy, wz, P[i, 0], P[i, 1], P[i, 2])
                 La = max(La, min(a1, a2))
                 Ub = min(Ub, max(b1, b2))
+            if Ub - La < thr:
+                order[k], order[0] = order[0], m
+                return Ub - La
         return Ub - La
 
     def branch_bound(W, M, P, box, h0, min_size, eps, decide, out):
@@ -141,18 +158,23 @@ def _core(leg):
         gub = -np.inf                 # bound of the discarded tiles
         n = 0
         tiles = 0
+        # hardest orientations first: the one that last ended a bound is tried first; early
+        # exits below the pruning threshold never change a decision (in the non-deciding mode
+        # the threshold is kept at or below -UB_TOL so that EMPTY stays provable)
+        first = np.arange(M)
         for i in range(nx):
             for j in range(ny):
                 x0 = box[0] + i * h0
                 y0 = box[2] + j * h0
                 x1 = min(x0 + h0, box[1])
                 y1 = min(y0 + h0, box[3])
-                ub = tile_ub(x0, x1, y0, y1, W, M, P)
+                ub = tile_ub(x0, x1, y0, y1, W, M, P,
+                             -UB_TOL if decide else min(best + eps, -UB_TOL), first)
                 tiles += 1
                 if ub < -UB_TOL:
                     gub = max(gub, ub)
                     continue
-                f, zl, zh = margin(0.5 * (x0 + x1), 0.5 * (y0 + y1), W, M, P)
+                f, zl, zh = margin(0.5 * (x0 + x1), 0.5 * (y0 + y1), W, M, P, best, first)
                 if f > best:
                     best, bx, by, bzl, bzh = f, 0.5 * (x0 + x1), 0.5 * (y0 + y1), zl, zh
                 T[n, 0], T[n, 1], T[n, 2], T[n, 3], T[n, 4] = x0, x1, y0, y1, ub
@@ -190,9 +212,12 @@ def _core(leg):
                 cx1 = xm if q // 2 == 0 else x1
                 cy0 = y0 if q % 2 == 0 else ym
                 cy1 = ym if q % 2 == 0 else y1
-                cub = min(ub, tile_ub(cx0, cx1, cy0, cy1, W, M, P))
+                cub = min(ub, tile_ub(cx0, cx1, cy0, cy1, W, M, P,
+                                      -UB_TOL if decide else min(best + eps, -UB_TOL),
+                                      first))
                 tiles += 1
-                f, zl, zh = margin(0.5 * (cx0 + cx1), 0.5 * (cy0 + cy1), W, M, P)
+                f, zl, zh = margin(0.5 * (cx0 + cx1), 0.5 * (cy0 + cy1), W, M, P, best,
+                                   first)
                 if f > best:
                     best, bx, by, bzl, bzh = f, 0.5 * (cx0 + cx1), 0.5 * (cy0 + cy1), zl, zh
                 S[sp, 0], S[sp, 1], S[sp, 2], S[sp, 3], S[sp, 4] = cx0, cx1, cy0, cy1, cub
