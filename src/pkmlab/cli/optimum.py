@@ -110,5 +110,5 @@ def capability(
     _lines(b, f"{escape(mech.name or mech.family)}: orientation capability (largest ±a "
            "simultaneous Euler box with a dexterous position)",
            f"  a in [{b.lower:.4f}, {b.upper:.4f}] deg (width {b.width:.4f} deg; "
-           f"{samples}³ sample alone: {b.sampled:.4f} deg)\n"
+           f"{samples}³ grid alone: {b.sampled:.4f} deg)\n"
            f"  certified point ({x:.4f}, {y:.4f}, {z:.4f}) mm")

@@ -45,6 +45,10 @@ the method; in short:
   continuous position), then the certified lower end: levels from the sampled one down in
   doubling steps, then bisection; at each level the best point near the witness is certified,
   and an orientation that refutes it joins the sample for the next point (cutting planes).
+  Finally the upper end is bisected again over the sample *and* those cut orientations (all
+  inside the box, so a level where together they admit no position is above the capability):
+  the cuts are the orientations between the samples that bind, so the upper end moves from the
+  grid's capability down towards the certified one.
 """
 
 from __future__ import annotations
@@ -104,6 +108,23 @@ def _core(leg):
                         W[m, s, 1] = r[3] * ux + r[4] * uy + r[5] * uz - Bp[s, 1]
                         W[m, s, 2] = r[6] * ux + r[7] * uy + r[8] * uz - Bp[s, 2]
                     m += 1
+
+    def sample_cuts(U, Bp, e0, theta, n, extra, ne, X):
+        """The sample of :func:`sample` followed by the first ``ne`` cut orientations
+        ``e0 + extra[k]·theta`` (``extra`` in unit-box coordinates, so inside the box)."""
+        sample(U, Bp, e0, theta, n, X)
+        M = n * n * n
+        for k in range(ne):
+            tx = e0[0] + extra[k, 0] * theta
+            ty = e0[1] + extra[k, 1] * theta
+            tz = e0[2] + extra[k, 2] * theta
+            rr = _kernels._euler_matrix(math.sin(tx), math.cos(tx), math.sin(ty),
+                                        math.cos(ty), math.sin(tz), math.cos(tz))
+            for s in range(6):
+                ux, uy, uz = U[s, 0], U[s, 1], U[s, 2]
+                X[M + k, s, 0] = rr[0] * ux + rr[1] * uy + rr[2] * uz - Bp[s, 0]
+                X[M + k, s, 1] = rr[3] * ux + rr[4] * uy + rr[5] * uz - Bp[s, 1]
+                X[M + k, s, 2] = rr[6] * ux + rr[7] * uy + rr[8] * uz - Bp[s, 2]
 
     def margin(x, y, W, M, P, thr, order):
         """``(f, max a, min b)`` of the column (x, y) over the first M orientations of W,
@@ -350,16 +371,17 @@ def _core(leg):
                 sp += 1
         return status, cells
 
-    raw = (sample, margin, tile_ub, branch_bound, certify)
+    raw = (sample, sample_cuts, margin, tile_ub, branch_bound, certify)
     ident = identity(*raw, extra=("search-core",))
     # the functions call each other through closure cells: rebinding the names makes those
     # cells hold the jitable versions
     sample = jitable(sample, ident, error_model="numpy")
+    sample_cuts = jitable(sample_cuts, ident, error_model="numpy")
     margin = jitable(margin, ident, error_model="numpy")
     tile_ub = jitable(tile_ub, ident, error_model="numpy")
     branch_bound = jitable(branch_bound, ident, error_model="numpy")
     certify = jitable(certify, ident, error_model="numpy")
-    return {"sample": sample, "margin": margin, "tile_ub": tile_ub,
+    return {"sample": sample, "sample_cuts": sample_cuts, "margin": margin, "tile_ub": tile_ub,
             "branch_bound": branch_bound, "certify": certify}
 
 
@@ -405,16 +427,20 @@ def make_certify(leg):
 @cache
 def make_capability(leg):
     """``cap(U, Bp, P, PR, e0, n, box, h0, theta_max, tol, min_size, min_half, budget,
-    out (12,))``: the orientation capability in one call (module notes; ``PR`` the column
-    profile of the certification, or rows with ``K < 0``). ``out``: theta_lo (certified),
-    theta_hi (sample empty at every position), sampled theta (witness), its x, y, z, the
-    certified point x, y, z, flags (1: not bounded below theta_max, 2: nominal empty, 4: an
-    undecided branch and bound, 8: certification undecided or ``budget`` cells spent; one
-    certification gets a quarter of it), branch-and-bound calls, certification cells."""
+    out (13,), cuts (CUTS, 3))``: the orientation capability in one call (module notes;
+    ``PR`` the column profile of the certification, or rows with ``K < 0``). ``out``: theta_lo
+    (certified), theta_hi (the sample and the cut orientations admit no position), sampled
+    theta (the ``n³`` grid alone, witness), its x, y, z, the certified point x, y, z, flags
+    (1: not bounded below theta_max, 2: nominal empty, 4: an undecided branch and bound, 8:
+    certification undecided or ``budget`` cells spent; one certification gets an eighth of
+    it), branch-and-bound calls, certification cells, the number of cut orientations written
+    to ``cuts`` (unit-box coordinates: the Euler offset at level θ is ``cuts[k]·θ``)."""
     core = _core(leg)
     sample, branch_bound, certify = core["sample"], core["branch_bound"], core["certify"]
+    sample_cuts = core["sample_cuts"]
 
-    def cap(U, Bp, P, PR, e0, n, box, h0, theta_max, tol, min_size, min_half, budget, out):
+    def cap(U, Bp, P, PR, e0, n, box, h0, theta_max, tol, min_size, min_half, budget, out,
+            cuts):
         M = n * n * n
         W = np.empty((M, 6, 3))
         r = np.empty(8)
@@ -427,6 +453,7 @@ def make_capability(leg):
         calls += 1
         if r[BB_STATUS] != FEASIBLE:
             out[0], out[1], out[2], out[9], out[10], out[11] = 0.0, 0.0, 0.0, 2.0, calls, 0.0
+            out[12] = 0.0
             return
         lo, hi = 0.0, theta_max
         wx, wy, wz = r[BB_X], r[BB_Y], 0.5 * (r[BB_ZLO] + r[BB_ZHI])
@@ -484,18 +511,7 @@ def make_capability(leg):
                 step *= 2.0
             ok = False
             for _ in range(CUTS_PER_LEVEL):
-                sample(U, Bp, e0, mid, n, X)
-                for k in range(ne):
-                    tx = e0[0] + extra[k, 0] * mid
-                    ty = e0[1] + extra[k, 1] * mid
-                    tz = e0[2] + extra[k, 2] * mid
-                    rr = _kernels._euler_matrix(math.sin(tx), math.cos(tx), math.sin(ty),
-                                                math.cos(ty), math.sin(tz), math.cos(tz))
-                    for s in range(6):
-                        ux, uy, uz = U[s, 0], U[s, 1], U[s, 2]
-                        X[M + k, s, 0] = rr[0] * ux + rr[1] * uy + rr[2] * uz - Bp[s, 0]
-                        X[M + k, s, 1] = rr[3] * ux + rr[4] * uy + rr[5] * uz - Bp[s, 1]
-                        X[M + k, s, 2] = rr[6] * ux + rr[7] * uy + rr[8] * uz - Bp[s, 2]
+                sample_cuts(U, Bp, e0, mid, n, extra, ne, X)
                 branch_bound(X, M + ne, P, near, 0.5 * LOCAL_MM, min_size, MAX_EPS, False, r)
                 calls += 1
                 if not r[BB_F] >= 0.0:
@@ -525,12 +541,33 @@ def make_capability(leg):
             if cells > budget:            # the whole certification's budget is spent
                 flags |= 8
                 break
+        # the upper end again, with the cuts: the sample and the orientations that refuted
+        # points all lie in the box, so a level where they leave no position is above the
+        # capability too (their own capability lies in [clo, hi])
+        if ne > 0 and not flags & 5:
+            slo = max(clo, 0.0)
+            while hi - slo > tol:
+                mid = 0.5 * (slo + hi)
+                sample_cuts(U, Bp, e0, mid, n, extra, ne, X)
+                branch_bound(X, M + ne, P, box, h0, min_size, 0.0, True, r)
+                calls += 1
+                if r[BB_STATUS] == FEASIBLE:
+                    slo = mid
+                elif r[BB_STATUS] == EMPTY:
+                    hi = mid
+                else:
+                    flags |= 4
+                    break
+            out[1] = hi
         out[0], out[6], out[7], out[8] = clo, cx, cy, cz
-        out[9], out[10], out[11] = flags, calls, cells
+        out[9], out[10], out[11], out[12] = flags, calls, cells, ne
+        for k in range(ne):
+            for c in range(3):
+                cuts[k, c] = extra[k, c]
 
     f8, i8 = nt.float64, nt.int64
     return cached_kernel(cap, nt.void(_F2, _F2, _F2, _F3, _F1, i8, _F1, f8, f8, f8, f8, f8, i8,
-                                      _F1), roots=tuple(_raw(core)))
+                                      _F1, _F2), roots=tuple(_raw(core)))
 
 
 def _raw(core):

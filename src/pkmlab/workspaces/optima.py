@@ -16,6 +16,9 @@ dexterous workspace of the continuous box is non-empty). One compiled call
   (from the monotone radial leg intervals at the tile's nearest and farthest distance from
   each leg's axis) is negative; tiles are split down to 1e-4 mm. z is exact per column.
   Every larger box contains this sample, so no larger box has a dexterous position either.
+  The sample is the ``samples³`` grid plus the orientations that refuted points on the way to
+  the lower end (below; all inside the box): ``upper`` is bisected once more with them, which
+  moves it from the grid's value towards the certified one (``binding`` lists them).
 * ``lower``: a point ``p`` (reported) certified for the continuous box: the box is split into
   cells, and on a cell each leg's offset ``w = R·u - b`` stays within ``|u|·3δ`` of its value
   at the cell's centre (δ the cell's half-width), so the leg's interval is bounded from the
@@ -28,10 +31,11 @@ dexterous workspace of the continuous box is non-empty). One compiled call
   plus the orientations that refuted earlier points. ``θ`` steps down from the sampled level
   in doubling steps until a level is certified, then is bisected to ``tol``, within a budget
   of orientation cells (the note says when it ran out; the lower end is certified anyway).
-* ``sampled``: the largest ``θ`` whose sample has a position (a witness), to ``tol``.
+* ``sampled``: the largest ``θ`` whose ``samples³`` grid has a position (a witness), to
+  ``tol``; ``upper`` may lie below it.
 
 ``upper`` and ``sampled`` are bisected to ``tol`` (0.01°). The bracket ``upper - lower`` is
-wider than ``tol`` when the sample misses orientations that bind or the cell bounds are loose
+wider than ``tol`` when the cuts miss orientations that bind or the cell bounds are loose
 (links near horizontal): certification then fails or runs out of budget above ``lower``.
 
 **Needed stroke** (:func:`stroke_needed`) — for an orientation set (a simultaneous box with
@@ -111,7 +115,8 @@ class OptimumBracket:
     frame) at the certified end (``lower`` for the capability, ``upper`` for the needed
     stroke); ``note`` says why a bracket is wider or open. ``history`` lists the
     exchange rounds of :func:`stroke_needed` and ``binding`` the orientations (Euler offsets
-    from the box's centre, rad) they added to the ``samples³`` grid."""
+    from the box's centre, rad) they added to the ``samples³`` grid (for the capability: the
+    cut orientations at the upper end's level)."""
 
     name: str
     unit: str
@@ -176,9 +181,10 @@ def orientation_capability(mech, samples: int = 7, tol_deg: float = CAPABILITY_T
     e0, U, B, box = _inputs(mech)
     P = _kernels.carray(mech.column_params())
     cap = _search.make_capability(type(mech).column_leg)
-    out = np.empty(12)
+    out = np.empty(13)
+    cuts = np.empty((_search.CUTS, 3))
     cap(U, B, P, _profile(mech), e0, int(samples), box, FIRST_TILE_MM, math.radians(max_deg),
-        math.radians(tol_deg), MIN_TILE_MM, MIN_HALF_RAD, CAPABILITY_CELL_BUDGET, out)
+        math.radians(tol_deg), MIN_TILE_MM, MIN_HALF_RAD, CAPABILITY_CELL_BUDGET, out, cuts)
     flags = int(out[9])
     notes = []
     if flags & 2:
@@ -197,10 +203,13 @@ def orientation_capability(mech, samples: int = 7, tol_deg: float = CAPABILITY_T
         upper = math.inf
     return OptimumBracket(
         "orientation_capability", "deg", lower, upper, sampled, tuple(out[6:9]), samples,
-        f"branch and bound over continuous positions ({samples}^3 orientation samples, "
-        f"upper end) and a point certified for the continuous box (lower end), bisected to "
-        f"{tol_deg:g}°; {int(out[10])} searches, {int(out[11])} orientation cells",
-        "; ".join(notes), time.perf_counter() - t0)
+        f"branch and bound over continuous positions ({samples}^3 orientation samples and "
+        f"{int(out[12])} cut orientations, upper end) and a point certified for the "
+        f"continuous box (lower end), bisected to {tol_deg:g}°; {int(out[10])} searches, "
+        f"{int(out[11])} orientation cells",
+        "; ".join(notes), time.perf_counter() - t0,
+        binding=tuple(tuple(map(float, c)) for c in cuts[:int(out[12])] * out[1])
+        if math.isfinite(upper) else ())
 
 
 def _box_sample(theta: float, n: int) -> np.ndarray:
