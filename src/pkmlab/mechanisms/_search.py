@@ -466,7 +466,7 @@ def make_capability(leg):
             wx, wy, wz = r[BB_X], r[BB_Y], 0.5 * (r[BB_ZLO] + r[BB_ZHI])
         elif r[BB_STATUS] == UNDECIDED:
             flags |= 4
-        while hi - lo > tol and not flags & 1:
+        while hi - lo > 0.5 * tol and not flags & 1:
             mid = 0.5 * (lo + hi)
             sample(U, Bp, e0, mid, n, W)
             branch_bound(W, M, P, box, h0, min_size, 0.0, True, r)
@@ -501,7 +501,7 @@ def make_capability(leg):
         # well below it few)
         step = 10.0 * tol
         found = False
-        while chi - clo > tol or first:
+        while (chi - clo > 0.5 * tol and hi - clo > tol) or first:
             if first:
                 mid = chi
             elif found:
@@ -546,7 +546,7 @@ def make_capability(leg):
         # capability too (their own capability lies in [clo, hi])
         if ne > 0 and not flags & 5:
             slo = max(clo, 0.0)
-            while hi - slo > tol:
+            while hi - slo > 0.5 * tol and hi - clo > tol:
                 mid = 0.5 * (slo + hi)
                 sample_cuts(U, Bp, e0, mid, n, extra, ne, X)
                 branch_bound(X, M + ne, P, box, h0, min_size, 0.0, True, r)
