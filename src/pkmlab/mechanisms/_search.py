@@ -168,6 +168,14 @@ def _core(leg):
                 return Ub - La
         return Ub - La
 
+    def exit_below(decide, best, eps):
+        """Where a tile bound may stop early: below the pruning threshold, and in the
+        non-deciding mode while no witness is known also below -UB_TOL, so that a status
+        EMPTY (every bound below -UB_TOL) stays exact."""
+        if decide:
+            return -UB_TOL
+        return best + eps if best >= 0.0 else min(best + eps, -UB_TOL)
+
     def branch_bound(W, M, P, box, h0, min_size, eps, decide, out):
         """Branch and bound of the margin over continuous (x, y) in ``box`` (x0, x1, y0, y1);
         see the module notes. Writes ``out[BB_*]``."""
@@ -180,8 +188,7 @@ def _core(leg):
         n = 0
         tiles = 0
         # hardest orientations first: the one that last ended a bound is tried first; early
-        # exits below the pruning threshold never change a decision (in the non-deciding mode
-        # the threshold is kept at or below -UB_TOL so that EMPTY stays provable)
+        # exits below the pruning threshold never change a decision (exit_below)
         first = np.arange(M)
         for i in range(nx):
             for j in range(ny):
@@ -190,7 +197,7 @@ def _core(leg):
                 x1 = min(x0 + h0, box[1])
                 y1 = min(y0 + h0, box[3])
                 ub = tile_ub(x0, x1, y0, y1, W, M, P,
-                             -UB_TOL if decide else min(best + eps, -UB_TOL), first)
+                             exit_below(decide, best, eps), first)
                 tiles += 1
                 if ub < -UB_TOL:
                     gub = max(gub, ub)
@@ -234,8 +241,7 @@ def _core(leg):
                 cy0 = y0 if q % 2 == 0 else ym
                 cy1 = ym if q % 2 == 0 else y1
                 cub = min(ub, tile_ub(cx0, cx1, cy0, cy1, W, M, P,
-                                      -UB_TOL if decide else min(best + eps, -UB_TOL),
-                                      first))
+                                      exit_below(decide, best, eps), first))
                 tiles += 1
                 f, zl, zh = margin(0.5 * (cx0 + cx1), 0.5 * (cy0 + cy1), W, M, P, best,
                                    first)
@@ -371,7 +377,7 @@ def _core(leg):
                 sp += 1
         return status, cells
 
-    raw = (sample, sample_cuts, margin, tile_ub, branch_bound, certify)
+    raw = (sample, sample_cuts, margin, tile_ub, exit_below, branch_bound, certify)
     ident = identity(*raw, extra=("search-core",))
     # the functions call each other through closure cells: rebinding the names makes those
     # cells hold the jitable versions
@@ -379,10 +385,11 @@ def _core(leg):
     sample_cuts = jitable(sample_cuts, ident, error_model="numpy")
     margin = jitable(margin, ident, error_model="numpy")
     tile_ub = jitable(tile_ub, ident, error_model="numpy")
+    exit_below = jitable(exit_below, ident, error_model="numpy")
     branch_bound = jitable(branch_bound, ident, error_model="numpy")
     certify = jitable(certify, ident, error_model="numpy")
     return {"sample": sample, "sample_cuts": sample_cuts, "margin": margin, "tile_ub": tile_ub,
-            "branch_bound": branch_bound, "certify": certify}
+            "exit_below": exit_below, "branch_bound": branch_bound, "certify": certify}
 
 
 _F1, _F2, _F3 = nt.float64[::1], nt.float64[:, ::1], nt.float64[:, :, ::1]
