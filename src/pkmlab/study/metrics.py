@@ -108,12 +108,13 @@ _ALL = [
            "box (psu6, ups6, stroke only; other families: the largest grid level verified "
            "by bisection)"),
     Metric("orientation_capability_upper", "orientation_capability", "deg", "bound",
-           "upper end of the bracket: the box's orientation sample admits no position, "
-           "proved by branch and bound over continuous positions (other families: the "
-           "first grid level found empty)"),
+           "upper end of the bracket: the box's orientation grid and the orientations of "
+           "the box that refuted candidate points admit no position, proved by branch and "
+           "bound over continuous positions (other families: the first grid level found "
+           "empty)"),
     Metric("orientation_capability_bracket", "orientation_capability", "deg", "bound",
-           "orientation_capability_upper - orientation_capability (the bisections run to "
-           "0.01°)"),
+           "orientation_capability_upper - orientation_capability (psu6, ups6: the search "
+           "stops within 0.01° or notes why not; grid: the bisection runs to 0.01°)"),
     # needed stroke (continuous optimum, psu6 / ups6)
     Metric("needed_stroke", "needed_stroke", "mm", "bound",
            "smallest actuator travel (upper limit − lower limit, the lower limit kept) at "
