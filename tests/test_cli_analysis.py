@@ -119,3 +119,30 @@ def test_trajectory_cli_reports_the_first_violation(tmp_path):
     assert r.exit_code == 2 and not (tmp_path / "none").exists()
     r = CliRunner().invoke(app, ["trajectory", str(HOPKINS)])
     assert r.exit_code == 2 and "--paper-motion" in r.stderr
+
+
+def test_column_shared_maps_equal_the_per_voxel_computation():
+    """Issue 14 (cheap exports): for a 6-PSU, J does not depend on z, so the maps evaluate J
+    once per (x, y) column; every voxel's worst κ, LCI and force over the set equal a per-voxel
+    computation (J at the voxel itself, numpy's cond, the IK's validity) on the drawn subset."""
+    from pkmlab.dexterity import max_force_all_directions
+    from pkmlab.dexterity.maps import drawn_voxels
+
+    mech = load_mechanism(HOPKINS)
+    res = workspace(mech, "dexterous", OrientationSet.box(np.radians([10] * 3), samples=3), 6.0)
+    where = drawn_voxels(res, [res.zs[len(res.zs) // 2]])
+    maps = {m: metric_map(mech, res, m, L=60.0, f_max=150.0, where=where)
+            for m in ("kappa", "lci", "force")}
+    pos = maps["kappa"].positions
+    Rs = res.orientations.rotations()
+    P, RR = np.tile(pos, (len(Rs), 1)), np.repeat(Rs, len(pos), axis=0)
+    J = mech.jacobian((P, RR))
+    valid = mech.inverse((P, RR)).valid
+    Jh = J.copy()
+    Jh[..., 3:] /= 60.0
+    kap = np.where(valid, np.linalg.cond(Jh), np.inf).reshape(len(Rs), -1)
+    force = np.where(valid, max_force_all_directions(J, 150.0, 60.0), 0.0).reshape(len(Rs), -1)
+    assert len(np.unique(maps["kappa"].index[:, :2], axis=0)) < len(pos)   # columns shared
+    np.testing.assert_allclose(maps["kappa"].values, kap.max(axis=0), rtol=1e-9)
+    np.testing.assert_allclose(maps["lci"].values, (1.0 / kap).min(axis=0), rtol=1e-9)
+    np.testing.assert_allclose(maps["force"].values, force.min(axis=0), rtol=1e-9)

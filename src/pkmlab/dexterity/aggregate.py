@@ -64,6 +64,23 @@ def orientation_batches(pos: np.ndarray, R: np.ndarray):
         yield m0, n, np.tile(pos, (n, 1)), np.repeat(Rm, V, axis=0)
 
 
+def _units(mech, idx, pos):
+    """Evaluation units of the voxels ``idx`` (lexicographic, as from :func:`_voxels` or a
+    subset of it in the same order): the voxels, or their (x, y) columns for families whose
+    Jacobian does not depend on z (``column_invariant``).
+
+    Returns ``(unit_pos (U, 3), voxel_unit (V,), shared)``.
+    """
+    if mech.column_invariant and len(idx):
+        # idx comes from np.argwhere (aggregate._voxels), in lexicographic (i, j, k) order: a
+        # column is a run of equal (i, j), so no sort is needed
+        new = np.empty(len(idx), dtype=bool)
+        new[0] = True
+        np.any(idx[1:, :2] != idx[:-1, :2], axis=1, out=new[1:])
+        return pos[np.flatnonzero(new)], np.cumsum(new) - 1, True
+    return pos, np.arange(len(idx)), False
+
+
 def _ik_valid(mech, p: np.ndarray, R: np.ndarray) -> np.ndarray:
     ik = mech.inverse((np.ascontiguousarray(p), R))
     return ik.valid

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from .aggregate import _ik_valid, _voxels, orientation_batches
+from .aggregate import _ik_valid, _units, _voxels, orientation_batches
 from .force import max_force_all_directions
 from .metrics import CharacteristicLength, condition_number, resolve_length
 from .stiffness import stiffness
@@ -103,25 +103,27 @@ def metric_map(mech, result, metric: str = "kappa",
         idx, pos = idx[keep], pos[keep]
     R = result.orientations.rotations()
     V = len(pos)
+    # J (and so the metric) is evaluated once per (x, y) column for column-invariant families
+    unit_pos, voxel_unit, _ = _units(mech, idx, pos)
+    U = len(unit_pos)
     worse_is_larger = METRICS[metric][2]
+    bad = np.inf if worse_is_larger else 0.0          # an unreachable pose
     worst = np.full(V, -np.inf if worse_is_larger else np.inf)
     for m0, n, p, Rr in orientation_batches(pos, R):
-        J = mech.jacobian((p, Rr))
-        valid = _ik_valid(mech, p, Rr)
+        J = mech.jacobian((np.tile(unit_pos, (n, 1)), np.repeat(R[m0:m0 + n], U, axis=0)))
         if metric in ("kappa", "lci"):
             val = condition_number(J, L)
-            val = np.where(valid, val, np.inf)
             if metric == "lci":
                 val = 1.0 / val
         elif metric == "force":
-            val = np.where(valid, np.nan_to_num(max_force_all_directions(J, f_max, L)), 0.0)
+            val = np.nan_to_num(max_force_all_directions(J, f_max, L))
         else:
             ok = np.all(np.isfinite(J), axis=(1, 2))
             val = np.zeros(len(J))
             if ok.any():
                 val[ok] = stiffness(J[ok], k).translational_min
-            val = np.where(valid, val, 0.0)
-        val = val.reshape(n, V)
+        val = np.where(_ik_valid(mech, p, Rr).reshape(n, V), val.reshape(n, U)[:, voxel_unit],
+                       bad)
         worst = np.maximum(worst, val.max(axis=0)) if worse_is_larger else \
             np.minimum(worst, val.min(axis=0))
         if progress is not None:

@@ -49,7 +49,7 @@ import numpy as np
 
 from ..poses import matrix_to_euler
 from ._linalg import KAPPA_BRACKET, sweep_bounds
-from .aggregate import _CHUNK, _ik_valid, _voxels
+from .aggregate import _CHUNK, _ik_valid, _units, _voxels
 from .force import _fmax, max_force_all_directions
 from .metrics import KAPPA_SINGULAR, CharacteristicLength, condition_number, resolve_length
 
@@ -165,21 +165,6 @@ def _nan_result(status, reason, V, M, L, length, fmax, t0, method) -> WorstCase:
                      length)
 
 
-def _units(mech, result, idx, pos):
-    """Evaluation units: voxels, or (x, y) columns for column-invariant families.
-
-    Returns ``(unit_pos (U, 3), voxel_unit (V,), shared)``.
-    """
-    if mech.column_invariant and len(idx):
-        # idx comes from np.argwhere (aggregate._voxels), in lexicographic (i, j, k) order: a
-        # column is a run of equal (i, j), so no sort is needed
-        new = np.empty(len(idx), dtype=bool)
-        new[0] = True
-        np.any(idx[1:, :2] != idx[:-1, :2], axis=1, out=new[1:])
-        return pos[np.flatnonzero(new)], np.cumsum(new) - 1, True
-    return pos, np.arange(len(idx)), False
-
-
 def _spatial_pairs(result, idx, voxel_unit, shared) -> np.ndarray:
     """``(P, 2)`` unit pairs of face-neighbouring occupied voxels (distinct units only)."""
     shape = result.occupancy.shape
@@ -247,7 +232,7 @@ def worst_case(mech, result, L: float | CharacteristicLength | None = None,
     idx, pos = _voxels(result)
     Rs = result.orientations.rotations()
     V, M = len(pos), len(Rs)
-    unit_pos, voxel_unit, shared = _units(mech, result, idx, pos)
+    unit_pos, voxel_unit, shared = _units(mech, idx, pos)
     U = len(unit_pos)
     where = (f"{V:,} voxels × {M:,} orientations" + (f" ({U:,} (x, y) columns: J does not "
                                                      "depend on z)" if shared else ""))
