@@ -11,12 +11,14 @@ import math
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
-from pkmlab.mechanisms import Luzi3
+from pkmlab.mechanisms import LEG_STATUS, NO_STROKE, Luzi3
 from pkmlab.poses import as_frames, matrix_to_euler
 from pkmlab.workspaces import OrientationSet, workspace
 from pkmlab.workspaces.bracket import volume_bracket
 
+OTHER = {v: k for k, v in LEG_STATUS.items()}["leg outside the working mode"]
 BOX = OrientationSet.box((math.radians(5),) * 3, samples=3)
 
 
@@ -102,3 +104,28 @@ def test_reachable_bracket_keeps_to_the_working_mode(own, reachable):
     # ... but not the mirror image of the workspace below the base
     mirror = V[V[:, 2] > 200.0] * np.array([1.0, 1.0, -1.0])
     assert len(mirror) > 10_000 and not b.contains(mirror, "outer").any()
+
+
+def test_cell_mode_holds_on_random_cells(own):
+    """``leg_cell_bounds(..., mode=True)``: +1 only where every point of the cell is in the
+    working mode, -1 only where none is (checked at a random point of each cell, half of them
+    on its boundary), over positions on both sides of the base plane."""
+    rng = np.random.default_rng(11)
+    n = 40_000
+    p = rng.uniform([-700, -700, -900], [700, 700, 900], (n, 3))
+    R = Rotation.from_rotvec(rng.normal(size=(n, 3)) * 0.2).as_matrix()
+    delta, alpha = rng.uniform(0, 80, n), rng.uniform(0, 0.2, n)
+    _, _, mode = own.leg_cell_bounds(p, R, delta, alpha, mode=True)
+    u = rng.normal(size=(n, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    ax = rng.normal(size=(n, 3))
+    ax /= np.linalg.norm(ax, axis=1, keepdims=True)
+    edge = rng.uniform(size=n) < 0.5
+    p2 = p + u * (np.where(edge, 1.0, rng.uniform(size=n)) * delta)[:, None]
+    R2 = Rotation.from_rotvec(ax * (np.where(edge, 1.0, rng.uniform(size=n))
+                                    * alpha)[:, None]).as_matrix() @ R
+    st = own.inverse((p2, R2), stroke=NO_STROKE).leg_status[:, 0::2]       # one leg a chain
+    other = st == OTHER
+    assert not np.any(other[mode > 0]) and np.all(other[mode < 0])
+    # every outcome occurs, and most cells are decided
+    assert (mode > 0).mean() > 0.2 and (mode < 0).mean() > 0.2 and (mode == 0).any()
