@@ -186,13 +186,13 @@ class Mechanism:
     #: bracket then bounds the volume inside undecided cubes to second order.
     position_curvature: ClassVar[bool] = False
 
-    def leg_cell_bounds(self, p, R, delta, alpha, branch=False):  # pragma: no cover
+    def leg_cell_bounds(self, p, R, delta, alpha, mode=False):  # pragma: no cover
         """``(q, eps)``, both ``(N, 6)``: for every position within ``delta (N,)`` mm of ``p``
         and every rotation within the angle ``alpha (N,)`` rad of ``R`` (``(p (N, 3), R (N,
         3, 3))`` the cell centres), each actuator value lies in ``q ± eps``; ``q`` is the value
-        at the centre wherever the family can say so. With ``branch``, also an int array of
-        the inverse kinematics' branch per chain where it is the same over the cell (0 where
-        it may change); luzi3: see its docstring."""
+        at the centre wherever the family can say so. With ``mode``, also an int array per
+        chain: +1 where the whole cell is in the working mode, -1 where none of it is, 0
+        where undecided; luzi3: see its docstring."""
         raise NotImplementedError
 
     def column_params(self) -> np.ndarray:  # pragma: no cover - optional

@@ -14,6 +14,12 @@ which is the closed-form inverse kinematics. The platform frame is the paper's S
 C_1, y axis along C_1 → C_3, z axis normal to σ. Actuators are ordered
 ``[l11, l12, l21, l22, l31, l32]`` as in the paper's Table 1.
 
+Working mode: chain i's branch is the sign of ``n_i · r_i = |r_i|² k · d_i`` (``n_i = k ×
+u_i``, ``d_i`` the part of ``C_i - A_i1`` normal to the chord ``A_i1 A_i2``). Where it changes,
+``t_i`` (kept along ``r_i``) turns over and the leg lengths jump, so each chain keeps its sign
+at the nominal pose (:func:`working_branches`); a chain on the other branch (e.g. the mirror
+image below the base) is ``leg outside the working mode`` in :meth:`~Luzi3.inverse`.
+
 The module also implements the paper's reduced direct position analysis in ψ1..ψ4
 (eqs. 1-13) and the ψ ↔ pose conversion; see ``docs/validation.md`` for the conventions and
 the errata found.
@@ -23,6 +29,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numba import njit
@@ -33,13 +40,28 @@ from ..poses import as_frames, frames_to_poses, skew
 from . import _kernels
 from .base import NO_STROKE, Mechanism, as_points, as_positive, as_stroke, as_vector3
 
-__all__ = ["Luzi3", "pose_to_psi", "psi_to_pose", "reduced_dpa", "ReducedDPAResult"]
+__all__ = ["Luzi3", "pose_to_psi", "psi_to_pose", "reduced_dpa", "ReducedDPAResult",
+           "working_branches"]
+
+
+def working_branches(mech) -> np.ndarray:
+    """``(3,)`` ±1: the branch (sign of ``n_i · r_i``, module notes) each chain of ``mech``
+    keeps: its sign at ``mech.nominal`` when given, else +1 (the platform normal pointing away
+    from every base chord, as at a level platform above the base, where the mid-stroke nominal
+    pose is searched)."""
+    if mech.nominal is None:
+        return np.ones(3)
+    p, R = as_frames(np.asarray(mech.nominal, dtype=float))
+    A1, r = mech.base_points[0::2], mech.base_points[1::2] - mech.base_points[0::2]
+    n = np.cross(R[0, :, 2], np.cross(r, p[0] + mech.tool_points @ R[0].T - A1))
+    return np.where(np.einsum("ki,ki->k", n, r) >= 0, 1.0, -1.0)
 
 
 @njit(inline="always")
 def _luzi_chain(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, i):
-    """Chain ``i``: lengths ``(q_i1, q_i2)`` of its legs, and False where the chain is degenerate
-    (its plane parallel to the platform normal, |k × u_i| ≈ 0; the lengths are then garbage)."""
+    """Chain ``i``: lengths ``(q_i1, q_i2)`` of its legs, False where the chain is degenerate
+    (its plane parallel to the platform normal, |k × u_i| ≈ 0; the lengths are then garbage),
+    and False where its branch (sign of n·r) is not its working one, ``g[28 + i]``."""
     a1x, a1y, a1z = g[6 * i], g[6 * i + 1], g[6 * i + 2]
     a2x, a2y, a2z = g[6 * i + 3], g[6 * i + 4], g[6 * i + 5]
     ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
@@ -62,13 +84,14 @@ def _luzi_chain(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, i):
     v1 = math.sqrt(ex * ex + ey * ey + ez * ez)
     ex, ey, ez = cx + s * nx - a2x, cy + s * ny - a2y, cz + s * nz - a2z
     v2 = math.sqrt(ex * ex + ey * ey + ez * ez)
-    return v1, v2, nn > 1e-12 * scale
+    return v1, v2, nn > 1e-12 * scale, sign * g[28 + i] > 0.0
 
 
 @register_jitable(inline="always")
 def _luzi_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st, j):
     """Per-pose inverse kinematics (see :mod:`._kernels`); both legs of a degenerate chain are
-    ``DEGENERATE`` with NaN lengths.
+    ``DEGENERATE`` with NaN lengths, both legs of a chain off its working branch
+    ``OTHER_MODE`` with their lengths.
 
     Branch-free (the degenerate case is computed too, a division by zero that is discarded),
     and the chains are unrolled by hand so that ``g`` is indexed by constants.
@@ -76,13 +99,15 @@ def _luzi_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, 
     chains = (_luzi_chain(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, 0),
               _luzi_chain(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, 1),
               _luzi_chain(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, 2))
-    for i, (v1, v2, ok) in enumerate(chains):
+    for i, (v1, v2, ok, mode) in enumerate(chains):
         k = 2 * i * _kernels.ROW + j
         q[k] = v1 if ok else np.nan
-        st[k] = _kernels.stroke_status(v1, qmin, qmax) if ok else _kernels.DEGENERATE
+        s1 = _kernels.stroke_status(v1, qmin, qmax) if mode else _kernels.OTHER_MODE
+        st[k] = s1 if ok else _kernels.DEGENERATE
         k += _kernels.ROW
         q[k] = v2 if ok else np.nan
-        st[k] = _kernels.stroke_status(v2, qmin, qmax) if ok else _kernels.DEGENERATE
+        s2 = _kernels.stroke_status(v2, qmin, qmax) if mode else _kernels.OTHER_MODE
+        st[k] = s2 if ok else _kernels.DEGENERATE
 
 
 @dataclass(frozen=True, eq=False)
@@ -165,7 +190,12 @@ class Luzi3(Mechanism):
 
     def _gparams(self) -> np.ndarray:
         return np.concatenate([self.base_points.ravel(), self.tool_points.ravel(),
-                               [self.upper_link]])
+                               [self.upper_link], self._branches])
+
+    @cached_property
+    def _branches(self) -> np.ndarray:
+        """``(3,)`` ±1: each chain's working branch (:func:`working_branches`)."""
+        return working_branches(self)
 
     def _level_yaw(self) -> float:
         """Yaw that points C_1 (seen from the platform centre) at chain 1's base midpoint."""
@@ -231,7 +261,7 @@ class Luzi3(Mechanism):
     cell_bounds = True
     position_curvature = True
 
-    def leg_cell_bounds(self, p, R, delta, alpha, branch: bool = False):
+    def leg_cell_bounds(self, p, R, delta, alpha, mode: bool = False):
         """Leg lengths at ``(p, R)`` and a bound on their change over a cell (triangle
         inequalities, no linearisation): for ``|p' - p| <= δ`` and ``angle(R'R^T) <= α``,
         with ``c = 2 sin(α/2)``,
@@ -251,8 +281,9 @@ class Luzi3(Mechanism):
 
         A slack of ``1e-9 mm + 1e-12·scale`` covers floating-point rounding. ``delta`` and
         ``alpha`` are ``(N,)`` (mm, rad); returns ``(q, eps)`` ``(N, 6)``, and with
-        ``branch`` also ``(N, 3)`` each chain's sign of ``n·r`` where it is the same over the
-        whole cell (the link's branch; 0 where it may flip or vanish).
+        ``mode`` also ``(N, 3)`` int8 per chain: +1 where its branch (sign of ``n·r``) is the
+        working one over the whole cell, -1 where it is the other one over the whole cell (no
+        pose of the cell is in the working mode), 0 where it may flip or vanish.
         """
         p = np.asarray(p, float).reshape(-1, 3)
         R = np.asarray(R, float).reshape(-1, 3, 3)
@@ -285,7 +316,8 @@ class Luzi3(Mechanism):
         far = np.stack([np.linalg.norm(C - A1, axis=-1), np.linalg.norm(C - A2, axis=-1)],
                        axis=-1).reshape(-1, 6)
         out = np.where(np.repeat(fixed, 2, axis=1), q, far), e
-        return (*out, np.where(fixed, sgn, 0.0).astype(np.int8)) if branch else out
+        return (*out, np.where(fixed, sgn * self._branches, 0.0).astype(np.int8)) if mode \
+            else out
 
     def leg_position_curvature(self, p, R, delta):
         """Gradient ``g (N, 6, 3)`` of each leg length in the position at ``(p, R)`` and a

@@ -10,8 +10,10 @@ value ``q`` at the item's centre and ``ε`` with ``|q' - q| <= ε`` for every po
 centre rotation alone (a *sample*, a rotation that belongs to the set). With ``m = min(q -
 qmin, qmax - q)`` per leg:
 
-* item *in*: every leg has ``m > ε`` (feasible at every point and rotation of the item);
-  item *out*: some leg has ``m < -ε``; the same at α = 0 for the sample.
+* item *in*: every leg has ``m > ε`` and the family says the whole item is in its working
+  mode (``leg_cell_bounds(..., mode=True)``: luzi3, every upper link on its working branch),
+  so it is feasible at every point and rotation of the item; item *out*: some leg has ``m <
+  -ε``, or no point of the item is in the working mode; the same at α = 0 for the sample.
 * constant and dexterous (every orientation): a cube is *out* when any sample of it is out,
   *in* when all its items are in (the items cover the set); the items found in are dropped.
 * reachable (some orientation): a cube is *in* when any sample of it is in, *out* when all its
@@ -147,29 +149,32 @@ def _corners(C0, H0):
 
 
 def _evaluate(mech, oset, P, hP, pid, Oc, Oh):
-    """Per item: ``(q (K, 6), margin (K, 6), eps over the item, eps of the sample, branch
-    (K, chains) at the sample)``."""
+    """Per item: ``(q (K, 6), margin (K, 6), eps over the item, eps of the sample, working
+    mode over the item (K,), working mode of the sample (K,))``, the modes +1 (certainly in
+    it), -1 (certainly not) or 0 (undecided), the least of the chains'."""
     lo_q, hi_q = mech.stroke
     K = len(pid)
     m, qq = np.empty((K, 6)), np.empty((K, 6))
-    br = []
+    w_cell, w_s = np.empty(K, np.int8), np.empty(K, np.int8)
     e_cell, e_s = np.empty((K, 6)), np.empty((K, 6))
     rotating = bool(np.any(Oh > 0))
     for s in range(0, K, _BATCH):
         sl = slice(s, s + _BATCH)
         p, R = P[pid[sl]], oset.rotations_at(Oc[sl])
         delta = math.sqrt(3.0) * hP[pid[sl]]
-        q, e_s[sl], b = mech.leg_cell_bounds(p, R, delta, 0.0, branch=True)
-        br.append(b)
+        q, e_s[sl], b = mech.leg_cell_bounds(p, R, delta, 0.0, mode=True)
+        w_s[sl] = b.min(axis=1)
         if rotating:
-            e_cell[sl] = mech.leg_cell_bounds(p, R, delta,
-                                              oc.angle_bound(oset, Oc[sl], Oh[sl]))[1]
+            _, e_cell[sl], b = mech.leg_cell_bounds(p, R, delta,
+                                                    oc.angle_bound(oset, Oc[sl], Oh[sl]),
+                                                    mode=True)
+            w_cell[sl] = b.min(axis=1)
         else:
-            e_cell[sl] = e_s[sl]
+            e_cell[sl], w_cell[sl] = e_s[sl], w_s[sl]
         qq[sl] = q
         with np.errstate(invalid="ignore"):
             m[sl] = np.minimum(q - lo_q, hi_q - q)
-    return qq, m, e_cell, e_s, (np.concatenate(br) if br else np.zeros((0, 3), np.int8))
+    return qq, m, e_cell, e_s, w_cell, w_s
 
 
 def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
@@ -191,8 +196,6 @@ def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
     Oc, Oh = np.tile(C0, (len(P), 1)), np.tile(H0, (len(P), 1))
     in_C, in_h = np.zeros((0, 3)), np.zeros(0)
     V = _corners(C0, H0)
-    b_nom = mech.leg_cell_bounds(p_nom[None], oset.rotations_at(C0[:1]), 0.0, 0.0,
-                                 branch=True)[2][0]
     history: list[dict] = []
     notes: list[str] = []
     evaluations = 0
@@ -200,24 +203,26 @@ def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
     stop = None
     step = 0
     while True:
-        q, m, e_cell, e_s, br = _evaluate(mech, oset, P, hP, pid, Oc, Oh)
+        q, m, e_cell, e_s, w_cell, w_s = _evaluate(mech, oset, P, hP, pid, Oc, Oh)
         evaluations += 6 * len(pid) * (2 if np.any(Oh > 0) else 1)
         with np.errstate(invalid="ignore"):
-            item_in, item_out = np.all(m > e_cell, axis=1), np.any(m < -e_cell, axis=1)
-            s_in, s_out = np.all(m > e_s, axis=1), np.any(m < -e_s, axis=1)
+            # feasible = within the stroke and in the working mode (every chain on its branch)
+            item_in = np.all(m > e_cell, axis=1) & (w_cell > 0)
+            item_out = np.any(m < -e_cell, axis=1) | (w_cell < 0)
+            s_in, s_out = np.all(m > e_s, axis=1) & (w_s > 0), np.any(m < -e_s, axis=1) | (w_s < 0)
         n = len(P)
-        spid, sO, sq = pid, Oc, q
+        spid, sO, sq, sw = pid, Oc, q, w_s
         if len(V):
             # the corners of the set as extra samples of every cube (leg extremes lie there)
             vp = np.repeat(np.arange(n), len(V))
             vO = np.tile(V, (n, 1))
-            vq, vm, _, ve, _ = _evaluate(mech, oset, P, hP, vp, vO, np.zeros((len(vp), 3)))
+            vq, vm, _, ve, _, vw = _evaluate(mech, oset, P, hP, vp, vO, np.zeros((len(vp), 3)))
             evaluations += 6 * len(vp)
             with np.errstate(invalid="ignore"):
-                s_in = np.concatenate([s_in, np.all(vm > ve, axis=1)])
-                s_out = np.concatenate([s_out, np.any(vm < -ve, axis=1)])
-            spid, sO, sq = np.concatenate([pid, vp]), np.concatenate([Oc, vO]), \
-                np.concatenate([q, vq])
+                s_in = np.concatenate([s_in, np.all(vm > ve, axis=1) & (vw > 0)])
+                s_out = np.concatenate([s_out, np.any(vm < -ve, axis=1) | (vw < 0)])
+            spid, sO, sq, sw = np.concatenate([pid, vp]), np.concatenate([Oc, vO]), \
+                np.concatenate([q, vq]), np.concatenate([w_s, vw])
         if kind == "reachable":
             c_in = np.zeros(n, bool)
             np.logical_or.at(c_in, spid, s_in)
@@ -226,11 +231,6 @@ def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
         else:
             c_out = np.zeros(n, bool)
             np.logical_or.at(c_out, spid, s_out)
-            if kind == "constant":
-                # one rotation: the component stays on the nominal branch of every link
-                other = np.any((br != 0) & (br != b_nom), axis=1)
-                c_out[pid[other]] = True
-                item_in &= np.all(br == b_nom, axis=1)
             keep = ~item_in & ~c_out[pid]
             c_in = ~c_out & (np.bincount(pid[keep], minlength=n) == 0)
         und = ~c_in & ~c_out
@@ -238,7 +238,7 @@ def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
         u_C, u_h = P[und], hP[und]
         sets = _components(in_C, in_h, u_C, u_h, p_nom, cons.connected)
         sel = und[spid]
-        part = (_partial(mech, oset, kind, P, hP, und, spid[sel], sO[sel], sq[sel],
+        part = (_partial(mech, oset, kind, P, hP, und, spid[sel], sO[sel], sq[sel], sw[sel],
                          in_C[sets[0]], in_h[sets[0]], cons.connected)
                 if mech.position_curvature else None)
         lo_s, up_s, note = _volumes(in_h, u_h, sets, part)
@@ -314,11 +314,12 @@ def _volumes(in_h, u_h, sets, part):
             float(v_in[outer[:n]].sum() + (f_up * v_u)[outer[n:]].sum()), None)
 
 
-def _partial(mech, oset, kind, P, hP, und, pid, O, q, keep_C, keep_h, connected):
+def _partial(mech, oset, kind, P, hP, und, pid, O, q, w, keep_C, keep_h, connected):
     """Second-order fractions of the undecided cubes (:mod:`.bracket_partial`) from their
     samples: the upper one (constant, dexterous) is the smallest over the samples; the lower
-    one (constant, reachable) the largest over the samples whose inner region has a vertex in
-    a kept in cube (so it joins the kept component; any sample without connectivity).
+    one (constant, reachable) the largest over the samples in the working mode over the cube
+    (``w > 0``) whose inner region has a vertex in a kept in cube (so it joins the kept
+    component; any sample without connectivity).
     ``q`` is the family's bound centre at α = 0, the leg length wherever the curvature bound
     ``M`` is finite (luzi3: both need the link's sign fixed over the cube)."""
     ui = np.cumsum(und) - 1
@@ -336,7 +337,7 @@ def _partial(mech, oset, kind, P, hP, und, pid, O, q, keep_C, keep_h, connected)
         if connected:
             Vx = vertices(P[pid], s).reshape(-1, 3)
             vert = vert & _in_cubes(Vx, keep_C, keep_h).reshape(vert.shape)
-        ok = vert.any(axis=1)
+        ok = vert.any(axis=1) & (w > 0)
         np.maximum.at(f_lo, cube[ok], inner[ok])
     return f_lo, f_up
 
