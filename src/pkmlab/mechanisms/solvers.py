@@ -13,6 +13,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..poses import as_frames, frames_to_poses, log_so3
 from ..tolerances import TOL
+from . import _kernels
 from .results import NO_STROKE, AssemblyModes, FKResult, step_frames
 
 
@@ -83,11 +84,13 @@ def newton(mech, p, R, q, *, tol: float, max_iter: int, polish: int = 2):
 
 
 def _working_mode(mech, p, R, q, tol_mode: float) -> np.ndarray:
-    """True where the family's inverse kinematics at (p, R) reproduces q."""
+    """True where the family's inverse kinematics at (p, R) reproduces q and puts no leg
+    outside the family's working mode (a mirror assembly has the same leg lengths)."""
     ik = mech.inverse((p, R), stroke=NO_STROKE)
     with np.errstate(invalid="ignore"):
         err = np.max(np.abs(ik.q - q), axis=1)
-    return np.isfinite(err) & (err <= tol_mode)
+    other = np.any(ik.leg_status == _kernels.OTHER_MODE, axis=1)
+    return np.isfinite(err) & (err <= tol_mode) & ~other
 
 
 def forward_newton(mech, q, guess=None, *, tol: float = TOL.fk_residual_mm, max_iter: int = 50,
