@@ -32,10 +32,12 @@ certified upper bound on κ (:func:`pkmlab.dexterity._linalg.sweep_bounds`, numb
 (singular values) is computed only for the poses whose bound reaches the largest exact κ found,
 in decreasing order of the bound. Families whose Jacobian does not depend on z at fixed (x, y)
 and orientation (``column_invariant``, the 6-PSU) are evaluated once per (x, y) column.
-Every (voxel, orientation) pair is checked with the inverse kinematics and only the feasible
-ones count: all of them in a dexterous or constant workspace except voxel centres on its
-boundary to rounding (e.g. the 6-UPS base plane, the edge of its working mode), and in a
-reachable workspace only the orientations reachable at each voxel.
+Feasibility comes from the inverse kinematics, per unit (voxel or column) and orientation: a
+column counts at an orientation when one of its voxels is feasible (its middle voxel is tried
+first, the others only where that fails). Only the feasible pairs count: all of them in a
+dexterous or constant workspace except voxel centres on its boundary to rounding (e.g. the
+6-UPS base plane, the edge of its working mode), and in a reachable workspace only the
+orientations reachable at each voxel.
 """
 
 from __future__ import annotations
@@ -90,7 +92,9 @@ class WorstCase:
         pairs_checked: neighbouring sample pairs compared.
         voxels, orientations: the grid: occupied voxels × sample orientations.
         poses: Jacobians evaluated (voxels, or (x, y) columns, × orientations).
-        feasible: feasible (voxel, orientation) samples (inverse kinematics valid).
+        feasible: feasible (unit, orientation) pairs: units are the voxels, or the (x, y)
+            columns of a column-invariant family, and a pair is feasible when the inverse
+            kinematics is valid at one of the unit's voxels.
         exact: poses whose κ was computed exactly (the others were bounded below the maximum).
         L: characteristic length used (mm); ``length``: with its status and reason.
         force_limit: ``(6,)`` actuator force limits (N).
@@ -163,6 +167,42 @@ def _nan_result(status, reason, V, M, L, length, fmax, t0, method) -> WorstCase:
     return WorstCase(nan, nan, False, reason, nan, nan, np.full(6, nan), np.full(6, nan), 0, 0,
                      0, V, M, 0, 0, 0, L, fmax, method, status, time.perf_counter() - t0,
                      length)
+
+
+def _unit_feasibility(mech, pos, Rs, voxel_unit, U) -> np.ndarray:
+    """``(U, M)`` bool: some voxel of the unit is feasible at the orientation (inverse
+    kinematics valid). Each unit's middle voxel is tried first at every orientation; only where
+    it fails are the unit's other voxels tried, so a column that holds the whole set costs one
+    pose per orientation instead of one per voxel (the result is the same)."""
+    M = len(Rs)
+    counts = np.bincount(voxel_unit, minlength=U)
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    rep = starts + counts // 2
+    feas = np.zeros((U, M), dtype=bool)
+    step = max(1, _CHUNK // U)
+    for m0 in range(0, M, step):
+        Rm = Rs[m0:m0 + step]
+        k = len(Rm)
+        feas[:, m0:m0 + k] = _ik_valid(mech, np.tile(pos[rep], (k, 1)),
+                                       np.repeat(Rm, U, axis=0)).reshape(k, U).T
+    miss = np.argwhere(~feas & (counts > 1)[:, None])          # (unit, orientation)
+    if not len(miss):
+        return feas
+    n = counts[miss[:, 0]] - 1                                  # the other voxels of each
+    ends = np.cumsum(n)
+    first = 0
+    while first < len(miss):                                    # batches of about _CHUNK poses
+        last = int(np.searchsorted(ends, ends[first] - n[first] + _CHUNK, side="right"))
+        last = max(last, first + 1)
+        u, m, nb = miss[first:last, 0], miss[first:last, 1], n[first:last]
+        off = np.repeat(np.cumsum(nb) - nb, nb)
+        j = np.arange(int(nb.sum())) - off                      # 0 .. n-1 within each pair
+        vox = np.repeat(starts[u], nb) + j
+        vox += vox >= np.repeat(rep[u], nb)                     # skip the middle voxel
+        ok = _ik_valid(mech, pos[vox], Rs[np.repeat(m, nb)])
+        feas[u, m] = np.logical_or.reduceat(ok, np.cumsum(nb) - nb)
+        first = last
+    return feas
 
 
 def _spatial_pairs(result, idx, voxel_unit, shared) -> np.ndarray:
@@ -245,20 +285,11 @@ def worst_case(mech, result, L: float | CharacteristicLength | None = None,
         log.warning("worst_case: %s", reason)
         return _nan_result("too large", reason, V, M, L, length, fmax, t0, f"max over {where}")
 
-    # feasibility of every (voxel, orientation) pair; a unit is feasible if one of its voxels is
-    feas = np.zeros((U, M), dtype=bool)
-    n_feasible = 0
-    step = max(1, _CHUNK // V)
-    for m0 in range(0, M, step):
-        Rm = Rs[m0:m0 + step]
-        k = len(Rm)
-        ok = _ik_valid(mech, np.tile(pos, (k, 1)), np.repeat(Rm, V, axis=0)).reshape(k, V)
-        n_feasible += int(ok.sum())
-        rows, cols = np.nonzero(ok)
-        feas[voxel_unit[cols], m0 + rows] = True
-    if n_feasible < V * M:
-        log.debug("worst_case: %d of %d (voxel, orientation) samples infeasible",
-                  V * M - n_feasible, V * M)
+    feas = _unit_feasibility(mech, pos, Rs, voxel_unit, U)
+    n_feasible = int(feas.sum())
+    if n_feasible < U * M:
+        log.debug("worst_case: %d of %d (unit, orientation) pairs infeasible",
+                  U * M - n_feasible, U * M)
 
     sign = np.zeros((U, M), dtype=np.int8)            # sign of det J; 0: singular or infeasible
     cand_idx, cand_up = [], []                        # poses whose κ bound may be the maximum
@@ -355,8 +386,9 @@ def worst_case(mech, result, L: float | CharacteristicLength | None = None,
             mech.jacobian((unit_pos[fu][None], Rs[fm][None])), fmax, L)[0])
         if not math.isfinite(f_exact):
             f_exact = 0.0
-    method = (f"max over {where} = {U * M:,} poses, {n_feasible:,} of {V * M:,} (voxel, "
-              f"orientation) samples feasible; exact κ at {exact:,} poses (the others bounded "
+    unit = "column" if shared else "voxel"
+    method = (f"max over {where} = {U * M:,} poses, {n_feasible:,} of {U * M:,} ({unit}, "
+              f"orientation) pairs feasible; exact κ at {exact:,} poses (the others bounded "
               f"below the maximum); singular: κ = inf at a sample, or det J changes sign "
               f"across {n_pairs:,} neighbouring sample pairs")
     res = WorstCase(
