@@ -169,31 +169,34 @@ def _gram_lambda_max(A, G, T):
         s += G[i, i]
     if not s > 0.0:
         return 0.0
+    inv = 1.0 / s
     for i in range(6):
         for j in range(6):
-            G[i, j] /= s
-    logb = 0.0
-    w = 0.5
+            G[i, j] *= inv
+    b = s
     for step in range(_POWER):
         c = 0.0
         for i in range(6):
             for j in range(6):
                 c += G[i, j] * G[i, j]
-        logb += w * math.log(c)
-        w *= 0.5
+        r = c                       # c^(2^-(step+1)) by square roots (c in [1/6, 1])
+        for _ in range(step + 1):
+            r = math.sqrt(r)
+        b *= r
         if step == _POWER - 1:
             break
+        inv = 1.0 / c
         for i in range(6):
             for j in range(i, 6):
                 v = 0.0
                 for k in range(6):
                     v += G[i, k] * G[k, j]
-                T[i, j] = v / c
-                T[j, i] = v / c
+                T[i, j] = v * inv
+                T[j, i] = v * inv
         for i in range(6):
             for j in range(6):
                 G[i, j] = T[i, j]
-    return s * math.exp(logb)
+    return b
 
 
 @njit(cache=True, error_model="numpy")
