@@ -306,3 +306,6 @@ def sweep_bounds(J, L, fmax, kup, force, det):
 
 #: ``kup / KAPPA_BRACKET`` of :func:`sweep_bounds` is a lower bound on κ (exact arithmetic).
 KAPPA_BRACKET = 6.0 ** (1.0 / 2 ** _POWER)
+#: relative allowance for rounding in ``kup``: ``kup·(1 + KAPPA_ROUND) >= κ`` below 1e8 (above
+#: it, treat the bound as unbounded)
+KAPPA_ROUND = 1e-6

@@ -50,7 +50,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..poses import matrix_to_euler
-from ._linalg import KAPPA_BRACKET, sweep_bounds
+from ._linalg import KAPPA_BRACKET, KAPPA_ROUND, sweep_bounds
 from .aggregate import _CHUNK, _ik_valid, _units, _voxels
 from .force import _fmax, max_force_all_directions
 from .metrics import KAPPA_SINGULAR, CharacteristicLength, condition_number, resolve_length
@@ -64,7 +64,7 @@ __all__ = ["WorstCase", "worst_case", "MAX_POSES"]
 MAX_POSES = 50_000_000
 
 _EXACT_BATCH = 256
-_ROUND = 1e-6          # relative allowance for rounding in the κ bound of sweep_bounds
+_ROUND = KAPPA_ROUND   # relative allowance for rounding in the κ bound of sweep_bounds
 _SINGULAR_BOUND = KAPPA_SINGULAR / KAPPA_BRACKET / (1 + _ROUND) ** 2   # may be singular
 
 
