@@ -25,7 +25,8 @@ method whose name starts with ``_``):
   giving their closed form for the guaranteed volume bracket, :mod:`pkmlab.workspaces.bracket`);
   families without column kernels may set ``cell_bounds`` and give ``leg_cell_bounds(p, R,
   delta, alpha)`` (each leg's length and a bound on its change over a position ball × rotation
-  cell) for the cell bracket, :mod:`pkmlab.workspaces.bracket_cells`;
+  cell; ``leg_cell_margins`` when feasibility needs more than the window, rss6) for the cell
+  bracket, :mod:`pkmlab.workspaces.bracket_cells`;
 * equality and hashing by geometry (two mechanisms with the same family, joints, stroke, tool
   offset and nominal pose are equal, whatever their names).
 
@@ -194,6 +195,19 @@ class Mechanism:
         the inverse kinematics' branch per chain where it is the same over the cell (0 where
         it may change); luzi3: see its docstring."""
         raise NotImplementedError
+
+    def leg_cell_margins(self, p, R, delta, alpha, branch=False):
+        """``(q, m, eps[, branch])``: the feasibility margins the cell bracket tests, ``m``
+        and ``eps`` ``(N, K)`` with ``|m' - m| <= eps`` over the cell; a leg is feasible
+        where all its margins are >= 0, so the item is certainly in when every ``m > eps``,
+        certainly out when some ``m < -eps``. Default (K = 6): ``min(q - qmin, qmax - q)``
+        from :meth:`leg_cell_bounds` (1-Lipschitz in q, so the same eps); rss6 adds the
+        rod's closing margins (:mod:`._crank_cells`)."""
+        out = self.leg_cell_bounds(p, R, delta, alpha, branch)
+        lo, hi = self.stroke
+        with np.errstate(invalid="ignore"):
+            m = np.minimum(out[0] - lo, hi - out[0])
+        return (out[0], m, *out[1:])
 
     def column_params(self) -> np.ndarray:  # pragma: no cover - optional
         """``(6, 3)`` per-leg parameters of ``column_leg``."""

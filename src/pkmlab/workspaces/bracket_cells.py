@@ -1,5 +1,6 @@
 """A guaranteed volume bracket on position cells × orientation cells, for families without
-column kernels whose legs are bounded over a cell (``cell_bounds``: luzi3).
+column kernels whose legs are bounded over a cell (``cell_bounds``: luzi3; rss6, whose legs
+have two more margins, the rod's closing, through ``leg_cell_margins``).
 
 **Cells.** Positions are covered by axis-aligned cubes on a grid anchored at the origin (edge
 ``resolution·2^k``; the first edge is the smallest such that the search box is at most 32
@@ -147,29 +148,26 @@ def _corners(C0, H0):
 
 
 def _evaluate(mech, oset, P, hP, pid, Oc, Oh):
-    """Per item: ``(q (K, 6), margin (K, 6), eps over the item, eps of the sample, branch
-    (K, chains) at the sample)``."""
-    lo_q, hi_q = mech.stroke
+    """Per item: ``(q (K, 6), margins (K, M), eps over the item, eps of the sample, branch
+    (K, chains) at the sample)``, the margins of the family's ``leg_cell_margins`` (M = 6,
+    ``min(q - qmin, qmax - q)``, unless the family says otherwise)."""
     K = len(pid)
-    m, qq = np.empty((K, 6)), np.empty((K, 6))
-    br = []
-    e_cell, e_s = np.empty((K, 6)), np.empty((K, 6))
     rotating = bool(np.any(Oh > 0))
+    qq, m, e_cell, e_s, br = [np.zeros((0, 6))], [np.zeros((0, 6))], [np.zeros((0, 6))], \
+        [np.zeros((0, 6))], [np.zeros((0, 3), np.int8)]
     for s in range(0, K, _BATCH):
         sl = slice(s, s + _BATCH)
         p, R = P[pid[sl]], oset.rotations_at(Oc[sl])
         delta = math.sqrt(3.0) * hP[pid[sl]]
-        q, e_s[sl], b = mech.leg_cell_bounds(p, R, delta, 0.0, branch=True)
-        br.append(b)
-        if rotating:
-            e_cell[sl] = mech.leg_cell_bounds(p, R, delta,
-                                              oc.angle_bound(oset, Oc[sl], Oh[sl]))[1]
-        else:
-            e_cell[sl] = e_s[sl]
-        qq[sl] = q
-        with np.errstate(invalid="ignore"):
-            m[sl] = np.minimum(q - lo_q, hi_q - q)
-    return qq, m, e_cell, e_s, (np.concatenate(br) if br else np.zeros((0, 3), np.int8))
+        q, ms, es, b = mech.leg_cell_margins(p, R, delta, 0.0, branch=True)
+        for acc, x in ((qq, q), (m, ms), (e_s, es), (br, b)):
+            acc.append(x)
+        e_cell.append(mech.leg_cell_margins(p, R, delta, oc.angle_bound(oset, Oc[sl],
+                                                                          Oh[sl]))[2]
+                      if rotating else es)
+    if K == 0:
+        return qq[0], m[0], e_cell[0], e_s[0], br[0]
+    return tuple(np.concatenate(x[1:]) for x in (qq, m, e_cell, e_s, br))
 
 
 def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
