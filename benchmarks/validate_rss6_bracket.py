@@ -8,7 +8,8 @@ engine's estimates.
    circular |θ(point) - θ(centre)| / εθ from the IK where εθ is finite, and the largest
    |μ| / |ΔW| over the legs whose IK status (closing and window) differs between centre and
    point (|μ| must be at most the distance the platform joint moved), plus the count of
-   wrong decisions (``μ > ε`` at an infeasible point or ``μ < -ε`` at a feasible one).
+   wrong decisions (``μ > ε`` at an infeasible point or ``μ < -ε`` at a feasible one), and
+   the second-order remainder of ``leg_position_curvature`` over its bound (rotation fixed).
 2. Brackets on the shipped servo platform (studies/mechanisms/instructables-servo-6rss.yaml)
    and on a geometry of our own, for each kind (±2° simultaneous box for dexterous and
    reachable), with growing budgets, against the engine (exact in z, its ``volume_error``
@@ -80,8 +81,18 @@ def bound_check(mech, n=200_000, seed=0):
     flip = ok != ok2
     rm = np.abs(mu[flip]) / moved[flip]
     wrong = int(np.sum((mu > eps) & ~ok2) + np.sum((mu < -eps) & ok2))
+    # second order in the position (rotation fixed): |θ(p + dp) - θ - g·dp| <= M |dp|² / 2
+    g, M = mech.leg_position_curvature(p, R, delta)
+    dp = p2 - p
+    q3 = mech.inverse((p + dp, R), stroke=NO_STROKE).q
+    rem = np.abs(np.mod(q3 - ik.q - np.einsum("nkj,nj->nk", g, dp) + math.pi, 2 * math.pi)
+                 - math.pi)
+    dd = np.sum(dp * dp, axis=1)
+    sec = np.isfinite(M) & (dd > 1.0)[:, None]
+    r2 = rem[sec] / (0.5 * M * dd[:, None])[sec]
     return (float(rt.max()), float(np.median(rt)), float(fin.mean()), float(rm.max()),
-            int(flip.sum()), float(np.mean(np.abs(mu) > eps)), wrong)
+            int(flip.sum()), float(np.mean(np.abs(mu) > eps)), wrong, float(r2.max()),
+            float(np.median(r2)), float(np.isfinite(M).mean()))
 
 
 def brackets(mech, budgets=(1.0, 4.0, 16.0)):
@@ -110,11 +121,13 @@ def main(what):
     print("load:", os.getloadavg())
     if what in ("all", "bounds"):
         print("| geometry | θ ratio max | θ ratio median | share with finite εθ | "
-              "|μ|/|ΔW| max (status changed) | status changes | decided | wrong decisions |")
+              "|μ|/|ΔW| max (status changed) | status changes | decided | wrong decisions | "
+              "2nd order ratio max | median | share with finite M |")
         for m in (servo(), own()):
             r = bound_check(m)
             print(f"| {m.name or 'own'} | {r[0]:.4f} | {r[1]:.3f} | {r[2]:.2f} | {r[3]:.4f} | "
-                  f"{r[4]} | {r[5]:.2f} | {r[6]} |", flush=True)
+                  f"{r[4]} | {r[5]:.2f} | {r[6]} | {r[7]:.4f} | {r[8]:.3f} | {r[9]:.2f} |",
+                  flush=True)
     if what in ("all", "brackets"):
         print("| geometry | kind | budget | bracket | width | took | engine (cm³) |")
         for m in (servo(), own()):

@@ -117,6 +117,33 @@ def test_leg_bounds_hold_on_random_cells(which, request):
     assert np.all(ok2[surely]) and not np.any(ok2[never])
 
 
+@pytest.mark.parametrize("which", ["servo", "mixed"])
+def test_position_curvature_bounds_the_linearisation(which, request):
+    """Gradient against central differences of the IK; the second-order remainder against
+    its bound M·|dp|²/2 (rotation fixed), where M is finite."""
+    mech = request.getfixturevalue(which)
+    rng = np.random.default_rng(8)
+    p, R, delta, _, p2, _ = _cells(mech, rng, 20_000)
+    g, M = mech.leg_position_curvature(p, R, delta)
+    fin = np.isfinite(M)
+    h = 1e-5
+    for j in range(3):
+        d = np.zeros(3)
+        d[j] = h
+        fd = (mech.inverse((p + d, R), stroke=NO_STROKE).q
+              - mech.inverse((p - d, R), stroke=NO_STROKE).q) / (2 * h)
+        np.testing.assert_allclose(g[:, :, j][fin], fd[fin], atol=1e-7)
+    dp = p2 - p
+    q = mech.inverse((p, R), stroke=NO_STROKE).q
+    q2 = mech.inverse((p2, R), stroke=NO_STROKE).q
+    rem = np.abs(np.mod(q2 - q - np.einsum("nkj,nj->nk", g, dp) + math.pi, 2 * math.pi)
+                 - math.pi)
+    dd = np.sum(dp * dp, axis=1)
+    sec = fin & (dd > 1.0)[:, None]
+    ratio = rem[sec] / (0.5 * M * dd[:, None])[sec]
+    assert fin.mean() > 0.3 and ratio.max() <= 1.0 and ratio.max() > 0.3
+
+
 def _engine_inside(b, ref, kind):
     """The engine is exact in z, its volume_error covers the x-y grid; its orientation set is
     a sample: an upper estimate of the dexterous volume, a lower one of the reachable."""

@@ -63,7 +63,7 @@ import math
 
 import numpy as np
 
-__all__ = ["crank_cell_terms"]
+__all__ = ["crank_cell_terms", "crank_position_curvature"]
 
 
 def crank_cell_terms(p, R, delta, alpha, B, T, u, v, n, a, s, b, window, slack):
@@ -111,3 +111,43 @@ def crank_cell_terms(p, R, delta, alpha, B, T, u, v, n, a, s, b, window, slack):
             feasible &= (theta >= lo) & (theta <= hi)
     D = np.where(real, D, -np.minimum(m1, m2))
     return theta, et, np.where(feasible, D, -D), np.broadcast_to(eP, m1.shape)
+
+
+def crank_position_curvature(p, R, delta, B, T, u, v, n, a, s, b, slack):
+    """Gradient ``g (N, 6, 3)`` of each crank angle in the position at ``(p, R)`` and a bound
+    ``M (N, 6)`` on its second derivative over the ball ``|p' - p| <= δ`` (rotation fixed), so
+    ``|θ(p') - θ(p) - g·(p' - p)| <= M·|p' - p|²/2``; ``inf`` where none is given.
+
+    From ``f(θ, W) = |W - C(θ)|² - s² = 0`` (``d = W - C``): ``f_W = 2d``, ``f_θ = b·h``,
+    ``f_WW = 2I``, ``f_Wθ = -2C'`` (``|C'| = a``), ``f_θθ = G`` (``|G| <= ρ = 2ar``), so
+    ``g = -2d/(b·h)`` and ``D²θ = -(f_WW + f_Wθ gᵀ + g f_Wθᵀ + f_θθ g gᵀ)/f_θ``, of norm at most
+    ``M = (2 + 4a·L + 2a·(r + δ)·L²)/h_min`` with ``L = 2s/h_min`` (module notes: ``h >=
+    h_min`` on the ball where ``m1, m2 > δ``). Finite only there and where the angle cannot
+    wrap across ±π on the ball (``|θ| + δ·L < π``), so that the wrapped angle is the smooth
+    one."""
+    theta, et, _, _ = crank_cell_terms(p, R, delta, 0.0, B, T, u, v, n, a, s, b,
+                                       (-math.pi, math.pi), slack)
+    p = np.asarray(p, float).reshape(-1, 3)
+    R = np.asarray(R, float).reshape(-1, 3, 3)
+    N = len(p)
+    dl = np.broadcast_to(np.asarray(delta, float), (N,))[:, None] + slack
+    W = p[:, None, :] + np.einsum("nij,kj->nki", R, T) - B
+    x = np.einsum("nki,ki->nk", W, u)
+    y = np.einsum("nki,ki->nk", W, v)
+    z = np.einsum("nki,ki->nk", W, n)
+    r = np.hypot(x, y)
+    dmin, dmax = np.hypot(z, r - a), np.hypot(z, r + a)
+    m1, m2 = s - dmin, dmax - s
+    ok = (m1 > dl) & (m2 > dl) & np.isfinite(theta)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        C = a[:, None] * (np.cos(theta)[..., None] * u + np.sin(theta)[..., None] * v)
+        d = W - C
+        h = np.sqrt(np.maximum((s - dmin) * (s + dmin) * (dmax - s) * (dmax + s), 0.0))
+        g = -2 * d * (b / h)[..., None]
+        hmin = np.sqrt(np.where(ok, (m1 - dl) * (s + np.maximum(dmin - dl, 0.0))
+                                * (m2 - dl) * (dmax - dl + s), np.nan))
+        L = 2 * s / hmin
+        M = (2 + 4 * a * L + 2 * a * (r + dl) * L * L) / hmin
+        ok &= np.abs(theta) + dl * L * (1 + 1e-9) < math.pi
+        M = np.where(ok, M * (1 + 1e-9) + 1e-12, np.inf)
+    return np.where(ok[..., None], g, 0.0), M

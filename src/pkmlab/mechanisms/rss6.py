@@ -51,7 +51,7 @@ from ..errors import ParameterError
 from ..poses import as_frames
 from . import _kernels
 from ._crank import crank_column_leg, crank_params
-from ._crank_cells import crank_cell_terms
+from ._crank_cells import crank_cell_terms, crank_position_curvature
 from ._set_columns import set_column_intervals
 from .base import NO_STROKE, Mechanism, as_points, as_positive, as_vector3
 from .layout import build_paired
@@ -420,6 +420,24 @@ class RSS6(Mechanism):
         spheres about the crank ends at the window edges; :mod:`._crank_cells`)."""
         theta, _, m, e = self._cell_terms(p, R, delta, alpha)
         return (theta, m, e, self._branches(len(theta))) if branch else (theta, m, e)
+
+    #: off: the second-order fractions of :mod:`pkmlab.workspaces.bracket_partial` with the
+    #: bound below narrow the bracket per cube size but cost more time than they save (the
+    #: servo platform's boundary is mostly the rod's closing limit, where ``M`` is infinite;
+    #: docs/validation.md, "Guaranteed volume bracket for rss6")
+    position_curvature = False
+
+    def leg_position_curvature(self, p, R, delta):
+        """Gradient ``g (N, 6, 3)`` of each crank angle in the position and a bound ``M (N, 6)``
+        on its second derivative over the ball ``|p' - p| <= δ`` (rotation fixed), ``inf``
+        where the rod may fail to close on the ball or the angle may wrap
+        (:func:`._crank_cells.crank_position_curvature`), in the form
+        :mod:`pkmlab.workspaces.bracket_partial` takes (not enabled: see
+        ``position_curvature``)."""
+        return crank_position_curvature(p, R, delta, self.base_points, self.tool_points,
+                                        self.zero_directions, self.v_directions,
+                                        self.servo_axes, self.crank_length, self.rod_length,
+                                        self.branch, 1e-9 + 1e-12 * self.scale)
 
     def leg_segments(self, p, R):
         """Rod end points ``(N, 6, 3)`` each: crank-end ball joint → platform ball joint."""
