@@ -7,6 +7,7 @@ brackets rss6 (it refused before)."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -49,6 +50,12 @@ def mixed():
                              rod_length=140.0, stroke=(-0.9, 1.3), branch=[1, -1] * 3)
 
 
+@pytest.fixture(scope="module")
+def full(servo):
+    """A full servo window [-π, π]: the closing limits alone decide (no window edge)."""
+    return dataclasses.replace(servo, stroke_window=(-math.pi, math.pi))
+
+
 def _cells(mech, rng, n, dmax=10.0, amax=0.1):
     pn = mech.nominal_pose[:3]
     p = pn + rng.uniform(-1, 1, (n, 3)) * [80, 80, 60]
@@ -77,7 +84,7 @@ def _closing(mech, p, R):
     return mech.rod_length - near, far - mech.rod_length
 
 
-@pytest.mark.parametrize("which", ["servo", "own", "mixed"])
+@pytest.mark.parametrize("which", ["servo", "own", "mixed", "full"])
 def test_leg_bounds_hold_on_random_cells(which, request):
     mech = request.getfixturevalue(which)
     rng = np.random.default_rng(21)
