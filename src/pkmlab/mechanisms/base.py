@@ -197,12 +197,13 @@ class Mechanism:
         raise NotImplementedError
 
     def leg_cell_margins(self, p, R, delta, alpha, branch=False):
-        """``(q, m, eps[, branch])``: the feasibility margins the cell bracket tests, ``m``
-        and ``eps`` ``(N, K)`` with ``|m' - m| <= eps`` over the cell; a leg is feasible
-        where all its margins are >= 0, so the item is certainly in when every ``m > eps``,
-        certainly out when some ``m < -eps``. Default (K = 6): ``min(q - qmin, qmax - q)``
-        from :meth:`leg_cell_bounds` (1-Lipschitz in q, so the same eps); rss6 adds the
-        rod's closing margins (:mod:`._crank_cells`)."""
+        """``(q, m, eps[, branch])``: the margins the cell bracket tests, ``m`` and ``eps``
+        ``(N, K)`` such that ``m > eps`` proves that condition feasible at every point of the
+        cell and ``m < -eps`` proves it infeasible (the item is certainly in when every
+        ``m > eps``, certainly out when some ``m < -eps``). Default (K = 6):
+        ``min(q - qmin, qmax - q)`` from :meth:`leg_cell_bounds` (1-Lipschitz in q, so
+        ``|m' - m| <= eps`` with the same eps); rss6: a signed lower bound of the distance
+        to the other status, which also covers the rod's closing (:mod:`._crank_cells`)."""
         out = self.leg_cell_bounds(p, R, delta, alpha, branch)
         lo, hi = self.stroke
         with np.errstate(invalid="ignore"):

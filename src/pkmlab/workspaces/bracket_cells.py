@@ -1,6 +1,6 @@
 """A guaranteed volume bracket on position cells × orientation cells, for families without
-column kernels whose legs are bounded over a cell (``cell_bounds``: luzi3; rss6, whose legs
-have two more margins, the rod's closing, through ``leg_cell_margins``).
+column kernels whose legs are bounded over a cell (``cell_bounds``: luzi3; rss6, whose rods
+may also fail to close, through the margins of its ``leg_cell_margins``).
 
 **Cells.** Positions are covered by axis-aligned cubes on a grid anchored at the origin (edge
 ``resolution·2^k``; the first edge is the smallest such that the search box is at most 32
@@ -9,7 +9,8 @@ a (cube, orientation cell) pair. The family's ``leg_cell_bounds(p, R, δ, α)`` 
 value ``q`` at the item's centre and ``ε`` with ``|q' - q| <= ε`` for every position within
 ``δ`` (the cube's half-diagonal) and rotation within α; with α = 0 it bounds the cube at the
 centre rotation alone (a *sample*, a rotation that belongs to the set). With ``m = min(q -
-qmin, qmax - q)`` per leg:
+qmin, qmax - q)`` per leg (or the family's ``leg_cell_margins``: ``m > ε`` proves the leg
+feasible on the item, ``m < -ε`` infeasible):
 
 * item *in*: every leg has ``m > ε`` (feasible at every point and rotation of the item);
   item *out*: some leg has ``m < -ε``; the same at α = 0 for the sample.
