@@ -18,6 +18,7 @@ from pkmlab import load_mechanism
 from pkmlab.cli import app
 from pkmlab.errors import ParameterError
 from pkmlab.mechanisms._kernels import make_leg_eval
+from pkmlab.mechanisms.sixleg import SixLeg
 from pkmlab.mechanisms.ups6 import working_sides
 from pkmlab.study import evaluators as ev_mod
 from pkmlab.study import load_study
@@ -309,9 +310,11 @@ def test_time_budget_is_honoured_within_its_tolerance(psu):
 
 
 def test_bracket_refuses_what_it_cannot_guarantee(psu):
-    rss = load_mechanism(MECH_DIR / "instructables-servo-6rss.yaml")
+    # rss6 is bracketed on cells (tests/test_bracket_rss6.py); its generic sixleg declaration
+    # (crank columns, not radial, no cell bounds) is still refused
+    six = SixLeg.from_mechanism(load_mechanism(MECH_DIR / "instructables-servo-6rss.yaml"))
     with pytest.raises(ParameterError, match="bracket"):
-        volume_bracket(rss, "constant")
+        volume_bracket(six, "constant")
     with pytest.raises(ParameterError, match="constraints"):
         volume_bracket(psu, "constant", constraints=Constraints(kappa_max=50.0))
 

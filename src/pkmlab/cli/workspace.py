@@ -138,7 +138,8 @@ def workspace(
     = False,
     bracket: Annotated[bool, typer.Option(
         "--bracket", help="also bracket the volume over the continuous orientation set and "
-                          "x-y plane: guaranteed [lower, upper] (psu6, ups6; stroke only)")]
+                          "positions: guaranteed [lower, upper] (psu6, ups6; luzi3, rss6 on "
+                          "position x orientation cells; stroke only)")]
     = False,
     bracket_budget: Annotated[float, typer.Option(
         help="--bracket: wall-time budget in s, counted after loading the kernels (the "

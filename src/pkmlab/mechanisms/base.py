@@ -25,7 +25,8 @@ method whose name starts with ``_``):
   giving their closed form for the guaranteed volume bracket, :mod:`pkmlab.workspaces.bracket`);
   families without column kernels may set ``cell_bounds`` and give ``leg_cell_bounds(p, R,
   delta, alpha)`` (each leg's length and a bound on its change over a position ball × rotation
-  cell) for the cell bracket, :mod:`pkmlab.workspaces.bracket_cells`;
+  cell; ``leg_cell_margins`` when feasibility needs more than the window, rss6) for the cell
+  bracket, :mod:`pkmlab.workspaces.bracket_cells`;
 * equality and hashing by geometry (two mechanisms with the same family, joints, stroke, tool
   offset and nominal pose are equal, whatever their names).
 
@@ -194,6 +195,20 @@ class Mechanism:
         chain: +1 where the whole cell is in the working mode, -1 where none of it is, 0
         where undecided; luzi3: see its docstring."""
         raise NotImplementedError
+
+    def leg_cell_margins(self, p, R, delta, alpha, mode=False):
+        """``(q, m, eps[, mode])``: the margins the cell bracket tests, ``m`` and ``eps``
+        ``(N, K)`` such that ``m > eps`` proves that condition feasible at every point of the
+        cell and ``m < -eps`` proves it infeasible (the item is certainly in when every
+        ``m > eps``, certainly out when some ``m < -eps``). Default (K = 6):
+        ``min(q - qmin, qmax - q)`` from :meth:`leg_cell_bounds` (1-Lipschitz in q, so
+        ``|m' - m| <= eps`` with the same eps); rss6: a signed lower bound of the distance
+        to the other status, which also covers the rod's closing (:mod:`._crank_cells`)."""
+        out = self.leg_cell_bounds(p, R, delta, alpha, mode)
+        lo, hi = self.stroke
+        with np.errstate(invalid="ignore"):
+            m = np.minimum(out[0] - lo, hi - out[0])
+        return (out[0], m, *out[1:])
 
     def column_params(self) -> np.ndarray:  # pragma: no cover - optional
         """``(6, 3)`` per-leg parameters of ``column_leg``."""

@@ -51,6 +51,7 @@ from ..errors import ParameterError
 from ..poses import as_frames
 from . import _kernels
 from ._crank import crank_column_leg, crank_params
+from ._crank_cells import crank_cell_terms, crank_position_curvature
 from ._set_columns import set_column_intervals
 from .base import NO_STROKE, Mechanism, as_points, as_positive, as_vector3
 from .layout import build_paired
@@ -391,6 +392,55 @@ class RSS6(Mechanism):
         W = self.leg_offsets(R)
         reach = (self.crank_length + self.rod_length)[:, None]
         return np.stack([(-W - reach).max(axis=1), (-W + reach).min(axis=1)], axis=1)
+
+    # ---- cell volume bracket (pkmlab.workspaces.bracket_cells) -----------------------------
+    cell_bounds = True
+
+    def _cell_terms(self, p, R, delta, alpha):
+        return crank_cell_terms(p, R, delta, alpha, self.base_points, self.tool_points,
+                                self.zero_directions, self.v_directions, self.servo_axes,
+                                self.crank_length, self.rod_length, self.branch, self.stroke,
+                                1e-9 + 1e-12 * self.scale)
+
+    @staticmethod
+    def _in_mode(n):
+        """The working-mode flags of the cell protocol: +1 for every leg (the inverse
+        kinematics takes each leg's declared branch, so no pose is outside the mode)."""
+        return np.ones((n, 6), np.int8)
+
+    def leg_cell_bounds(self, p, R, delta, alpha, mode: bool = False):
+        """Crank angles at ``(p, R)`` (NaN where the rod does not close) and a bound on their
+        change over the cell ``|p' - p| <= δ``, ``angle(R'Rᵀ) <= α``: ``2s·εP/h_min`` where
+        the rod closes on the whole cell, ``inf`` elsewhere (:mod:`._crank_cells`). With
+        ``mode``, also the working-mode flags (+1: each leg keeps its declared branch)."""
+        theta, et, _, _ = self._cell_terms(p, R, delta, alpha)
+        return (theta, et, self._in_mode(len(theta))) if mode else (theta, et)
+
+    def leg_cell_margins(self, p, R, delta, alpha, mode: bool = False):
+        """``(θ, μ, ε[, mode])``, ``(N, 6)``: per leg a margin that proves it feasible
+        on the whole cell where ``μ > ε`` and infeasible where ``μ < -ε`` (a signed lower
+        bound of the distance to the other status, from the rod's closing limits and the
+        spheres about the crank ends at the window edges; :mod:`._crank_cells`)."""
+        theta, _, m, e = self._cell_terms(p, R, delta, alpha)
+        return (theta, m, e, self._in_mode(len(theta))) if mode else (theta, m, e)
+
+    #: off: the second-order fractions of :mod:`pkmlab.workspaces.bracket_partial` with the
+    #: bound below narrow the bracket per cube size but cost more time than they save (the
+    #: servo platform's boundary is mostly the rod's closing limit, where ``M`` is infinite;
+    #: docs/validation.md, "Guaranteed volume bracket for rss6")
+    position_curvature = False
+
+    def leg_position_curvature(self, p, R, delta):
+        """Gradient ``g (N, 6, 3)`` of each crank angle in the position and a bound ``M (N, 6)``
+        on its second derivative over the ball ``|p' - p| <= δ`` (rotation fixed), ``inf``
+        where the rod may fail to close on the ball or the angle may wrap
+        (:func:`._crank_cells.crank_position_curvature`), in the form
+        :mod:`pkmlab.workspaces.bracket_partial` takes (not enabled: see
+        ``position_curvature``)."""
+        return crank_position_curvature(p, R, delta, self.base_points, self.tool_points,
+                                        self.zero_directions, self.v_directions,
+                                        self.servo_axes, self.crank_length, self.rod_length,
+                                        self.branch, 1e-9 + 1e-12 * self.scale)
 
     def leg_segments(self, p, R):
         """Rod end points ``(N, 6, 3)`` each: crank-end ball joint → platform ball joint."""

@@ -83,8 +83,8 @@ _ALL = [
     # guaranteed volume bracket (evaluate.volume_bracket)
     Metric("workspace_volume_lower", "volume_bracket", "cm³", "guaranteed",
            "proven lower bound of the requested workspace's volume over the continuous "
-           "orientation set and positions (stroke and connectivity; psu6, ups6, luzi3): the "
-           "one to maximise"),
+           "orientation set and positions (stroke and connectivity; psu6, ups6, luzi3, rss6): "
+           "the one to maximise"),
     Metric("workspace_volume_upper", "volume_bracket", "cm³", "guaranteed",
            "proven upper bound of the same volume: the one to constrain from above"),
     Metric("workspace_volume_bracket_width", "volume_bracket", "%", "guaranteed",

@@ -75,8 +75,9 @@ set the nominal position is certainly not in the workspace, the engine keeps the
 (lower 0, upper the whole outer set), with a note.
 
 Only the actuator stroke (and connectivity) are bracketed; other constraints are refused.
-Families without column kernels that bound their legs over cells (``cell_bounds``: luzi3)
-are bracketed on position × orientation cells instead (:mod:`.bracket_cells`).
+Families that bound their legs over cells (``cell_bounds``: luzi3, and rss6, whose crank
+column sets are not radial) are bracketed on position × orientation cells instead
+(:mod:`.bracket_cells`).
 """
 
 from __future__ import annotations
@@ -112,7 +113,7 @@ def _request(mech, kind, orientations, resolution, constraints):
     check_request(kind, resolution)
     if not mech.cell_bounds and (not mech.column_radial or mech.column_method is None):
         raise ParameterError("bracket", "a family with radial column kernels (psu6, ups6) or "
-                             f"cell leg bounds (luzi3); family {mech.family!r} has neither",
+                             f"cell leg bounds (luzi3, rss6); family {mech.family!r} has neither",
                              mech.family)
     cons = constraints or Constraints()
     if cons.extra:

@@ -1,5 +1,6 @@
 """A guaranteed volume bracket on position cells × orientation cells, for families without
-column kernels whose legs are bounded over a cell (``cell_bounds``: luzi3).
+column kernels whose legs are bounded over a cell (``cell_bounds``: luzi3; rss6, whose rods
+may also fail to close, through the margins of its ``leg_cell_margins``).
 
 **Cells.** Positions are covered by axis-aligned cubes on a grid anchored at the origin (edge
 ``resolution·2^k``; the first edge is the smallest such that the search box is at most 32
@@ -8,7 +9,8 @@ a (cube, orientation cell) pair. The family's ``leg_cell_bounds(p, R, δ, α)`` 
 value ``q`` at the item's centre and ``ε`` with ``|q' - q| <= ε`` for every position within
 ``δ`` (the cube's half-diagonal) and rotation within α; with α = 0 it bounds the cube at the
 centre rotation alone (a *sample*, a rotation that belongs to the set). With ``m = min(q -
-qmin, qmax - q)`` per leg:
+qmin, qmax - q)`` per leg (or the family's ``leg_cell_margins``: ``m > ε`` proves the leg
+feasible on the item, ``m < -ε`` infeasible):
 
 * item *in*: every leg has ``m > ε`` and the family says the whole item is in its working
   mode (``leg_cell_bounds(..., mode=True)``: luzi3, every upper link on its working branch),
@@ -149,32 +151,32 @@ def _corners(C0, H0):
 
 
 def _evaluate(mech, oset, P, hP, pid, Oc, Oh):
-    """Per item: ``(q (K, 6), margin (K, 6), eps over the item, eps of the sample, working
-    mode over the item (K,), working mode of the sample (K,))``, the modes +1 (certainly in
-    it), -1 (certainly not) or 0 (undecided), the least of the chains'."""
-    lo_q, hi_q = mech.stroke
+    """Per item: ``(q (K, 6), margins (K, M), eps over the item, eps of the sample, working
+    mode over the item (K,), working mode of the sample (K,))``: the margins of the family's
+    ``leg_cell_margins`` (M = 6, ``min(q - qmin, qmax - q)``, unless the family says
+    otherwise); the modes +1 (certainly in it), -1 (certainly not) or 0 (undecided), the least
+    of the chains'."""
     K = len(pid)
-    m, qq = np.empty((K, 6)), np.empty((K, 6))
-    w_cell, w_s = np.empty(K, np.int8), np.empty(K, np.int8)
-    e_cell, e_s = np.empty((K, 6)), np.empty((K, 6))
     rotating = bool(np.any(Oh > 0))
+    out: list[list] = [[] for _ in range(6)]
     for s in range(0, K, _BATCH):
         sl = slice(s, s + _BATCH)
         p, R = P[pid[sl]], oset.rotations_at(Oc[sl])
         delta = math.sqrt(3.0) * hP[pid[sl]]
-        q, e_s[sl], b = mech.leg_cell_bounds(p, R, delta, 0.0, mode=True)
-        w_s[sl] = b.min(axis=1)
+        q, ms, es, b = mech.leg_cell_margins(p, R, delta, 0.0, mode=True)
+        ws = b.min(axis=1)
         if rotating:
-            _, e_cell[sl], b = mech.leg_cell_bounds(p, R, delta,
-                                                    oc.angle_bound(oset, Oc[sl], Oh[sl]),
-                                                    mode=True)
-            w_cell[sl] = b.min(axis=1)
+            _, _, ec, bc = mech.leg_cell_margins(p, R, delta,
+                                                 oc.angle_bound(oset, Oc[sl], Oh[sl]), mode=True)
+            wc = bc.min(axis=1)
         else:
-            e_cell[sl], w_cell[sl] = e_s[sl], w_s[sl]
-        qq[sl] = q
-        with np.errstate(invalid="ignore"):
-            m[sl] = np.minimum(q - lo_q, hi_q - q)
-    return qq, m, e_cell, e_s, w_cell, w_s
+            ec, wc = es, ws
+        for acc, x in zip(out, (q, ms, ec, es, wc, ws)):
+            acc.append(x)
+    if K == 0:
+        return (*(np.zeros((0, 6)) for _ in range(4)), np.zeros(0, np.int8),
+                np.zeros(0, np.int8))
+    return tuple(np.concatenate(x) for x in out)
 
 
 def cell_volume_bracket(mech, kind, oset, resolution, cons, target, budget_s,
