@@ -537,6 +537,31 @@ def test_kill_9_leaves_no_workers_and_resume_finishes(capsys, tmp_path, when):
         assert code == 0, err
 
 
+def test_ctrl_c_after_the_report_is_not_a_signal_death(tmp_path):
+    """Ctrl-C pressed again and again once the report is written, while the interpreter
+    shuts down (its module teardown takes about half a second): the run ends with its own
+    status (0, everything written) or 130 with one "interrupted", never killed by the signal
+    (status -2 before)."""
+    p = small_study(tmp_path, optimizer={"method": "sobol", "samples": 8})
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    proc = subprocess.Popen([sys.executable, "-m", "pkmlab.cli", "run", str(p)], env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    lines = []
+    for line in proc.stderr:
+        lines.append(line)
+        if "report.html written" in line:
+            break
+    while proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+        time.sleep(0.05)
+    lines += proc.stderr.readlines()
+    err = "".join(lines)
+    assert proc.returncode in (0, 130), err
+    assert "Traceback" not in err
+    assert (error_lines(err) == ["interrupted"]) == (proc.returncode == 130), err
+    assert (tmp_path / "out" / "report.html").exists()
+
+
 @pytest.mark.parametrize("when", ["mid", "late"])
 def test_ctrl_c_stops_the_run_cleanly_and_resume_finishes(capsys, tmp_path, when):
     """Ctrl-C while evaluating (mid) and once every evaluation is stored, while the designs

@@ -13,6 +13,9 @@ and exit with status 2.
 
 from __future__ import annotations
 
+import atexit
+import os
+import signal
 import sys
 from typing import Annotated
 
@@ -25,6 +28,7 @@ __all__ = ["app", "main"]
 
 
 _DEBUG = {"on": False}
+_INTERRUPTED = {"said": False}         # "interrupted" already written
 
 
 def _version(value: bool) -> None:
@@ -50,16 +54,23 @@ def _root(
 def main() -> None:
     """Console entry point: input errors exit 2 (one line); a file-system error exits 2 with
     its path; a candidate's programming error exits 1 with its traceback and parameters; any
-    other unexpected error exits 1 with one line (``--debug``: the traceback)."""
+    other unexpected error exits 1 with one line (``--debug``: the traceback); Ctrl-C exits
+    130 with "interrupted", also while the interpreter shuts down afterwards (for that, the
+    process's SIGINT handling is left replaced: this is the program's entry, not a library
+    call)."""
     import sqlite3
 
     from ..errors import CandidateError, NumericalError, ParameterError
     from ..yamlio import locate_error
 
+    # registered first, so it runs after every other exit handler: the module teardown that
+    # follows (freeing compiled kernels, about half a second) cannot be interrupted halfway
+    atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
     try:
         code = app(standalone_mode=False)      # click returns an Exit's code in this mode
         if code == 130:                        # typer turns Ctrl-C into Exit(130), silently
             sys.stderr.write("interrupted\n")
+            _INTERRUPTED["said"] = True
         raise SystemExit(code if isinstance(code, int) else 0)
     except typer.Exit as exc:
         raise SystemExit(exc.exit_code) from None
@@ -71,6 +82,7 @@ def main() -> None:
         raise SystemExit(2) from None
     except (typer.Abort, KeyboardInterrupt):
         sys.stderr.write("interrupted\n")
+        _INTERRUPTED["said"] = True
         raise SystemExit(130) from None
     except CandidateError as exc:
         sys.stderr.write(f"error: {exc}\n")
@@ -102,3 +114,19 @@ def main() -> None:
         sys.stderr.write(f"error: {type(exc).__name__}: {exc} (this is a bug in pkmlab; run "
                          "with --debug for the traceback)\n")
         raise SystemExit(1) from None
+    finally:
+        # the command is over; a Ctrl-C while the interpreter shuts down (joining worker
+        # pools, a second or more after a study's report) ends it at once with status 130
+        # instead of a signal death or a traceback from a library's exit handler
+        signal.signal(signal.SIGINT, _interrupted_at_exit)
+
+
+def _interrupted_at_exit(signum, frame) -> None:
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    if not _INTERRUPTED["said"]:
+        os.write(2, b"interrupted\n")
+    os._exit(130)
