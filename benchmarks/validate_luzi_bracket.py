@@ -30,6 +30,7 @@ from scipy.spatial.transform import Rotation
 from pkmlab import load_mechanism
 from pkmlab.mechanisms import NO_STROKE
 from pkmlab.mechanisms.luzi3 import Luzi3
+from pkmlab.testing import cell_points
 from pkmlab.workspaces import OrientationSet, workspace
 from pkmlab.workspaces.bracket import volume_bracket
 
@@ -55,21 +56,13 @@ def bound_check(mech, n=200_000, seed=0):
     R = Rotation.from_rotvec(rng.normal(size=(n, 3)) * 0.3).as_matrix()
     delta, alpha = rng.uniform(0, 60, n), rng.uniform(0, 0.3, n)
     q, eps = mech.leg_cell_bounds(p, R, delta, alpha)
-    edge = rng.uniform(size=n) < 0.5
-    u = rng.normal(size=(n, 3))
-    u /= np.linalg.norm(u, axis=1, keepdims=True)
-    rad = np.where(edge, 1.0, rng.uniform(size=n) ** (1 / 3)) * delta
-    ax = rng.normal(size=(n, 3))
-    ax /= np.linalg.norm(ax, axis=1, keepdims=True)
-    ang = np.where(edge, 1.0, rng.uniform(size=n)) * alpha
-    p2 = p + u * rad[:, None]
-    R2 = Rotation.from_rotvec(ax * ang[:, None]).as_matrix() @ R
+    p2, R2, dp = cell_points(rng, p, R, delta, alpha, ball=True)
+    rad = np.linalg.norm(dp, axis=1)
     q2 = mech.inverse((p2, R2), stroke=NO_STROKE).q
     fin = np.isfinite(eps) & np.isfinite(q2)     # (every bound is finite; the fallback
     ratio = np.abs(q2 - q)[fin] / eps[fin]      # |C - A| ± (εC + l/2) where the link may flip)
     # second order in the position (rotation fixed): |q(p + dp) - q - g·dp| <= M |dp|² / 2
     g, M = mech.leg_position_curvature(p, R, delta)
-    dp = u * rad[:, None]
     q3 = mech.inverse((p + dp, R), stroke=NO_STROKE).q
     q0 = mech.inverse((p, R), stroke=NO_STROKE).q
     rem = np.abs(q3 - q0 - np.einsum("nkj,nj->nk", g, dp))

@@ -35,6 +35,7 @@ from scipy.spatial.transform import Rotation
 from pkmlab import load_mechanism
 from pkmlab.mechanisms import NO_STROKE
 from pkmlab.mechanisms.rss6 import RSS6
+from pkmlab.testing import cell_points
 from pkmlab.workspaces import OrientationSet, workspace
 from pkmlab.workspaces.bracket import volume_bracket
 
@@ -59,14 +60,7 @@ def bound_check(mech, n=200_000, seed=0):
     p = mech.nominal_pose[:3] + rng.uniform(-1, 1, (n, 3)) * [80, 80, 60]
     R = Rotation.from_rotvec(rng.normal(size=(n, 3)) * 0.25).as_matrix()
     delta, alpha = rng.uniform(0, 10, n), rng.uniform(0, 0.1, n)
-    edge = rng.uniform(size=n) < 0.5
-    u = rng.normal(size=(n, 3))
-    u /= np.linalg.norm(u, axis=1, keepdims=True)
-    ax = rng.normal(size=(n, 3))
-    ax /= np.linalg.norm(ax, axis=1, keepdims=True)
-    p2 = p + u * (np.where(edge, 1.0, rng.uniform(size=n) ** (1 / 3)) * delta)[:, None]
-    R2 = Rotation.from_rotvec(ax * (np.where(edge, 1.0, rng.uniform(size=n))
-                                    * alpha)[:, None]).as_matrix() @ R
+    p2, R2, _ = cell_points(rng, p, R, delta, alpha, ball=True)
     theta, et = mech.leg_cell_bounds(p, R, delta, alpha)
     _, mu, eps = mech.leg_cell_margins(p, R, delta, alpha)
     ik, ik2 = (mech.inverse(x, stroke=NO_STROKE) for x in ((p, R), (p2, R2)))

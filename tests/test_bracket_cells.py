@@ -17,6 +17,7 @@ from typer.testing import CliRunner
 from pkmlab import load_mechanism
 from pkmlab.cli import app
 from pkmlab.mechanisms import NO_STROKE
+from pkmlab.testing import cell_points
 from pkmlab.workspaces import OrientationSet, workspace
 from pkmlab.workspaces.bracket import volume_bracket
 from pkmlab.workspaces.bracket_cells import touching_components
@@ -45,14 +46,7 @@ def test_leg_bound_holds_on_random_cells(luzi):
     q, eps = luzi.leg_cell_bounds(p, R, delta, alpha)
     ik = luzi.inverse((p, R), stroke=NO_STROKE).q
     centred = np.isclose(q, ik, rtol=0, atol=1e-9)   # elsewhere the link may flip in the cell
-    u = rng.normal(size=(n, 3))
-    u /= np.linalg.norm(u, axis=1, keepdims=True)
-    ax = rng.normal(size=(n, 3))
-    ax /= np.linalg.norm(ax, axis=1, keepdims=True)
-    edge = rng.uniform(size=n) < 0.5            # half on the cell's boundary
-    p2 = p + u * (np.where(edge, 1.0, rng.uniform(size=n)) * delta)[:, None]
-    R2 = Rotation.from_rotvec(ax * (np.where(edge, 1.0, rng.uniform(size=n))
-                                    * alpha)[:, None]).as_matrix() @ R
+    p2, R2, _ = cell_points(rng, p, R, delta, alpha)    # half on the cell's boundary
     q2 = luzi.inverse((p2, R2), stroke=NO_STROKE).q
     fin = np.isfinite(q2)                       # the link is defined at the point
     assert centred.mean() > 0.9 and not centred.all() and np.all(np.isfinite(eps))

@@ -21,6 +21,7 @@ from pkmlab import load_mechanism
 from pkmlab.cli import app
 from pkmlab.mechanisms import NO_STROKE
 from pkmlab.mechanisms.rss6 import RSS6
+from pkmlab.testing import cell_points
 from pkmlab.workspaces import OrientationSet, workspace
 from pkmlab.workspaces.bracket import volume_bracket
 
@@ -61,14 +62,7 @@ def _cells(mech, rng, n, dmax=10.0, amax=0.1):
     p = pn + rng.uniform(-1, 1, (n, 3)) * [80, 80, 60]
     R = Rotation.from_rotvec(rng.normal(size=(n, 3)) * 0.25).as_matrix()
     delta, alpha = rng.uniform(0, dmax, n), rng.uniform(0, amax, n)
-    u = rng.normal(size=(n, 3))
-    u /= np.linalg.norm(u, axis=1, keepdims=True)
-    ax = rng.normal(size=(n, 3))
-    ax /= np.linalg.norm(ax, axis=1, keepdims=True)
-    edge = rng.uniform(size=n) < 0.5            # half on the cell's boundary
-    p2 = p + u * (np.where(edge, 1.0, rng.uniform(size=n)) * delta)[:, None]
-    R2 = Rotation.from_rotvec(ax * (np.where(edge, 1.0, rng.uniform(size=n))
-                                    * alpha)[:, None]).as_matrix() @ R
+    p2, R2, _ = cell_points(rng, p, R, delta, alpha)    # half on the cell's boundary
     return p, R, delta, alpha, p2, R2
 
 

@@ -15,6 +15,7 @@ from scipy.spatial.transform import Rotation
 
 from pkmlab.mechanisms import LEG_STATUS, NO_STROKE, Luzi3
 from pkmlab.poses import as_frames, matrix_to_euler
+from pkmlab.testing import cell_points
 from pkmlab.workspaces import OrientationSet, workspace
 from pkmlab.workspaces.bracket import volume_bracket
 
@@ -116,14 +117,7 @@ def test_cell_mode_holds_on_random_cells(own):
     R = Rotation.from_rotvec(rng.normal(size=(n, 3)) * 0.2).as_matrix()
     delta, alpha = rng.uniform(0, 80, n), rng.uniform(0, 0.2, n)
     _, _, mode = own.leg_cell_bounds(p, R, delta, alpha, mode=True)
-    u = rng.normal(size=(n, 3))
-    u /= np.linalg.norm(u, axis=1, keepdims=True)
-    ax = rng.normal(size=(n, 3))
-    ax /= np.linalg.norm(ax, axis=1, keepdims=True)
-    edge = rng.uniform(size=n) < 0.5
-    p2 = p + u * (np.where(edge, 1.0, rng.uniform(size=n)) * delta)[:, None]
-    R2 = Rotation.from_rotvec(ax * (np.where(edge, 1.0, rng.uniform(size=n))
-                                    * alpha)[:, None]).as_matrix() @ R
+    p2, R2, _ = cell_points(rng, p, R, delta, alpha)
     st = own.inverse((p2, R2), stroke=NO_STROKE).leg_status[:, 0::2]       # one leg a chain
     other = st == OTHER
     assert not np.any(other[mode > 0]) and np.all(other[mode < 0])

@@ -236,7 +236,7 @@ def test_second_order_certification_holds_where_links_are_near_horizontal():
                       "platform_rotation": "27.8 deg", "pairing": "same"},
         "stroke": ["0 mm", "4 in"], "tool_offset": ["0 mm", "0 mm", "47 mm"]})
     b = orientation_capability(mech, 5)
-    assert 44.0 <= b.lower <= b.upper < 44.2              # measured [44.0726, 44.1156]
+    assert 44.0 <= b.lower <= b.upper < 44.2              # measured [44.0757, 44.0850]
     th = math.radians(b.lower)
     p = np.asarray(b.point)
     assert_point_holds(mech, p, th, np.random.default_rng(11), minima=4)

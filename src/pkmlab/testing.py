@@ -20,6 +20,9 @@ The checks:
 * :func:`check_assembly_modes` — the nominal pose is the first mode and doubling the starts finds
   nothing new;
 * :func:`check_bad_shapes` — malformed pose arrays raise a named error.
+
+:func:`cell_points` draws test points inside position × orientation cells, for checking a
+family's cell bounds (``leg_cell_bounds``, ``leg_cell_margins``) against its kinematics.
 """
 
 from __future__ import annotations
@@ -31,7 +34,7 @@ from .poses import as_frames, euler_to_matrix, exp_so3, log_so3
 
 __all__ = ["random_valid_poses", "rotation_error", "check_round_trip", "check_jacobian",
            "check_batching", "check_statuses", "check_assembly_modes", "check_bad_shapes",
-           "CHECKS", "run_contract"]
+           "CHECKS", "run_contract", "cell_points"]
 
 REASON = {v: k for k, v in LEG_STATUS.items()}
 
@@ -204,3 +207,21 @@ def run_contract(mech, skip: tuple[str, ...] = ()) -> list[str]:
             raise AssertionError(f"{name}: {exc}") from exc
         done.append(name)
     return done
+
+
+def cell_points(rng, p, R, delta, alpha, *, ball: bool = False):
+    """A random point of each cell ``|p' - p| <= delta``, ``angle(R'·Rᵀ) <= alpha`` (``p (N, 3)``
+    mm, ``R (N, 3, 3)``, ``delta`` and ``alpha (N,)`` mm and rad): half of them on the cell's
+    boundary (the distance and the angle both at their ends), the others inside, with the
+    distance uniform in ``[0, δ]`` (``ball``: the point uniform in the ball). Returns
+    ``(p', R', p' - p)``."""
+    n = len(p)
+    u = rng.normal(size=(n, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    ax = rng.normal(size=(n, 3))
+    ax /= np.linalg.norm(ax, axis=1, keepdims=True)
+    edge = rng.uniform(size=n) < 0.5
+    r = rng.uniform(size=n)
+    dp = u * (np.where(edge, 1.0, r ** (1 / 3) if ball else r) * delta)[:, None]
+    ang = np.where(edge, 1.0, rng.uniform(size=n)) * alpha
+    return p + dp, exp_so3(ax * ang[:, None]) @ R, dp
