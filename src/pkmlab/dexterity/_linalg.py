@@ -309,3 +309,9 @@ KAPPA_BRACKET = 6.0 ** (1.0 / 2 ** _POWER)
 #: relative allowance for rounding in ``kup``: ``kup·(1 + KAPPA_ROUND) >= κ`` below 1e8 (above
 #: it, treat the bound as unbounded)
 KAPPA_ROUND = 1e-6
+
+
+def kappa_upper(kup: np.ndarray) -> np.ndarray:
+    """``kup`` of :func:`sweep_bounds` made safe against rounding: ``kup·(1 + KAPPA_ROUND)``,
+    and ``inf`` above 1e8, where the rounding may exceed the allowance."""
+    return np.where(kup > 1e8, np.inf, kup * (1 + KAPPA_ROUND))

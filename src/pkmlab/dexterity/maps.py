@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ._linalg import KAPPA_ROUND, sweep_bounds
+from ._linalg import kappa_upper, sweep_bounds
 from .aggregate import _CHUNK, _ik_valid, _units, _voxels, orientation_batches
 from .force import max_force_all_directions
 from .metrics import CharacteristicLength, condition_number, resolve_length
@@ -145,9 +145,9 @@ def _unit_kappa_max(mech, unit_pos, R, L) -> np.ndarray:
     """``(U,)`` the largest κ of every unit over the orientations ``R``, exact.
 
     Every pose gets the certified bound of :func:`._linalg.sweep_bounds` (one LU per pose,
-    ``kup >= κ`` up to ``KAPPA_ROUND``); each unit's exact κ at its largest bound is a lower
-    bound on its maximum, so only the poses whose bound reaches it need the exact κ (singular
-    values): on the demo designs about a fifth of them."""
+    made safe against rounding by :func:`._linalg.kappa_upper`); each unit's exact κ at its
+    largest bound is a lower bound on its maximum, so only the poses whose bound reaches it
+    need the exact κ (singular values): on the demo designs about a fifth of them."""
     U, M = len(unit_pos), len(R)
     if U == 0 or M == 0:
         return np.full(U, -np.inf)
@@ -162,7 +162,7 @@ def _unit_kappa_max(mech, unit_pos, R, L) -> np.ndarray:
         kup, force, det = (np.empty(n * U) for _ in range(3))
         sweep_bounds(J, L, ones, kup, force, det)
         up[m0:m0 + n] = kup.reshape(n, U)
-    up = np.where(up > 1e8, np.inf, up * (1 + KAPPA_ROUND))
+    up = kappa_upper(up)
     kmax = condition_number(mech.jacobian((unit_pos, R[np.argmax(up, axis=0)])), L)
     cand = np.argwhere(up >= kmax)                   # (orientation, unit)
     for b0 in range(0, len(cand), _CHUNK):

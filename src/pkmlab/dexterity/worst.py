@@ -50,7 +50,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..poses import matrix_to_euler
-from ._linalg import KAPPA_BRACKET, KAPPA_ROUND, sweep_bounds
+from ._linalg import KAPPA_BRACKET, KAPPA_ROUND, kappa_upper, sweep_bounds
 from .aggregate import _CHUNK, _ik_valid, _units, _voxels
 from .force import _fmax, max_force_all_directions
 from .metrics import KAPPA_SINGULAR, CharacteristicLength, condition_number, resolve_length
@@ -309,8 +309,7 @@ def worst_case(mech, result, L: float | CharacteristicLength | None = None,
         kup = np.where(fe, kup, -np.inf)
         force = np.where(fe, force, np.inf)
         det = np.where(fe, det, 0.0)
-        # rounding allowance of the bound; above 1e8 it may exceed it: treat as unbounded
-        up = np.where(kup > 1e8, np.inf, kup * (1 + _ROUND))
+        up = kappa_upper(kup)
         fin = np.isfinite(up)
         if fin.any():
             lower = max(lower, float(up[fin].max()) / KAPPA_BRACKET / (1 + _ROUND) ** 2)
