@@ -17,7 +17,7 @@ import pytest
 import yaml
 from conftest import MECH_DIR
 
-from pkmlab.cli import main
+from pkmlab.cli import run_cli
 from pkmlab.study import SerialRunner, load_study, run_study
 
 HW = MECH_DIR / "hopkins-williams-6psu.yaml"
@@ -33,7 +33,7 @@ def cli(capsys, *args, env: dict | None = None, monkeypatch=None) -> tuple[int, 
     old = sys.argv
     sys.argv = ["pkmlab", *map(str, args)]
     try:
-        main()
+        run_cli()
         code = 0
     except SystemExit as exc:
         code = exc.code
