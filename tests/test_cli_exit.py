@@ -12,6 +12,7 @@ import pytest
 
 _SCRIPT = """
 import atexit, sys, threading, time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from pkmlab.cli import main
 
@@ -26,6 +27,8 @@ def late():
     time.sleep(0.3)
     flag.write_text("thread finished")
 threading.Thread(target=late).start()
+pool = ThreadPoolExecutor(1)          # never shut down: its exit hook stops its thread
+pool.submit(time.sleep, 0.1)
 sys.stdout.write("x" * 200000)        # still buffered when the command ends
 sys.argv = ["pkmlab"] + sys.argv[2:]
 main()
