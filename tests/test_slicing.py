@@ -14,7 +14,13 @@ from pkmlab.cli import app
 from pkmlab.config import workspace_spec
 from pkmlab.errors import ParameterError
 from pkmlab.workspaces.mesh import STL_HEADER
-from pkmlab.workspaces.plots import overlay_figure, slice_figure
+from pkmlab.workspaces.plots import (
+    SlicePicture,
+    overlay_figure,
+    png_bytes,
+    slice_figure,
+    write_slice_pictures,
+)
 from pkmlab.workspaces.slicing import MAX_PANELS, nice_ceil, slice_layout
 
 HOPKINS = MECH_DIR / "hopkins-williams-6psu.yaml"
@@ -144,3 +150,29 @@ def test_metric_slices_are_not_washed_out_by_a_few_near_singular_voxels(small):
     assert lo < 5.1 and hi < 10 and extend == "max"
     fig = slice_figure(small, values=values, label="κ")
     assert "percentile" in fig.axes[-1].get_ylabel()
+
+
+def test_slice_pictures_drawn_on_one_grid_equal_separate_figures(small, tmp_path):
+    """``write_slice_pictures`` builds the panel grid once for several colourings (the export's
+    plain sections and κ map); every picture must be pixel for pixel the figure
+    ``slice_figure`` draws alone, in any order (a colour bar removed gives the panels their
+    places back), with the task overlay on top."""
+    import matplotlib.image as mpimg
+
+    rng = np.random.default_rng(3)
+    k1 = rng.random(small.occupancy.shape) * 10
+    k1[small.occupancy.nonzero()[0][0], :, :] = 900         # a few extremes: capped bar
+    k2 = rng.random(small.occupancy.shape)
+    square = np.array([[0.0, 0.0], [20.0, 0.0], [20.0, 20.0], [0.0, 0.0]])
+    grid = {"overlay": lambda z: [square], "overlay_label": "task"}
+    pics = [SlicePicture(tmp_path / "a.png"), SlicePicture(tmp_path / "b.png", k1, "κ", 110),
+            SlicePicture(tmp_path / "c.png"), SlicePicture(tmp_path / "d.png", k2, "LCI")]
+    assert write_slice_pictures(small, pics, **grid) == [p.path for p in pics]
+    for p in pics:
+        alone = tmp_path / f"alone-{p.path.name}"
+        alone.write_bytes(png_bytes(slice_figure(small, values=p.values, label=p.label,
+                                                 **grid), p.dpi))
+        a, b = mpimg.imread(p.path), mpimg.imread(alone)
+        assert a.shape == b.shape and np.array_equal(a, b), p.path.name
+    assert not np.array_equal(mpimg.imread(pics[0].path), mpimg.imread(pics[2].path)[::-1])
+    assert mpimg.imread(pics[1].path).shape != mpimg.imread(pics[0].path).shape   # 110 dpi

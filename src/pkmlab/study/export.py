@@ -139,7 +139,7 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
     from ..dexterity.maps import METRICS as MAPS
     from ..dexterity.maps import drawn_voxels, mesh_colours, metric_map, vertex_values
     from ..workspaces import workspace
-    from ..workspaces.plots import slice_figure
+    from ..workspaces.plots import SlicePicture, write_slice_pictures
     from ..workspaces.slicing import slice_layout
 
     d.mkdir(parents=True, exist_ok=True)
@@ -181,9 +181,7 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
                                       "z_range_mm", "centroid_mm", "resolution_mm", "empty",
                                       "method")}
         info["slice_layout"] = lay.as_dict()
-        step("slices")
-        res.plot_slices(d / "slices.png", **opts, **overlay)
-        files.append("slices.png")
+        pictures, first = [SlicePicture(d / "slices.png")], None
         if overlay:
             cut = [z for z in lay.levels if overlay["overlay"](z)]
             info["task_slices_mm"] = cut or ("the task lies between the slices: none "
@@ -222,16 +220,13 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
             info["vertex_values"] = {n: {"label": MAPS[n][0], "unit": MAPS[n][1]}
                                      for n in values}
             if first is not None:
-                step(f"{first.metric} slices")
-                fig = slice_figure(res, values=np.where(np.isfinite(first.grid), first.grid,
-                                                        np.nan),
-                                   label=f"{first.label}, L = {L:.4g} mm", **opts,
-                                   **overlay)
-                name = f"{first.metric}_slices.png"
-                buf = io.BytesIO()
-                fig.savefig(buf, format="png", dpi=110)
-                atomic.write_bytes(d / name, buf.getvalue())
-                files.append(name)
+                pictures.append(SlicePicture(d / f"{first.metric}_slices.png",
+                                             np.where(np.isfinite(first.grid), first.grid,
+                                                      np.nan),
+                                             f"{first.label}, L = {L:.4g} mm", 110))
+        step("slices" + (f" and {first.metric} slices" if first is not None else ""))
+        write_slice_pictures(res, pictures, **opts, **overlay)
+        files += [pic.path.name for pic in pictures]
     atomic.write_text(d / "design.json", json.dumps(_plain(info), indent=2) + "\n")
     return info
 

@@ -11,13 +11,26 @@ from __future__ import annotations
 import io
 import math
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from ..atomic import write_bytes
 from .slicing import MAX_PANELS, slice_layout
 
-__all__ = ["plot_slices", "slice_figure", "overlay_figure"]
+__all__ = ["SlicePicture", "overlay_figure", "plot_slices", "png_bytes", "slice_figure",
+           "write_slice_pictures"]
+
+
+class SlicePicture(NamedTuple):
+    """One picture of :func:`write_slice_pictures`: ``values (nx, ny, nz)`` colours the
+    sections (``None``: plain grey sections), named ``label`` on the colour bar; written as
+    PNG at ``dpi``."""
+
+    path: Path
+    values: np.ndarray | None = None
+    label: str = ""
+    dpi: int = 120
 
 
 def slice_figure(result, window: float | None = None, spacing: float | None = None,
@@ -33,62 +46,119 @@ def slice_figure(result, window: float | None = None, spacing: float | None = No
     ``layout`` (``"auto"`` or ``"paper"``), ``window``, ``spacing``, ``centre`` and
     ``max_panels`` choose the sections (:func:`.slicing.slice_layout`; ``None``: the
     layout's)."""
+    sections = _Sections(result, window, spacing, centre, columns, layout, max_panels,
+                         overlay, overlay_label)
+    sections.paint(values, cmap, label)
+    return sections.fig
 
-    lay = slice_layout(result, layout, window, spacing, centre, max_panels)
-    levels, window, spacing = lay.levels, lay.window, lay.spacing
-    n = max(len(levels), 1)
-    cols = columns or int(math.ceil(math.sqrt(n)))
-    rows = int(math.ceil(n / cols))
-    cx, cy = lay.centre
-    half = window / 2
-    h = result.resolution
-    fig, axes = _panel_grid(rows, cols, 2.2, 0.8)
-    extent = (result.xs[0] - h / 2, result.xs[-1] + h / 2, result.ys[0] - h / 2,
-              result.ys[-1] + h / 2) if len(result.xs) else (0, 1, 0, 1)
-    im = None
-    if values is not None and not np.any(np.isfinite(values)):
-        values = None                     # nothing to colour: plain sections
-    if values is not None:
-        vmin, vmax, extend = _colour_range(values)
-    for a, ax in enumerate(axes.ravel()):
-        ax.set_aspect("equal")
-        ax.tick_params(labelsize=6)
-        if a >= len(levels):
-            ax.axis("off")
-            continue
-        z = levels[a]
-        sec = result.slice(z)
-        if values is None:
-            img = np.where(sec, 1.0, np.nan).T
-            ax.imshow(img, origin="lower", extent=extent, cmap="Greys", vmin=0, vmax=1.3,
-                      interpolation="nearest")
-        else:
-            k = int(np.clip(round((z - result.zs[0]) / h), 0, len(result.zs) - 1))
-            img = np.where(sec, values[:, :, k], np.nan).T
-            im = ax.imshow(img, origin="lower", extent=extent, cmap=cmap, vmin=vmin, vmax=vmax,
-                           interpolation="nearest")
-        for poly in (overlay(z) if overlay is not None else ()):
-            if len(poly) == 1:
-                ax.plot(poly[:, 0], poly[:, 1], "r.", ms=3)
+
+def write_slice_pictures(result, pictures: list[SlicePicture], cmap: str = "viridis",
+                         **grid) -> list[Path]:
+    """Write several slice grids of one workspace that differ only in their colouring (for
+    example the plain sections and a κ map), building the panel grid, its titles, overlay and
+    ticks once: about 70 ms of each picture. ``grid``: the layout and overlay keywords of
+    :func:`slice_figure`. Each picture is what :func:`slice_figure` draws with its values."""
+    sections = _Sections(result, **grid)
+    written = []
+    for pic in pictures:
+        sections.paint(pic.values, cmap, pic.label)
+        written.append(write_bytes(Path(pic.path), png_bytes(sections.fig, pic.dpi)))
+    return written
+
+
+def png_bytes(fig, dpi: int) -> bytes:
+    """``fig`` as PNG at ``dpi``, with zlib's fastest compression: slice grids are flat
+    colours, about 9 % larger than at the default level and 10 ms faster each."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi, pil_kwargs={"compress_level": 1})
+    return buf.getvalue()
+
+
+class _Sections:
+    """A slice grid's figure without its colouring: panels, titles, overlay, ticks, title.
+    :meth:`paint` draws (or redraws) the sections' images and colour bar."""
+
+    def __init__(self, result, window=None, spacing=None, centre=None, columns=None,
+                 layout="auto", max_panels=MAX_PANELS, overlay=None, overlay_label=""):
+        lay = slice_layout(result, layout, window, spacing, centre, max_panels)
+        self.result, self.levels = result, lay.levels
+        n = max(len(self.levels), 1)
+        cols = columns or int(math.ceil(math.sqrt(n)))
+        rows = int(math.ceil(n / cols))
+        cx, cy = lay.centre
+        half = lay.window / 2
+        h = result.resolution
+        self.fig, self.axes = _panel_grid(rows, cols, 2.2, 0.8)
+        self.extent = (result.xs[0] - h / 2, result.xs[-1] + h / 2, result.ys[0] - h / 2,
+                       result.ys[-1] + h / 2) if len(result.xs) else (0, 1, 0, 1)
+        for a, ax in enumerate(self.axes.ravel()):
+            ax.set_aspect("equal")
+            ax.tick_params(labelsize=6)
+            if a >= len(self.levels):
+                ax.axis("off")
+                continue
+            z = self.levels[a]
+            for poly in (overlay(z) if overlay is not None else ()):
+                if len(poly) == 1:
+                    ax.plot(poly[:, 0], poly[:, 1], "r.", ms=3, zorder=3)
+                else:
+                    ax.plot(poly[:, 0], poly[:, 1], "r-", lw=1, zorder=3)
+            ax.set_title(f"z = {z:.1f} mm", fontsize=7)
+        _outer_ticks(self.axes, len(self.levels), (cx - half, cx + half),
+                     (cy - half, cy + half))
+        name = getattr(result.mechanism, "name", "") or result.mechanism.family
+        if result.empty:
+            first = self.axes.ravel()[0]
+            first.text(0.5, 0.5, "empty: no position satisfies\nthe constraints",
+                       ha="center", va="center", transform=first.transAxes, fontsize=8)
+        empty = " (empty)" if result.empty else ""
+        drawn = f"; red: {overlay_label}" if overlay is not None and overlay_label else ""
+        self.fig.suptitle(f"{name}: {result.kind} workspace{empty}\n{lay.describe()}{drawn}",
+                          fontsize=9)
+        self._painted: list = []                 # the images of the current colouring
+        self._bar = None
+        # where the panels are before a colour bar shrinks and re-anchors them
+        self._places = [(ax.get_position(original=True), ax.get_anchor())
+                        for ax in self.axes.ravel()]
+
+    def paint(self, values, cmap: str, label: str) -> None:
+        """Draw the sections coloured by ``values`` (``None``: grey), replacing the previous
+        colouring and its colour bar (the panels get their places back)."""
+        if self._bar is not None:             # before its image, which it refers to
+            self._bar.remove()
+            self._bar = None
+            for ax, (pos, anchor) in zip(self.axes.ravel(), self._places):
+                ax.set_position(pos)
+                ax.set_anchor(anchor)
+        for artist in self._painted:
+            artist.remove()
+        self._painted = []
+        result, h = self.result, self.result.resolution
+        if values is not None and not np.any(np.isfinite(values)):
+            values = None                     # nothing to colour: plain sections
+        if values is not None:
+            vmin, vmax, extend = _colour_range(values)
+        im = None
+        for a, ax in enumerate(self.axes.ravel()[:len(self.levels)]):
+            z = self.levels[a]
+            sec = result.slice(z)
+            if values is None:
+                img = np.where(sec, 1.0, np.nan).T
+                self._painted.append(ax.imshow(img, origin="lower", extent=self.extent,
+                                               cmap="Greys", vmin=0, vmax=1.3,
+                                               interpolation="nearest"))
             else:
-                ax.plot(poly[:, 0], poly[:, 1], "r-", lw=1)
-        ax.set_title(f"z = {z:.1f} mm", fontsize=7)
-    _outer_ticks(axes, len(levels), (cx - half, cx + half), (cy - half, cy + half))
-    if im is not None:
-        note = {"neither": "", "max": "\n(colours capped at the 99th percentile)",
-                "min": "\n(colours floored at the 1st percentile)",
-                "both": "\n(colours: 1st to 99th percentile)"}[extend]
-        fig.colorbar(im, ax=axes, shrink=0.6, extend=extend, label=label + note)
-    name = getattr(result.mechanism, "name", "") or result.mechanism.family
-    if result.empty:
-        axes.ravel()[0].text(0.5, 0.5, "empty: no position satisfies\nthe constraints",
-                             ha="center", va="center", transform=axes.ravel()[0].transAxes,
-                             fontsize=8)
-    empty = " (empty)" if result.empty else ""
-    drawn = f"; red: {overlay_label}" if overlay is not None and overlay_label else ""
-    fig.suptitle(f"{name}: {result.kind} workspace{empty}\n{lay.describe()}{drawn}",
-                 fontsize=9)
-    return fig
+                k = int(np.clip(round((z - result.zs[0]) / h), 0, len(result.zs) - 1))
+                img = np.where(sec, values[:, :, k], np.nan).T
+                im = ax.imshow(img, origin="lower", extent=self.extent, cmap=cmap, vmin=vmin,
+                               vmax=vmax, interpolation="nearest")
+                self._painted.append(im)
+        if im is not None:
+            note = {"neither": "", "max": "\n(colours capped at the 99th percentile)",
+                    "min": "\n(colours floored at the 1st percentile)",
+                    "both": "\n(colours: 1st to 99th percentile)"}[extend]
+            self._bar = self.fig.colorbar(im, ax=self.axes, shrink=0.6, extend=extend,
+                                          label=label + note)
 
 
 def _panel_grid(rows: int, cols: int, size: float, top: float, bottom: float = 0.0):
@@ -124,6 +194,10 @@ def _outer_ticks(axes, used: int, xlim: tuple[float, float], ylim: tuple[float, 
         ax = axes[a // cols, a % cols]
         ax.set_xticks(xt if a + cols >= used else [])
         ax.set_yticks(yt if a % cols == 0 else [])
+        # an axis without ticks draws nothing, yet matplotlib lays its ticks out at every
+        # save: hidden, it is skipped (the figure is the same; its saves are about 40 % faster)
+        ax.xaxis.set_visible(a + cols >= used)
+        ax.yaxis.set_visible(a % cols == 0)
         ax.set_xlim(*xlim)
         ax.set_ylim(*ylim)
 
@@ -148,12 +222,11 @@ def _colour_range(values: np.ndarray) -> tuple[float, float, str]:
     return plo, phi, extend
 
 
-def plot_slices(result, path, **kw) -> Path:
-    """Write the slice grid to ``path`` (PNG). An empty workspace gets a labelled blank."""
-    path = Path(path)
-    buf = io.BytesIO()
-    slice_figure(result, **kw).savefig(buf, format="png", dpi=120)
-    return write_bytes(path, buf.getvalue())
+def plot_slices(result, path, values: np.ndarray | None = None, label: str = "",
+                **kw) -> Path:
+    """Write the slice grid to ``path`` (PNG, 120 dpi). An empty workspace gets a labelled
+    blank."""
+    return write_slice_pictures(result, [SlicePicture(Path(path), values, label)], **kw)[0]
 
 
 def overlay_figure(results: list, labels: list[str], layout: str = "auto",
