@@ -21,6 +21,7 @@ from numba import njit, prange
 from numba import types as nt
 
 from .._jit import cached_kernel
+from ..threads import threads_for
 
 __all__ = ["singular_values", "sweep_bounds", "KAPPA_BRACKET"]
 
@@ -199,10 +200,16 @@ def _gram_lambda_max(A, G, T):
     return b
 
 
-@njit(cache=True, error_model="numpy")
-def sweep_bounds(J, L, fmax, kup, force, det):
+#: poses per parallel task of :func:`sweep_bounds` (each task has its own scratch matrices)
+_SWEEP_TASK = 512
+
+
+def sweep_bounds(J, L, fmax, kup, force, det) -> None:
     """For each ``J[m] (6, 6)``: det J, the all-direction force capability and an upper bound
-    on κ(J_h), from one LU factorisation (partial pivoting) and the inverse.
+    on κ(J_h), from one LU factorisation (partial pivoting) and the inverse, written into
+    ``kup``, ``force`` and ``det`` (C-contiguous float64 ``(M,)``); on numba's threads in
+    tasks of :data:`_SWEEP_TASK` poses (one thread for a small stack,
+    :func:`pkmlab.threads.threads_for`).
 
     * ``force[m] = min_i fmax_i / ‖(J⁻ᵀ)_{i,0:3}‖`` (N; :func:`max_force_all_directions`);
     * ``kup[m] >= κ(J_h) = σmax(J_h)·σmax(J_h⁻¹)``, from ``λmax(G) <= tr(G^(2^k))^(2^-k)`` for
@@ -212,96 +219,120 @@ def sweep_bounds(J, L, fmax, kup, force, det):
     * a matrix with a non-finite entry: ``kup = inf``, ``force = NaN``, ``det = NaN``;
       an exactly zero pivot: ``kup = inf``, ``force = 0``, ``det = 0``.
     """
-    A = np.empty((6, 6))
-    B = np.empty((6, 6))
-    G = np.empty((6, 6))
-    T = np.empty((6, 6))
-    piv = np.empty(6, np.int64)
-    for m in range(J.shape[0]):
-        finite = True
+    J = np.require(J, np.float64, ("C", "A", "W"))
+    fmax = np.require(np.broadcast_to(fmax, (6,)), np.float64, ("C", "A", "W"))
+    with threads_for(len(J)):
+        _sweep()(J, float(L), fmax, kup, force, det)
+
+
+def _sweep_loop(J, L, fmax, kup, force, det):
+    n = J.shape[0]
+    for task in prange((n + _SWEEP_TASK - 1) // _SWEEP_TASK):
+        A = np.empty((6, 6))
+        B = np.empty((6, 6))
+        G = np.empty((6, 6))
+        T = np.empty((6, 6))
+        piv = np.empty(6, np.int64)
+        for m in range(task * _SWEEP_TASK, min(n, (task + 1) * _SWEEP_TASK)):
+            _sweep_pose(J, m, L, fmax, kup, force, det, A, B, G, T, piv)
+
+
+@cache
+def _sweep():
+    """:func:`_sweep_loop` compiled on numba's thread pool (cached through
+    :func:`pkmlab._jit.cached_kernel`, like every parallel kernel)."""
+    f1 = nt.float64[::1]
+    return cached_kernel(_sweep_loop, nt.void(nt.float64[:, :, ::1], nt.float64, f1, f1, f1, f1),
+                         parallel=True, error_model="numpy")
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _sweep_pose(J, m, L, fmax, kup, force, det, A, B, G, T, piv):
+    """One pose of :func:`sweep_bounds`, with the caller's scratch ``A, B, G, T, piv``."""
+    finite = True
+    for i in range(6):
+        for k in range(6):
+            v = J[m, i, k]
+            if not math.isfinite(v):
+                finite = False
+            A[i, k] = v
+    if not finite:
+        kup[m] = np.inf
+        force[m] = np.nan
+        det[m] = np.nan
+        return
+    d = 1.0
+    zero = False
+    for k in range(6):
+        p = k
+        best = abs(A[k, k])
+        for i in range(k + 1, 6):
+            if abs(A[i, k]) > best:
+                best = abs(A[i, k])
+                p = i
+        piv[k] = p
+        if best == 0.0:
+            zero = True
+            break
+        if p != k:
+            d = -d
+            for c in range(6):
+                t = A[k, c]
+                A[k, c] = A[p, c]
+                A[p, c] = t
+        d *= A[k, k]
+        for i in range(k + 1, 6):
+            f = A[i, k] / A[k, k]
+            A[i, k] = f
+            for c in range(k + 1, 6):
+                A[i, c] -= f * A[k, c]
+    if zero:
+        kup[m] = np.inf
+        force[m] = 0.0
+        det[m] = 0.0
+        return
+    det[m] = d
+    for i in range(6):                    # B = P·I, then forward and back substitution
+        for c in range(6):
+            B[i, c] = 1.0 if i == c else 0.0
+    for k in range(6):
+        p = piv[k]
+        if p != k:
+            for c in range(6):
+                t = B[k, c]
+                B[k, c] = B[p, c]
+                B[p, c] = t
+    for c in range(6):
         for i in range(6):
-            for k in range(6):
-                v = J[m, i, k]
-                if not math.isfinite(v):
-                    finite = False
-                A[i, k] = v
-        if not finite:
-            kup[m] = np.inf
-            force[m] = np.nan
-            det[m] = np.nan
-            continue
-        d = 1.0
-        zero = False
+            v = B[i, c]
+            for k in range(i):
+                v -= A[i, k] * B[k, c]
+            B[i, c] = v
+        for i in range(5, -1, -1):
+            v = B[i, c]
+            for k in range(i + 1, 6):
+                v -= A[i, k] * B[k, c]
+            B[i, c] = v / A[i, i]
+    fm = np.inf                           # B = J⁻¹, so (J⁻ᵀ)_{i,0:3} = B[0:3, i]
+    for c in range(6):
+        g = B[0, c] * B[0, c] + B[1, c] * B[1, c] + B[2, c] * B[2, c]
+        if g > 0.0:
+            v = fmax[c] / math.sqrt(g)
+            if v < fm:
+                fm = v
+    force[m] = fm
+    for i in range(6):                    # J_h = J·diag(1, 1, 1, 1/L, 1/L, 1/L)
         for k in range(6):
-            p = k
-            best = abs(A[k, k])
-            for i in range(k + 1, 6):
-                if abs(A[i, k]) > best:
-                    best = abs(A[i, k])
-                    p = i
-            piv[k] = p
-            if best == 0.0:
-                zero = True
-                break
-            if p != k:
-                d = -d
-                for c in range(6):
-                    t = A[k, c]
-                    A[k, c] = A[p, c]
-                    A[p, c] = t
-            d *= A[k, k]
-            for i in range(k + 1, 6):
-                f = A[i, k] / A[k, k]
-                A[i, k] = f
-                for c in range(k + 1, 6):
-                    A[i, c] -= f * A[k, c]
-        if zero:
-            kup[m] = np.inf
-            force[m] = 0.0
-            det[m] = 0.0
-            continue
-        det[m] = d
-        for i in range(6):                    # B = P·I, then forward and back substitution
-            for c in range(6):
-                B[i, c] = 1.0 if i == c else 0.0
-        for k in range(6):
-            p = piv[k]
-            if p != k:
-                for c in range(6):
-                    t = B[k, c]
-                    B[k, c] = B[p, c]
-                    B[p, c] = t
+            A[i, k] = J[m, i, k] if k < 3 else J[m, i, k] / L
+    la = _gram_lambda_max(A, G, T)
+    for i in range(3, 6):                 # J_h⁻¹ = diag(1, 1, 1, L, L, L)·J⁻¹
         for c in range(6):
-            for i in range(6):
-                v = B[i, c]
-                for k in range(i):
-                    v -= A[i, k] * B[k, c]
-                B[i, c] = v
-            for i in range(5, -1, -1):
-                v = B[i, c]
-                for k in range(i + 1, 6):
-                    v -= A[i, k] * B[k, c]
-                B[i, c] = v / A[i, i]
-        fm = np.inf                           # B = J⁻¹, so (J⁻ᵀ)_{i,0:3} = B[0:3, i]
+            B[i, c] *= L
+    for i in range(6):                    # λmax(B Bᵀ) = λmax(Bᵀ B): use Bᵀ as "A"
         for c in range(6):
-            g = B[0, c] * B[0, c] + B[1, c] * B[1, c] + B[2, c] * B[2, c]
-            if g > 0.0:
-                v = fmax[c] / math.sqrt(g)
-                if v < fm:
-                    fm = v
-        force[m] = fm
-        for i in range(6):                    # J_h = J·diag(1, 1, 1, 1/L, 1/L, 1/L)
-            for k in range(6):
-                A[i, k] = J[m, i, k] if k < 3 else J[m, i, k] / L
-        la = _gram_lambda_max(A, G, T)
-        for i in range(3, 6):                 # J_h⁻¹ = diag(1, 1, 1, L, L, L)·J⁻¹
-            for c in range(6):
-                B[i, c] *= L
-        for i in range(6):                    # λmax(B Bᵀ) = λmax(Bᵀ B): use Bᵀ as "A"
-            for c in range(6):
-                A[i, c] = B[c, i]
-        lb = _gram_lambda_max(A, G, T)
-        kup[m] = math.sqrt(la * lb) if la > 0.0 and lb > 0.0 else np.inf
+            A[i, c] = B[c, i]
+    lb = _gram_lambda_max(A, G, T)
+    kup[m] = math.sqrt(la * lb) if la > 0.0 and lb > 0.0 else np.inf
 
 
 #: ``kup / KAPPA_BRACKET`` of :func:`sweep_bounds` is a lower bound on κ (exact arithmetic).
