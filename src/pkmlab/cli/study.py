@@ -204,10 +204,16 @@ def run(
     store.close()
     outp = Path(study.output)
     with log_lines(), _writing_into(outp):
+        t1 = time.perf_counter()
         info = write_report(outp, study, records)
+        t2 = time.perf_counter()
         _, problems = export_designs(outp, study, pareto_records(study, records))
+        t3 = time.perf_counter()
         page = write_study_page(outp, study, records)
-    info.update(seconds=elapsed, output=str(outp), export_problems=problems, report=str(page))
+    timings = {"evaluation_s": elapsed, "summary_s": t2 - t1, "export_s": t3 - t2,
+               "page_s": time.perf_counter() - t3}
+    info.update(seconds=elapsed, output=str(outp), export_problems=problems, report=str(page),
+                timings_s=timings)
     if as_json:
         _emit(info)
         return
