@@ -253,6 +253,10 @@ def test_cli_run_end_to_end_and_report(tmp_path):
                  "study.resolved.yaml", "evaluations.sqlite"):
         assert (out / name).exists(), name
     assert info["evaluations"] == 9
+    parts = info["timings_s"]                 # where the command's time went, in seconds
+    assert set(parts) == {"evaluation_s", "summary_s", "export_s", "page_s"}
+    assert all(v > 0 for v in parts.values())
+    assert sum(parts.values()) < time.perf_counter() - t0
     lines = (out / "evaluations.csv").read_text().splitlines()
     assert len(lines) == 10
     designs = [d for d in (out / "designs").iterdir() if d.is_dir()]
