@@ -115,6 +115,34 @@ def test_sweep_bounds_bracket_kappa_and_match_force_and_det():
     assert kup[701] == np.inf and np.isnan(force[701]) and np.isnan(det[701])
 
 
+def test_sweep_bounds_on_two_threads_equal_one_thread():
+    """Above SMALL_WORK poses the kernel runs on numba's threads in tasks of its own scratch
+    matrices: the same numbers as one thread, bit for bit, a partial last task included."""
+    import numba
+
+    if numba.get_num_threads() < 2:
+        pytest.skip("one numba thread on this machine")
+    rng = np.random.default_rng(8)
+    n = 5003                                     # > SMALL_WORK, not a multiple of the task
+    J = rng.normal(size=(n, 6, 6))
+    J[10, :, 5] = J[10, :, 4]                    # singular
+    J[n - 1, 0, 0] = np.nan                      # in the last, partial task
+    runs = []
+    for threads in (2, 1):
+        numba.set_num_threads(threads)
+        try:
+            out = [np.empty(n) for _ in range(3)]
+            sweep_bounds(J, 50.0, np.full(6, F_MAX), *out)
+        finally:
+            numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+        runs.append(out)
+    for a, b in zip(*runs):
+        assert np.array_equal(a, b, equal_nan=True)
+    assert runs[0][0][10] == np.inf and np.isnan(runs[0][1][n - 1])
+    with pytest.raises(ValueError, match="kup must be a writeable C-contiguous"):
+        sweep_bounds(J, 50.0, np.full(6, F_MAX), np.empty(2 * n)[::2], *runs[0][1:])
+
+
 # ---- the whole grid ---------------------------------------------------------------------------
 
 

@@ -75,10 +75,13 @@ def _end_process(code: int | str | None) -> None:
     everything (a fifth of its run; measured in docs/validation.md), and nothing pkmlab writes
     depends on it: every file is closed by the command that wrote it. The same order as a
     ``multiprocessing`` child's end (threads, exit handlers, ``os._exit``)."""
-    if isinstance(code, str):                  # SystemExit("message"): printed, status 1
-        sys.stderr.write(code + "\n")
-        code = 1
-    status = 0 if code is None else int(code)
+    if code is None:
+        status = 0
+    elif isinstance(code, int) and -2**31 <= code < 2**31:
+        status = code
+    else:                           # SystemExit("message") and other objects: printed, status 1
+        sys.stderr.write(f"{code}\n")
+        status = 1
     # the interpreter's own two exit steps, in its order: the threading exit hooks (which
     # stop executor threads) then waiting for the other threads; then the exit handlers
     threading._shutdown()
@@ -87,8 +90,8 @@ def _end_process(code: int | str | None) -> None:
     for stream in (sys.stdout, sys.stderr):
         try:
             stream.flush()
-        except (OSError, ValueError):           # a closed pipe: as the interpreter does
-            status = status or 120
+        except (OSError, ValueError):   # a closed pipe: status 120 as the interpreter's, no
+            status = status or 120      # "Exception ignored" message
     os._exit(status)
 
 
@@ -97,15 +100,18 @@ def run_cli() -> None:
     errors exit 2 (one line); a file-system error exits 2 with its path; a candidate's
     programming error exits 1 with its traceback and parameters; any other unexpected error
     exits 1 with one line (``--debug``: the traceback); Ctrl-C exits 130 with "interrupted",
-    also while the exit handlers run afterwards (for that, the process's SIGINT handling is
-    left replaced: this is the program's entry, not a library call)."""
+    also afterwards while threads are waited for and the exit handlers registered after the
+    command started run (worker pools, Dask clients); it is ignored during the handlers that
+    libraries registered at import, which run last (for that, the process's SIGINT handling
+    is left replaced: this is the program's entry, not a library call)."""
     import sqlite3
 
     from ..errors import CandidateError, NumericalError, ParameterError
     from ..yamlio import locate_error
 
-    # registered first, so it runs after every other exit handler: whatever follows (the
-    # module teardown, when not ended by main) cannot be interrupted halfway
+    # registered before the command, so it runs after every exit handler the command adds
+    # (pools, clients): what follows (the handlers libraries registered at import, and the
+    # module teardown when not ended by main) cannot be interrupted halfway
     atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
     try:
         code = app(standalone_mode=False)      # click returns an Exit's code in this mode

@@ -219,8 +219,13 @@ def sweep_bounds(J, L, fmax, kup, force, det) -> None:
     * a matrix with a non-finite entry: ``kup = inf``, ``force = NaN``, ``det = NaN``;
       an exactly zero pivot: ``kup = inf``, ``force = 0``, ``det = 0``.
     """
-    J = np.require(J, np.float64, ("C", "A", "W"))
+    J = np.require(J, np.float64, ("C", "A", "W"))     # the kernel's one signature: writeable
     fmax = np.require(np.broadcast_to(fmax, (6,)), np.float64, ("C", "A", "W"))
+    for name, a in (("kup", kup), ("force", force), ("det", det)):
+        if not (a.dtype == np.float64 and a.flags.c_contiguous and a.flags.writeable
+                and a.shape == (len(J),)):
+            raise ValueError(f"sweep_bounds: {name} must be a writeable C-contiguous float64 "
+                             f"array of shape ({len(J)},), got {a.dtype} {a.shape}")
     with threads_for(len(J)):
         _sweep()(J, float(L), fmax, kup, force, det)
 
