@@ -176,3 +176,27 @@ def test_slice_pictures_drawn_on_one_grid_equal_separate_figures(small, tmp_path
         assert a.shape == b.shape and np.array_equal(a, b), p.path.name
     assert not np.array_equal(mpimg.imread(pics[0].path), mpimg.imread(pics[2].path)[::-1])
     assert mpimg.imread(pics[1].path).shape != mpimg.imread(pics[0].path).shape   # 110 dpi
+
+
+def test_auto_window_also_shows_the_task_overlay(small):
+    """A task region larger than the workspace is drawn, not clipped away: the demo study's
+    101.6 mm task box fell outside its 90 mm window and the title promised red outlines that
+    no panel showed. The sections' heights stay the workspace's; the paper layout and an
+    explicit window keep theirs."""
+    from pkmlab.workspaces.plots import sections_layout
+
+    task = np.array([[-150.0, -120.0], [150.0, -120.0], [150.0, 120.0], [-150.0, 120.0],
+                     [-150.0, -120.0]])
+    overlay = lambda z: [task]                                              # noqa: E731
+    plain, drawn = slice_layout(small), sections_layout(small, overlay)
+    assert plain.window < 300 <= drawn.window
+    np.testing.assert_allclose(drawn.levels, plain.levels)
+    fig = slice_figure(small, overlay=overlay, overlay_label="task")
+    ax = fig.axes[0]
+    x0, x1 = ax.get_xlim()
+    y0, y1 = ax.get_ylim()
+    assert x0 <= -150 and x1 >= 150 and y0 <= -120 and y1 >= 120
+    assert sections_layout(small, overlay, layout="paper").window == slice_layout(
+        small, "paper").window
+    assert sections_layout(small, overlay, window=80.0).window == 80.0
+    assert sections_layout(small, lambda z: []).window == plain.window      # nothing to cover

@@ -139,8 +139,7 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
     from ..dexterity.maps import METRICS as MAPS
     from ..dexterity.maps import drawn_voxels, mesh_colours, metric_map, vertex_values
     from ..workspaces import workspace
-    from ..workspaces.plots import SlicePicture, write_slice_pictures
-    from ..workspaces.slicing import slice_layout
+    from ..workspaces.plots import SlicePicture, sections_layout, write_slice_pictures
 
     d.mkdir(parents=True, exist_ok=True)
     params = study.space.baseline_values() if r["params"] == BASELINE else r["params"]
@@ -175,7 +174,7 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
             info["task_workspace"] = (f"dexterous workspace over the task's orientation set "
                                       f"({len(ev.task.orientations.rotations())} "
                                       f"orientations), h = {h:g} mm, drawn for the task")
-        lay = slice_layout(res, **opts)
+        lay = sections_layout(res, overlay.get("overlay"), **opts)
         info["workspace"] = {k: v for k, v in res.metrics().items()
                              if k in ("kind", "volume_cm3", "volume_error_cm3", "bbox_mm",
                                       "z_range_mm", "centroid_mm", "resolution_mm", "empty",

@@ -16,10 +16,10 @@ from typing import NamedTuple
 import numpy as np
 
 from ..atomic import write_bytes
-from .slicing import MAX_PANELS, slice_layout
+from .slicing import MAX_PANELS, SliceLayout, slice_layout
 
-__all__ = ["SlicePicture", "overlay_figure", "plot_slices", "png_bytes", "slice_figure",
-           "write_slice_pictures"]
+__all__ = ["SlicePicture", "overlay_figure", "plot_slices", "png_bytes", "sections_layout",
+           "slice_figure", "write_slice_pictures"]
 
 
 class SlicePicture(NamedTuple):
@@ -74,13 +74,30 @@ def png_bytes(fig, dpi: int) -> bytes:
     return buf.getvalue()
 
 
+def sections_layout(result, overlay=None, layout: str = "auto", window: float | None = None,
+                    spacing: float | None = None, centre=None,
+                    max_panels: int = MAX_PANELS) -> SliceLayout:
+    """The slice layout of ``result`` (:func:`.slicing.slice_layout`) that also shows the
+    ``overlay``'s sections at its heights: the ``auto`` window grows to cover them unless a
+    window or centre is given (the ``paper`` layout stays the paper's, clipped)."""
+    lay = slice_layout(result, layout, window, spacing, centre, max_panels)
+    if overlay is None or layout != "auto" or window is not None or centre is not None:
+        return lay
+    polys = [np.asarray(p, dtype=float) for z in lay.levels for p in overlay(z)]
+    if not polys:
+        return lay
+    pts = np.concatenate(polys)
+    return slice_layout(result, layout, window, spacing, centre, max_panels,
+                        cover=(pts.min(axis=0), pts.max(axis=0)))
+
+
 class _Sections:
     """A slice grid's figure without its colouring: panels, titles, overlay, ticks, title.
     :meth:`paint` draws (or redraws) the sections' images and colour bar."""
 
     def __init__(self, result, window=None, spacing=None, centre=None, columns=None,
                  layout="auto", max_panels=MAX_PANELS, overlay=None, overlay_label=""):
-        lay = slice_layout(result, layout, window, spacing, centre, max_panels)
+        lay = sections_layout(result, overlay, layout, window, spacing, centre, max_panels)
         self.result, self.levels = result, lay.levels
         n = max(len(self.levels), 1)
         cols = columns or int(math.ceil(math.sqrt(n)))

@@ -87,7 +87,7 @@ def _inset_levels(zlo: float, zhi: float, spacing: float) -> np.ndarray:
 
 def slice_layout(results, layout: str = "auto", window: float | None = None,
                  spacing: float | None = None, centre=None,
-                 max_panels: int = MAX_PANELS) -> SliceLayout:
+                 max_panels: int = MAX_PANELS, cover=None) -> SliceLayout:
     """The layout of a slice plot of one :class:`~pkmlab.WorkspaceResult` or several.
 
     Args:
@@ -96,6 +96,9 @@ def slice_layout(results, layout: str = "auto", window: float | None = None,
         window, spacing: override the layout's window edge / section spacing (mm).
         centre: override the window's centre ``(x, y)`` (mm).
         max_panels: the most sections the ``auto`` layout shows.
+        cover: ``((x0, y0), (x1, y1))`` mm that the ``auto`` window must show as well as the
+            workspaces (e.g. a task region drawn on the sections); the sections' heights
+            stay the workspaces'.
     """
     if layout not in LAYOUTS:
         raise ParameterError("slice layout", f"one of {list(LAYOUTS)}", layout)
@@ -121,6 +124,10 @@ def slice_layout(results, layout: str = "auto", window: float | None = None,
         return SliceLayout("auto", float(win), float(spacing or h),
                            (float(c[0]), float(c[1])), np.empty(0))
     lo, hi = bounds
+    if cover is not None:
+        lo, hi = lo.copy(), hi.copy()
+        lo[:2] = np.minimum(lo[:2], cover[0])
+        hi[:2] = np.maximum(hi[:2], cover[1])
     edge = float(max(hi[0] - lo[0], hi[1] - lo[1]))
     win = window if window is not None else _window_ceil(max(1.05 * edge, 2 * h))
     c = (0.5 * (lo[:2] + hi[:2])) if centre is None else centre
