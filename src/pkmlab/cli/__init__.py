@@ -60,21 +60,22 @@ def main() -> None:
     its traceback."""
     try:
         run_cli()
-        code: int | str | None = 0
+        code: object = 0
     except SystemExit as exc:
         code = exc.code
     _end_process(code)
 
 
-def _end_process(code: int | str | None) -> None:
+def _end_process(code: object) -> None:
     """End the process the way the interpreter would, less its module teardown: run the
     threading exit hooks (they stop executors' threads) and wait for the threads that are not
     daemons, run the exit handlers (worker pools, Dask clients, temporary folders, logging),
-    flush the standard streams, then ``os._exit``. Freeing every
-    module and compiled kernel took 0.25-0.45 s after a ``pkmlab workspace`` had written
-    everything (a fifth of its run; measured in docs/validation.md), and nothing pkmlab writes
-    depends on it: every file is closed by the command that wrote it. The same order as a
-    ``multiprocessing`` child's end (threads, exit handlers, ``os._exit``)."""
+    flush the standard streams, then ``os._exit``. Freeing every module and compiled kernel
+    took 0.25-0.45 s after a ``pkmlab workspace`` had written everything (a fifth of its run;
+    measured in docs/validation.md), and nothing pkmlab writes depends on it: every file is
+    closed by the command that wrote it. The same order as a ``multiprocessing`` child's end
+    (threads, exit handlers, ``os._exit``). ``code``: the ``SystemExit`` code, with the
+    interpreter's meaning (``None`` 0, an int itself, anything else printed and 1)."""
     if code is None:
         status = 0
     elif isinstance(code, int) and -2**31 <= code < 2**31:
