@@ -109,8 +109,13 @@ def test_dexterous_and_reachable_brackets_hold(luzi):
     assert vols["dexterous"][0] <= vols["reachable"][1]
 
 
-def test_cli_brackets_luzi(tmp_path):
-    r = CliRunner().invoke(app, ["workspace", str(LUZI), "--resolution", "20", "--bracket",
+@pytest.mark.parametrize(("path", "resolution"), [
+    (LUZI, "20"),
+    # rss6 was refused before (exit 2: 'a family with radial column kernels ... or cell leg
+    # bounds')
+    (MECH_DIR / "instructables-servo-6rss.yaml", "4")])
+def test_cli_brackets_cell_families(tmp_path, path, resolution):
+    r = CliRunner().invoke(app, ["workspace", str(path), "--resolution", resolution, "--bracket",
                                  "--bracket-budget", "1", "--bracket-target", "0.2",
                                  "--out", str(tmp_path), "--json"])
     assert r.exit_code == 0, r.output

@@ -8,17 +8,14 @@ brackets rss6 (it refused before)."""
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 
 import numpy as np
 import pytest
 from conftest import MECH_DIR
 from scipy.spatial.transform import Rotation
-from typer.testing import CliRunner
 
 from pkmlab import load_mechanism
-from pkmlab.cli import app
 from pkmlab.mechanisms import NO_STROKE
 from pkmlab.mechanisms.rss6 import RSS6
 from pkmlab.testing import cell_points
@@ -199,15 +196,3 @@ def test_orientation_brackets_hold(kind, servo):
         assert b.lower > 0 and inner.sum() > 100 and np.all(ok[inner])
     else:
         assert np.all(b.contains(p[ok], "outer"))
-
-
-def test_cli_brackets_rss6(tmp_path):
-    """Refused before (exit 2: 'a family with radial column kernels ... or cell leg
-    bounds')."""
-    r = CliRunner().invoke(app, ["workspace", str(SERVO), "--resolution", "4", "--bracket",
-                                 "--bracket-budget", "1", "--bracket-target", "0.2",
-                                 "--out", str(tmp_path), "--json"])
-    assert r.exit_code == 0, r.output
-    vb = json.loads(r.output)["volume_bracket"]
-    assert 0 < vb["lower_mm3"] <= vb["upper_mm3"]
-    assert vb["stop_reason"] in ("converged", "budget: seconds")

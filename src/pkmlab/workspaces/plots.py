@@ -99,30 +99,16 @@ class _Sections:
                  layout="auto", max_panels=MAX_PANELS, overlay=None, overlay_label=""):
         lay = sections_layout(result, overlay, layout, window, spacing, centre, max_panels)
         self.result, self.levels = result, lay.levels
-        n = max(len(self.levels), 1)
-        cols = columns or int(math.ceil(math.sqrt(n)))
-        rows = int(math.ceil(n / cols))
-        cx, cy = lay.centre
-        half = lay.window / 2
         h = result.resolution
-        self.fig, self.axes = _panel_grid(rows, cols, 2.2, 0.8)
+        self.fig, self.axes = _panel_grid(lay, columns, 2.2, 0.8)
         self.extent = (result.xs[0] - h / 2, result.xs[-1] + h / 2, result.ys[0] - h / 2,
                        result.ys[-1] + h / 2) if len(result.xs) else (0, 1, 0, 1)
-        for a, ax in enumerate(self.axes.ravel()):
-            ax.set_aspect("equal")
-            ax.tick_params(labelsize=6)
-            if a >= len(self.levels):
-                ax.axis("off")
-                continue
-            z = self.levels[a]
+        for z, ax in zip(self.levels, self.axes.ravel()):
             for poly in (overlay(z) if overlay is not None else ()):
                 if len(poly) == 1:
                     ax.plot(poly[:, 0], poly[:, 1], "r.", ms=3, zorder=3)
                 else:
                     ax.plot(poly[:, 0], poly[:, 1], "r-", lw=1, zorder=3)
-            ax.set_title(f"z = {z:.1f} mm", fontsize=7)
-        _outer_ticks(self.axes, len(self.levels), (cx - half, cx + half),
-                     (cy - half, cy + half))
         name = getattr(result.mechanism, "name", "") or result.mechanism.family
         if result.empty:
             first = self.axes.ravel()[0]
@@ -178,27 +164,44 @@ class _Sections:
                                           label=label + note)
 
 
-def _panel_grid(rows: int, cols: int, size: float, top: float, bottom: float = 0.0):
-    """A figure of ``rows × cols`` square panels of ``size`` inches with fixed margins: ``top``
-    inches of height for the title and ``bottom`` for a legend. Every panel shows the same
-    window; :func:`_outer_ticks` puts ticks on the outer panels only. Fixed margins and outer
-    ticks only draw several times faster than a constrained layout with every panel's own
-    ticks: matplotlib builds every tick as artists, which dominated the time of a
-    ``pkmlab workspace`` run and of a study's design export."""
+def _panel_grid(lay: SliceLayout, columns: int | None, size: float, top: float,
+                bottom: float = 0.0):
+    """A figure of square panels of ``size`` inches, one per section of ``lay`` (``columns``
+    per row, default about the square root of their number), with fixed margins: ``top``
+    inches of height for the title and ``bottom`` for a legend. Every used panel has its title
+    (the height) and the layout's window, ticks on the outer panels only
+    (:func:`_outer_ticks`); the panels left over are hidden. Fixed margins and outer ticks
+    only draw several times faster than a constrained layout with every panel's own ticks:
+    matplotlib builds every tick as artists, which dominated the time of a ``pkmlab
+    workspace`` run and of a study's design export. What is drawn afterwards keeps the
+    window (the limits are set, so autoscaling is off)."""
     from matplotlib.figure import Figure
 
+    n = max(len(lay.levels), 1)
+    cols = columns or int(math.ceil(math.sqrt(n)))
+    rows = int(math.ceil(n / cols))
     W, H = size * cols, size * rows + top + bottom
     fig = Figure(figsize=(W, H))
     axes = fig.subplots(rows, cols, squeeze=False)
     fig.subplots_adjust(left=0.45 / W, right=1 - 0.15 / W, bottom=(0.3 + bottom) / H,
                         top=1 - top / H, wspace=0.12, hspace=0.25)
+    for a, ax in enumerate(axes.ravel()):
+        ax.set_aspect("equal")
+        ax.tick_params(labelsize=6)
+        if a < len(lay.levels):
+            ax.set_title(f"z = {lay.levels[a]:.1f} mm", fontsize=7)
+        else:
+            ax.axis("off")
+    (cx, cy), half = lay.centre, lay.window / 2
+    _outer_ticks(axes, len(lay.levels), (cx - half, cx + half), (cy - half, cy + half))
     return fig, axes
 
 
 def _outer_ticks(axes, used: int, xlim: tuple[float, float], ylim: tuple[float, float]) -> None:
-    """The same window (mm) on every used panel, set after drawing, and ticks on the outside
-    of the used panels only: y ticks in the first column, x ticks under every used panel that
-    has no used panel below it; the inner panels have none."""
+    """The same window (mm) on every used panel (set before drawing: autoscaling is then
+    off), and ticks on the outside of the used panels only: y ticks in the first column, x
+    ticks under every used panel that has no used panel below it; the inner panels have
+    none."""
     from matplotlib.ticker import MaxNLocator
 
     def ticks(lo, hi):
@@ -254,21 +257,10 @@ def overlay_figure(results: list, labels: list[str], layout: str = "auto",
     from matplotlib.lines import Line2D
 
     lay = slice_layout(list(results), layout, window, spacing, None, max_panels)
-    n = max(len(lay.levels), 1)
-    cols = int(math.ceil(math.sqrt(n)))
-    rows = int(math.ceil(n / cols))
     colours = ["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#D55E00", "#56B4E9", "#F0E442",
                "#000000"]
-    fig, axes = _panel_grid(rows, cols, 2.4, 0.95, 0.4)
-    cx, cy = lay.centre
-    half = lay.window / 2
-    for a, ax in enumerate(axes.ravel()):
-        ax.set_aspect("equal")
-        ax.tick_params(labelsize=6)
-        if a >= len(lay.levels):
-            ax.axis("off")
-            continue
-        z = lay.levels[a]
+    fig, axes = _panel_grid(lay, None, 2.4, 0.95, 0.4)
+    for z, ax in zip(lay.levels, axes.ravel()):
         for k, w in enumerate(results):
             if w.empty or len(w.xs) < 2 or len(w.ys) < 2:
                 continue
@@ -276,10 +268,8 @@ def overlay_figure(results: list, labels: list[str], layout: str = "auto",
             if sec.any():
                 ax.contour(w.xs, w.ys, sec.T.astype(float), levels=[0.5],
                            colors=[colours[k % len(colours)]], linewidths=1.2)
-        ax.set_title(f"z = {z:.1f} mm", fontsize=7)
     handles = [Line2D([], [], color=colours[k % len(colours)], label=lab)
                for k, lab in enumerate(labels)]
-    _outer_ticks(axes, len(lay.levels), (cx - half, cx + half), (cy - half, cy + half))
     fig.legend(handles=handles, loc="lower center", ncol=min(len(labels), 4), fontsize=8,
                frameon=False)
     fig.suptitle((title + "\n" if title else "") + lay.describe(), fontsize=9)
