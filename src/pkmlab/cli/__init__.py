@@ -88,12 +88,20 @@ def _end_process(code: object) -> None:
     threading._shutdown()
     atexit._run_exitfuncs()
     logging.shutdown()
+    if not _flushed() and status == 0:     # a closed pipe: 120 as the interpreter's, without
+        status = 120                        # its "Exception ignored" message
+    os._exit(status)
+
+
+def _flushed() -> bool:
+    """Flush stdout and stderr; False if one could not be (a closed pipe, a closed file)."""
+    ok = True
     for stream in (sys.stdout, sys.stderr):
         try:
             stream.flush()
-        except (OSError, ValueError):   # a closed pipe: status 120 as the interpreter's, no
-            status = status or 120      # "Exception ignored" message
-    os._exit(status)
+        except (OSError, ValueError):
+            ok = False
+    return ok
 
 
 def run_cli() -> None:
@@ -170,11 +178,7 @@ def run_cli() -> None:
 
 
 def _interrupted_at_exit(signum, frame) -> None:
-    for stream in (sys.stdout, sys.stderr):
-        try:
-            stream.flush()
-        except (OSError, ValueError):
-            pass
+    _flushed()
     if not _INTERRUPTED["said"]:
         os.write(2, b"interrupted\n")
     os._exit(130)
