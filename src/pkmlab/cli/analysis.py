@@ -88,7 +88,7 @@ def dexterity(
 
     from ..dexterity.maps import METRICS, mesh_colours, vertex_values
     from ..dexterity.report import dexterity_report
-    from ..workspaces.plots import slice_figure
+    from ..workspaces.plots import plot_slices
 
     mech = _load(mech_file)
     spec, req = _request(kind, orientation, box, semantics, tilt, torsion, samples, resolution,
@@ -131,9 +131,8 @@ def dexterity(
         files[0].write_text(json.dumps(report, indent=2, default=float) + "\n")
         if mmap is not None:
             vals = np.where(np.isfinite(mmap.grid), mmap.grid, np.nan)
-            fig = slice_figure(res, **spec.slice_options(), values=vals, label=mmap.label)
-            files.append(tmp / f"{metric}_slices.png")
-            fig.savefig(files[-1], dpi=120)
+            files.append(plot_slices(res, tmp / f"{metric}_slices.png", values=vals,
+                                     label=mmap.label, **spec.slice_options()))
             if res.mesh_problem is None:
                 m = res.mesh()
                 colours = mesh_colours(m, mmap)
