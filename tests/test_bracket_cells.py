@@ -119,7 +119,7 @@ def test_cli_brackets_cell_families(tmp_path, path, resolution):
                                  "--bracket-budget", "1", "--bracket-target", "0.2",
                                  "--out", str(tmp_path), "--json"])
     assert r.exit_code == 0, r.output
-    vb = json.loads(r.output)["volume_bracket"]
+    vb = json.loads(r.stdout)["volume_bracket"]
     assert 0 < vb["lower_mm3"] <= vb["upper_mm3"]
     assert vb["stop_reason"] in ("converged", "budget: seconds")
 
