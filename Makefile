@@ -1,20 +1,37 @@
-# The two commands a fresh machine needs: `make demo` and `make test`.
+# The two commands a fresh machine needs: `make demo` and `make test`. Both install exactly the
+# versions of uv.lock (runtime and dev extras, with hashes) into .venv, with uv, which make
+# first installs, pinned by hash, from tools/uv-requirements.txt.
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
+UVENV  := .uv
+UV     := $(UVENV)/bin/uv
 STAMP  := $(VENV)/.installed
 # The browser tests open report.html in a headless Chromium from the OS packages.
 BROWSER := $(VENV)/.chromium
+# uv uses the machine's Python (never downloads one) and keeps the project's environment in .venv
+export UV_PYTHON_DOWNLOADS := never
+export UV_PROJECT_ENVIRONMENT := $(VENV)
 
-.PHONY: demo test bench clean bytecode
+.PHONY: demo test bench clean bytecode lock lock-check fresh-check
 
-$(PY):
-	$(PYTHON) -m venv $(VENV)
+$(UV): tools/uv-requirements.txt
+	$(PYTHON) -m venv $(UVENV)
+	$(UVENV)/bin/python -m pip install --quiet --require-hashes --no-deps -r tools/uv-requirements.txt
+	touch $(UV)
 
-$(STAMP): pyproject.toml | $(PY)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[dev]'
+# --locked: fails, naming the cause, if uv.lock does not match pyproject.toml
+$(STAMP): pyproject.toml uv.lock | $(UV)
+	$(UV) sync --locked --extra dev --python $(PYTHON)
 	touch $(STAMP)
+
+# the lock matches pyproject.toml (run by `make test`, so by CI)
+lock-check: | $(UV)
+	$(UV) lock --check --python $(PYTHON)
+
+# refresh the lock after changing pyproject.toml (or to take new releases: make lock UPGRADE=1)
+lock: | $(UV)
+	$(UV) lock --python $(PYTHON) $(if $(UPGRADE),--upgrade)
 
 # bytecode for the editable sources, which an environment with PYTHONDONTWRITEBYTECODE set
 # would otherwise compile at every start (about 70 ms of each command); compileall rewrites
@@ -24,7 +41,7 @@ bytecode: $(STAMP)
 
 # Chromium for the browser tests: installed with apt-get when root and absent; otherwise the
 # browser tests skip, saying why.
-$(BROWSER): | $(PY)
+$(BROWSER): | $(STAMP)
 	@if command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1; then \
 		touch $(BROWSER); \
 	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
@@ -37,7 +54,7 @@ $(BROWSER): | $(PY)
 demo: bytecode
 	$(VENV)/bin/pkmlab run studies/hopkins-6psu-redesign.yaml --jobs 2 --overwrite
 
-test: bytecode $(BROWSER)
+test: lock-check bytecode $(BROWSER)
 	$(PY) -m pytest
 
 bench: bytecode
@@ -46,5 +63,11 @@ bench: bytecode
 	$(PY) benchmarks/bench_dexterity.py
 	$(PY) benchmarks/bench_study.py
 
+# A fresh clone of HEAD in a temporary folder runs the README's two commands and reports their
+# wall times (FRESH_KEEP=1 keeps the folder). The uv cache is the user's, as on a new machine
+# that has installed once; FRESH_COLD=1 gives uv an empty cache.
+fresh-check:
+	@tools/fresh-check
+
 clean:
-	rm -rf $(VENV) results/*/ .pytest_cache
+	rm -rf $(VENV) $(UVENV) results/*/ .pytest_cache
