@@ -186,17 +186,6 @@ def test_load_yaml_locates_fields(tmp_path):
     assert locate(("evaluate", "workspace", "samples"), nearest=False) is None
 
 
-def test_merge_keys_read_as_safe_load_reads_them(tmp_path):
-    from pkmlab.yamlio import load_yaml
-
-    text = ("a: &a {x: 1, y: 2}\nb: &b {y: 3, w: 4}\nc:\n  y: 9\n  <<: [*a, *b]\n"
-            "d: {<<: *a, x: 5}\n")
-    (tmp_path / "m.yaml").write_text(text)
-    data = load_yaml(tmp_path / "m.yaml")[0]
-    assert data == yaml.safe_load(text)
-    assert list(data["c"]) == list(yaml.safe_load(text)["c"])
-
-
 def test_utf16_with_a_byte_order_mark_is_read(tmp_path):
     src = MECH_DIR / "hopkins-williams-6psu.yaml"
     f = tmp_path / "utf16.yaml"

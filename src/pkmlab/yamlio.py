@@ -16,7 +16,17 @@ and refuses hostile or broken input with one :class:`~pkmlab.errors.ParameterErr
   YAML's standard scalar ones, unhashable keys;
 * syntax errors, with their line and column.
 
-Merge keys (``<<: *defaults``) work as in ``yaml.safe_load``.
+pkmlab's limits come first, whatever PyYAML is installed: libyaml applies limits of its own
+(a nesting depth of 1,000 since PyYAML 6.0.4) and reads ahead of the events it has delivered,
+so it can stop on its own rule before pkmlab's check sees the level that breaks pkmlab's. When
+the C parser stops, the file is read again with PyYAML's pure-Python parser, which has no limits
+of its own, and the first rule the file breaks is reported: pkmlab's, or the syntax error.
+
+Merge keys (``<<: *defaults`` or ``<<: [*a, *b]``) follow the YAML 1.1 merge key specification
+(https://yaml.org/type/merge.html): a key written in the mapping itself wins; otherwise a key
+of a mapping earlier in the merge list wins over the same key of a later one. The mapping keeps
+its own keys in their written order, followed by the merged keys it did not have, in the order
+of the merge list and of each merged mapping.
 """
 
 from __future__ import annotations
@@ -160,13 +170,13 @@ def _scalar(ev: ScalarEvent, name: str) -> Any:
               Shown(f"{ev.value[:40]!r} ({str(exc).splitlines()[-1][:80]})"))
 
 
-def _build(text: str, name: str, max_depth: int, max_alias_nodes: int):
+def _build(text: str, name: str, max_depth: int, max_alias_nodes: int, loader):
     positions: dict[tuple, tuple[int, int]] = {}
     ids: dict[int, tuple] = {}
     anchors: dict[str, tuple[Any, int, int]] = {}
     stack: list[_Frame] = []
     root, documents, budget = None, 0, max_alias_nodes
-    for ev in yaml.parse(text, Loader=_LOADER):
+    for ev in yaml.parse(text, Loader=loader):
         cls = type(ev)
         mark = getattr(ev, "start_mark", None)
         if cls is MapStart or cls is SeqStart:
@@ -266,22 +276,19 @@ def _add(frame: _Frame, value, nodes: int, height: int, pos, name: str, position
 
 
 def _merge(frame: _Frame, positions, name: str) -> None:
-    """``<<: *a`` or ``<<: [*a, *b]``: the keys of the merged mappings come first, the earlier
-    ones winning, and keys given explicitly override them (as in ``yaml.safe_load``)."""
-    merged: dict = {}
+    """``<<: *a`` or ``<<: [*a, *b]``, by the YAML 1.1 merge key specification: each merged
+    mapping, in the order of the list, adds the keys the mapping does not have yet, so the
+    mapping's own keys win, then the earlier merged mappings over the later ones."""
     for value, pos in frame.merges:
         maps = value if isinstance(value, list) else [value]
         if not all(isinstance(m, dict) for m in maps):
             _fail(name, *pos, "a mapping or a list of mappings to merge", value,
                   field=format_field(frame.path + ("<<",)))
-        for m in reversed(maps):    # the order of keys and values of yaml.safe_load
-            merged.update(m)
-            for k in m:
-                positions.setdefault(frame.path + (k,), pos)
-    explicit = dict(frame.value)
-    frame.value.clear()             # in place: the mapping's identity is indexed
-    frame.value.update(merged)
-    frame.value.update(explicit)
+        for m in maps:
+            for k, v in m.items():
+                if k not in frame.value:    # in place: the mapping's identity is indexed
+                    frame.value[k] = v
+                    positions.setdefault(frame.path + (k,), pos)
 
 
 def load_yaml(path: str | Path, *, max_bytes: int | None = None, max_depth: int | None = None,
@@ -313,12 +320,20 @@ def load_yaml(path: str | Path, *, max_bytes: int | None = None, max_depth: int 
         raise ParameterError(name, f"at most {max_bytes:,} bytes (pkmlab.yamlio.MAX_BYTES)",
                              Shown(f"{size:,} bytes"))
     text = _decode(raw, name)
+    limits = (max_depth, max_alias_nodes)
     try:
-        return _build(text, name, max_depth, max_alias_nodes)
+        return _build(text, name, *limits, loader=_LOADER)
     except yaml.YAMLError as exc:
-        _syntax(exc, text, name)
+        if _LOADER is yaml.SafeLoader:
+            _syntax(exc, text, name)
     except RecursionError:  # not expected (the depth is limited); never a traceback
         _fail(name, 1, 1, f"nested at most {max_depth} levels deep", Shown("deeper nesting"))
+    # the C parser stopped: the pure-Python one, without limits of its own, finds which rule
+    # the file breaks first (pkmlab's, or a syntax error), as the module docstring says
+    try:
+        return _build(text, name, *limits, loader=yaml.SafeLoader)
+    except yaml.YAMLError as exc:
+        _syntax(exc, text, name)
 
 
 # ---- errors that name the line and column of a field ------------------------------------------
