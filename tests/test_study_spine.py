@@ -239,8 +239,9 @@ def test_a_rerun_never_mixes_with_or_deletes_an_earlier_run(tmp_path):
     r = CliRunner().invoke(app, ["run", str(path)])
     assert r.exit_code == 2 and "--overwrite" in r.stderr
     assert (tmp_path / "out" / "evaluations.sqlite").read_bytes() == before
-    stale = tmp_path / "out" / "designs" / "99-stale"
+    stale = tmp_path / "out" / "designs" / "99-0123abcd"     # a design of the earlier run
     stale.mkdir(parents=True)
+    (stale / "design.json").write_text("{}")
     r = CliRunner().invoke(app, ["run", str(path), "--overwrite", "--json"])
     assert r.exit_code == 0, r.output
     assert not stale.exists()

@@ -170,6 +170,7 @@ def run(
     import time
 
     from ..progress import log_lines
+    from ..study.folder import OutputLock, check_output
     from ..study.optimisers import expected_evaluations
     from ..study.report import export_designs, pareto_records, write_report
     from ..study.run import run_study
@@ -186,30 +187,35 @@ def run(
     except ParameterError as exc:
         _fail(exc)
     prog, advance = _progress_bar(expected_evaluations(study.space, study.optimizer))
-    t0 = time.perf_counter()
-    try:
-        if prog is not None:
-            prog.start()
-        with _estimate_lines():
-            store = run_study(study, runner, resume=resume, overwrite=overwrite,
-                              progress=advance)
-    except ParameterError as exc:
-        _fail(exc)
-    finally:
-        if prog is not None:
-            prog.stop()
-        runner.close()
-    elapsed = time.perf_counter() - t0
-    records = store.all()
-    store.close()
     outp = Path(study.output)
-    with log_lines(), _writing_into(outp):
-        t1 = time.perf_counter()
-        info = write_report(outp, study, records)
-        t2 = time.perf_counter()
-        _, problems = export_designs(outp, study, pareto_records(study, records))
-        t3 = time.perf_counter()
-        page = write_study_page(outp, study, records)
+    # the folder stays locked until the report, the designs and the page are written: a second
+    # run (--overwrite or --resume) or a report rebuild meanwhile is refused
+    with contextlib.ExitStack() as held:
+        t0 = time.perf_counter()
+        try:
+            check_output(outp, study.source, overwrite=overwrite)
+            lock = held.enter_context(OutputLock(outp))
+            if prog is not None:
+                prog.start()
+            with _estimate_lines():
+                store = run_study(study, runner, resume=resume, overwrite=overwrite,
+                                  progress=advance, lock=lock)
+        except ParameterError as exc:
+            _fail(exc)
+        finally:
+            if prog is not None:
+                prog.stop()
+            runner.close()
+        elapsed = time.perf_counter() - t0
+        records = store.all()
+        store.close()
+        with log_lines(), _writing_into(outp):
+            t1 = time.perf_counter()
+            info = write_report(outp, study, records)
+            t2 = time.perf_counter()
+            _, problems = export_designs(outp, study, pareto_records(study, records))
+            t3 = time.perf_counter()
+            page = write_study_page(outp, study, records)
     timings = {"evaluation_s": elapsed, "summary_s": t2 - t1, "export_s": t3 - t2,
                "page_s": time.perf_counter() - t3}
     info.update(seconds=elapsed, output=str(outp), export_problems=problems, report=str(page),
@@ -253,11 +259,13 @@ def report(results_dir: Annotated[Path, typer.Argument(help="a study's results f
     """Rebuild the tables, Pareto plot, summary and report.html from the store and the
     exported designs (no re-evaluation)."""
     from ..progress import log_lines
+    from ..study.folder import OutputLock
     from ..study.report import write_report
     from ..webreport import write_study_page
 
     study, records = _open_results(results_dir)
-    with log_lines(), _writing_into(results_dir):
+    # not while a run writes there (the lock refuses, naming the run)
+    with log_lines(), _writing_into(results_dir), OutputLock(results_dir):
         info = write_report(results_dir, study, records)
         info["report"] = str(write_study_page(results_dir, study, records))
     info["output"] = str(results_dir)

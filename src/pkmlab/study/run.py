@@ -1,17 +1,16 @@
 """Drive a design study: optimiser → runner → store, resumable and reproducible.
 
-A run owns its output folder: it holds a lock there while it runs (a second run into the same
-folder refuses, naming the holder), and it never mixes with or deletes an earlier run unless
-asked (``resume`` continues it, ``overwrite`` replaces it).
+A run owns its output folder (:mod:`.folder`): it holds a lock there while it runs (a second run
+into the same folder refuses, naming the holder), and it never mixes with or deletes an earlier
+run unless asked (``resume`` continues it, ``overwrite`` replaces it, deleting only what pkmlab
+wrote).
 """
 
 from __future__ import annotations
 
 import logging
 import math
-import os
 import platform
-import shutil
 import time
 from pathlib import Path
 
@@ -21,6 +20,7 @@ from .. import __version__
 from ..errors import CandidateError, ParameterError
 from .definition import PENALTY, Study
 from .evaluators import evaluate_design
+from .folder import OutputLock, check_output, claim, clear_for_overwrite
 from .optimisers import OPTIMISERS, check_time
 from .store import Store, candidate_key
 
@@ -73,55 +73,7 @@ def feasible(study: Study, records: list[dict]) -> np.ndarray:
     return ok & np.all(F < PENALTY, axis=1) & np.all(G <= 0, axis=1)
 
 
-class OutputLock:
-    """An exclusive lock on a results folder (``.lock``, holding the owner's pid), released
-    on exit and by the operating system when the process dies."""
-
-    def __init__(self, folder: Path):
-        self.path = Path(folder) / ".lock"
-        self.fh = None
-
-    def __enter__(self) -> OutputLock:
-        import fcntl
-
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.fh = open(self.path, "a+")
-        try:
-            fcntl.flock(self.fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            self.fh.seek(0)
-            holder = self.fh.read().strip() or "another process"
-            self.fh.close()
-            raise ParameterError("output", "a results folder no other run is using",
-                                 f"{self.path.parent} is in use by {holder}") from None
-        self.fh.seek(0)
-        self.fh.truncate()
-        self.fh.write(f"pid {os.getpid()}")
-        self.fh.flush()
-        return self
-
-    def __exit__(self, *exc) -> None:
-        import fcntl
-
-        fcntl.flock(self.fh, fcntl.LOCK_UN)
-        self.fh.close()
-
-
-def check_output(out: Path, source: Path | None = None) -> None:
-    """Refuse a results folder that would hold (and on --overwrite delete) other files: the
-    file system root, the working directory, the study file's folder or a parent of them."""
-    target = Path(out).expanduser().resolve()
-    protected = [Path.cwd().resolve()]
-    if source is not None:
-        protected.append(Path(source).resolve().parent)
-    for p in protected:
-        if target == p or target in p.parents or target == Path(target.anchor):
-            raise ParameterError("output", "a results folder of its own (not the working "
-                                 "directory, the study's folder, a parent of them or /)",
-                                 str(out))
-
-
-def _prepare(out: Path, fp: str, resume: bool, overwrite: bool) -> Store:
+def _prepare(out: Path, fp: str, resume: bool, overwrite: bool, study_name: str) -> Store:
     path = out / "evaluations.sqlite"
     if path.exists() and resume:
         store = Store(path)
@@ -140,13 +92,14 @@ def _prepare(out: Path, fp: str, resume: bool, overwrite: bool) -> Store:
         raise ParameterError("output", "a new or empty folder (--resume continues the run in "
                              "it, --overwrite replaces it)",
                              f"{out} holds {len(leftovers)} entries of an earlier run")
-    for p in leftovers:
-        shutil.rmtree(p) if p.is_dir() and not p.is_symlink() else p.unlink()
+    if leftovers:
+        clear_for_overwrite(out)
+    claim(out, study_name)
     return Store(path)
 
 
 def run_study(study: Study, runner, *, resume: bool = False, overwrite: bool = False,
-              progress=None) -> Store:
+              progress=None, lock: OutputLock | None = None) -> Store:
     """Run (or resume) a study; every evaluation is committed to the store as it finishes.
 
     Args:
@@ -157,21 +110,29 @@ def run_study(study: Study, runner, *, resume: bool = False, overwrite: bool = F
         overwrite: replace an earlier run in the output folder (without it, a non-empty
             folder is refused).
         progress: optional callable ``progress(n_done_now)`` called per finished evaluation.
+        lock: the folder's :class:`~.folder.OutputLock`, held by the caller, which then writes
+            the report and designs before releasing it (as ``pkmlab run`` does); without it,
+            the run takes the lock for the evaluations only.
 
     Raises:
         ParameterError: the folder is in use, not empty, or holds another study.
         CandidateError: a candidate raised an undeclared exception (recorded first).
     """
     out = Path(study.output)
-    check_output(out, study.source)
+    check_output(out, study.source, overwrite=overwrite)
     fp = study.fingerprint()
-    with OutputLock(out):
-        store = _prepare(out, fp, resume, overwrite)
-        try:
-            _run(study, runner, store, fp, progress)
-        except BaseException:
-            store.close()
-            raise
+    if lock is None:
+        with OutputLock(out) as held:
+            return run_study(study, runner, resume=resume, overwrite=overwrite,
+                             progress=progress, lock=held)
+    if lock.path.parent.resolve() != out.resolve():
+        raise ValueError(f"the lock held is on {lock.path.parent}, the study writes {out}")
+    store = _prepare(out, fp, resume, overwrite, study.name)
+    try:
+        _run(study, runner, store, fp, progress)
+    except BaseException:
+        store.close()
+        raise
     return store
 
 
