@@ -3,13 +3,19 @@
 Every check takes a :class:`~pkmlab.mechanisms.Mechanism` and raises ``AssertionError`` naming
 what failed; :func:`run_contract` runs them all and returns the names of the checks that passed.
 They use only the public protocol (``inverse``, ``jacobian``, ``forward``, ``assembly_modes``,
-``stroke``, ``nominal_pose``, ``actuator_unit``)::
+``stroke``, ``nominal_pose``, ``actuator_unit``, ``actuator_names``, ``mobility``) and size
+themselves from the mechanism's declaration: poses move in its free coordinates only, the
+Jacobian is checked on its free twist columns, actuator vectors have ``n_actuators`` values::
 
     from pkmlab.testing import run_contract
     run_contract(MyFamily(...))
 
 The checks:
 
+* :func:`check_declaration` — the inverse kinematics writes one value per declared actuator
+  (the drivers fill the leg buffers with a sentinel first, so a kernel writing fewer or more
+  legs raises), the Jacobian is ``(N, actuators, free coordinates)``, and there are at least
+  as many actuators as free coordinates;
 * :func:`check_round_trip` — IK → FK of poses near nominal recovers the pose to 1e-9;
 * :func:`check_jacobian` — the analytic Jacobian against Richardson-extrapolated central
   differences of the inverse kinematics (error O(h⁴), so the tolerance can be tight);
@@ -32,20 +38,28 @@ import numpy as np
 from .mechanisms import LEG_STATUS, NO_STROKE
 from .poses import as_frames, euler_to_matrix, exp_so3, log_so3
 
-__all__ = ["random_valid_poses", "rotation_error", "check_round_trip", "check_jacobian",
+__all__ = ["random_valid_poses", "rotation_error", "check_declaration", "check_round_trip",
+           "check_jacobian",
            "check_batching", "check_statuses", "check_assembly_modes", "check_bad_shapes",
            "CHECKS", "run_contract", "cell_points"]
 
 REASON = {v: k for k, v in LEG_STATUS.items()}
 
 
+def _moves(mech) -> np.ndarray:
+    """``(6,)`` 1 for the pose coordinates the mechanism's mobility frees, else 0."""
+    m = np.zeros(6)
+    m[mech.mobility.index] = 1.0
+    return m
+
+
 def random_valid_poses(mech, n: int, seed: int, lin: float = 25.0, ang_deg: float = 10.0):
-    """``n`` poses near the nominal pose (±``lin`` mm, ±``ang_deg`` deg) whose inverse
-    kinematics is valid."""
+    """``n`` poses near the nominal pose (±``lin`` mm, ±``ang_deg`` deg in the free
+    coordinates) whose inverse kinematics is valid; six coordinates each."""
     rng = np.random.default_rng(seed)
     out, total = [], 0
     for _ in range(200):
-        X = mech.nominal_pose + np.concatenate(
+        X = mech.nominal_pose + _moves(mech) * np.concatenate(
             [rng.uniform(-lin, lin, (4 * n, 3)),
              np.radians(rng.uniform(-ang_deg, ang_deg, (4 * n, 3)))], axis=1)
         out.append(X[mech.inverse(X).valid])
@@ -61,6 +75,19 @@ def rotation_error(X1, X2):
     return np.linalg.norm(log_so3(np.einsum("nji,njk->nik", R1, R2)), axis=1)
 
 
+def check_declaration(mech):
+    L, mob = mech.n_actuators, mech.mobility
+    assert L == len(set(mech.actuator_names)), "actuator names must be distinct"
+    assert L >= mob.width, (f"{L} actuators cannot drive the {mob.width} free coordinates "
+                            f"({', '.join(mob.coordinates)})")
+    X = random_valid_poses(mech, 8, seed=0)
+    ik = mech.inverse(X)                       # raises if the kernel wrote another leg count
+    assert ik.q.shape == (8, L) and ik.leg_status.shape == (8, L), ik.q.shape
+    assert np.array_equal(mech.inverse(mob.free(X)).q, ik.q), "free-coordinate poses differ"
+    assert mech.jacobian(X).shape == (8, L, mob.width), mech.jacobian(X).shape
+    assert mech.actuator_limits.shape == (L, 2)
+
+
 def check_round_trip(mech, n: int = 1000, tol: float = 1e-9):
     X = random_valid_poses(mech, n, seed=1)
     q = mech.inverse(X).q
@@ -74,8 +101,10 @@ def check_round_trip(mech, n: int = 1000, tol: float = 1e-9):
 
 
 def _central(mech, p, R, h):
-    out = np.empty((len(p), 6, 6))
-    for j in range(6):
+    """Central differences of the IK along the free twist components ``(N, L, width)``."""
+    cols = mech.mobility.twist_columns
+    out = np.empty((len(p), mech.n_actuators, len(cols)))
+    for c, j in enumerate(cols):
         d = np.zeros(6)
         d[j] = h
         if j < 3:
@@ -84,7 +113,7 @@ def _central(mech, p, R, h):
         else:
             qp = mech.inverse((p, exp_so3(d[3:]) @ R), stroke=NO_STROKE).q
             qm = mech.inverse((p, exp_so3(-d[3:]) @ R), stroke=NO_STROKE).q
-        out[:, :, j] = (qp - qm) / (2 * h)
+        out[:, :, c] = (qp - qm) / (2 * h)
     return out
 
 
@@ -95,7 +124,11 @@ def check_jacobian(mech, n: int = 40, h: float = 1e-4, tol: float = 1e-7):
     p, R = as_frames(X)
     J = mech.jacobian(X)
     Jfd = (4.0 * _central(mech, p, R, h / 2) - _central(mech, p, R, h)) / 3.0
-    for cols, what in ((slice(0, 3), "translation"), (slice(3, 6), "rotation")):
+    free = mech.mobility.twist_columns
+    for group, what in ((free < 3, "translation"), (free >= 3, "rotation")):
+        if not group.any():
+            continue
+        cols = np.flatnonzero(group)
         scale = np.max(np.abs(J[:, :, cols]), axis=(1, 2), keepdims=True)
         rel = np.abs(J[:, :, cols] - Jfd[:, :, cols]) / scale
         assert rel.max() < tol, f"Jacobian {what} columns differ from finite differences " \
@@ -143,8 +176,9 @@ def check_statuses(mech):
     assert np.all(ik.leg_status[1] == REASON["non-finite pose"])
     # Far and wide poses: NaN exactly where there is no real solution; valid means finite.
     rng = np.random.default_rng(5)
-    W = mech.nominal_pose + np.concatenate([rng.uniform(-2, 2, (500, 3)) * mech.scale,
-                                            rng.uniform(-np.pi, np.pi, (500, 3))], axis=1)
+    W = mech.nominal_pose + _moves(mech) * np.concatenate(
+        [rng.uniform(-2, 2, (500, 3)) * mech.scale, rng.uniform(-np.pi, np.pi, (500, 3))],
+        axis=1)
     ik = mech.inverse(W, stroke=NO_STROKE)
     nan_ok = np.isin(ik.leg_status, [REASON["no real solution"], REASON["degenerate leg "
                                                                         "geometry"]])
@@ -152,8 +186,8 @@ def check_statuses(mech):
     assert np.all(np.isfinite(ik.q[ik.valid])), "a valid pose with a NaN actuator value"
     # Forward kinematics reports failure as data. Adjacent actuators at 1 and 5000 (mm: the
     # triangle inequality; rad: outside (-π, π], no inverse gives it) close no working loop.
-    impossible = np.array([1.0, 5000.0, 1.0, 5000.0, 1.0, 5000.0])
-    fk = mech.forward(np.array([q, impossible, np.full(6, np.nan)]))
+    impossible = np.resize([1.0, 5000.0], mech.n_actuators)
+    fk = mech.forward(np.array([q, impossible, np.full(mech.n_actuators, np.nan)]))
     assert fk.converged.tolist() == [True, False, False], fk.status
     assert np.all(np.isnan(fk.pose[1:]))
     assert all(s in ("not converged", "singular") for s in fk.status[1:])
@@ -187,7 +221,8 @@ def check_bad_shapes(mech):
 
 
 #: name → check, in the order :func:`run_contract` runs them
-CHECKS = {"round_trip": check_round_trip, "jacobian": check_jacobian,
+CHECKS = {"declaration": check_declaration, "round_trip": check_round_trip,
+          "jacobian": check_jacobian,
           "batching": check_batching, "statuses": check_statuses,
           "assembly_modes": check_assembly_modes, "bad_shapes": check_bad_shapes}
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..mechanisms import LEG_STATUS
+from ..mechanisms.mobility import require_spatial
 from ..workspaces import workspace
 from .aggregate import (
     gci_grid,
@@ -164,6 +165,7 @@ def dexterity_report(mech, request: dict, *, L: float | CharacteristicLength | N
         standard error), :func:`pkmlab.dexterity.worst_case` (worst κ, smallest force,
         singular pose inside), the well-conditioned and force-capable volumes.
     """
+    require_spatial(mech, "dexterity")
     if metric not in METRICS:
         raise ParameterError("metric", f"one of {list(METRICS)}", metric)
     if not (math.isfinite(well_conditioned) and well_conditioned >= 1):

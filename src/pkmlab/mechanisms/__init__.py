@@ -19,6 +19,7 @@ import logging
 
 from .base import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult, Mechanism
 from .luzi3 import Luzi3
+from .mobility import PLANAR, SPATIAL, TRANSLATIONAL, Mobility
 from .psu6 import PSU6
 from .rss6 import RSS6
 from .sixleg import SixLeg
@@ -53,6 +54,22 @@ def _check_plugin(cls) -> None:
                         "field and build()")
     if cls._ik_one is None:
         raise TypeError(f"{cls.__name__} has no _ik_one (per-pose numba inverse kinematics)")
+    mob, names = cls.mobility, cls.actuator_names
+    if len(names) < mob.width or len(set(names)) != len(names):
+        raise TypeError(f"{cls.__name__}.actuator_names must name at least one distinct "
+                        f"actuator per free coordinate of its mobility ({mob.name}: "
+                        f"{', '.join(mob.coordinates)}); got {names}")
+
+
+def register_family(cls) -> type[Mechanism]:
+    """Register a family class (checked as a plugin is) under ``cls.family``; returns it.
+
+    The entry points of :data:`PLUGIN_GROUP` go through this; a family defined in a script
+    or a test may call it directly. Registering the same class again is a no-op.
+    """
+    _check_plugin(cls)
+    REGISTRY[cls.family] = cls
+    return cls
 
 
 def load_plugins() -> dict[str, type[Mechanism]]:
@@ -64,19 +81,18 @@ def load_plugins() -> dict[str, type[Mechanism]]:
         if ep.name in _LOADED:
             continue
         try:
-            cls = ep.load()
-            _check_plugin(cls)
+            register_family(ep.load())
         except Exception as exc:  # a broken plugin must not break pkmlab
             PLUGIN_ERRORS[ep.name] = f"{type(exc).__name__}: {exc}"
             log.warning("pkmlab family plugin %r (%s) not loaded: %s", ep.name, ep.value,
                         PLUGIN_ERRORS[ep.name])
             continue
-        REGISTRY[cls.family] = cls
         PLUGIN_ERRORS.pop(ep.name, None)
         _LOADED.add(ep.name)
     return {k: v for k, v in REGISTRY.items() if k not in BUILTIN}
 
 
-__all__ = ["REGISTRY", "BUILTIN", "PLUGIN_GROUP", "PLUGIN_ERRORS", "load_plugins", "NO_STROKE",
+__all__ = ["REGISTRY", "BUILTIN", "PLUGIN_GROUP", "PLUGIN_ERRORS", "load_plugins",
+           "register_family", "NO_STROKE", "Mobility", "SPATIAL", "TRANSLATIONAL", "PLANAR",
            "Mechanism", "IKResult", "FKResult", "AssemblyModes", "LEG_STATUS", "PSU6", "UPS6",
            "Luzi3", "RSS6", "SixLeg"]

@@ -15,8 +15,14 @@ LLVM vectorises each stage over the poses of a block:
    :func:`_sincos`, the Z-Y-X product by :func:`_euler_matrix`);
 2. legs: call ``one`` for every pose ``j`` of the block; it writes leg ``i`` to slot
    ``i * ROW + j`` of the leg-major buffers ``q`` (float64) and ``st`` (int8);
-3. store: transpose the buffers into the ``(N, 6)`` outputs and take each pose's reason, the
-   most severe leg status.
+3. store: transpose the buffers into the ``(N, L)`` outputs (``L`` the family's actuator count,
+   ``Mechanism.n_actuators``) and take each pose's reason, the most severe leg status.
+
+Before stage 2 the status rows of the block are filled with :data:`UNWRITTEN`, one row more than
+the family declares (:func:`_prefill`): a pose whose ``one`` left a declared leg unwritten, or
+wrote a leg beyond them, gets the reason :data:`LEG_FAULT`, and the mechanism raises (a
+programming error of the family, never returned as data). The buffers hold at least seven
+rows, so a kernel written for six legs behind a smaller declaration stays inside them.
 
 For stage 2 to vectorise, ``one`` must be branch-free (conditional expressions that LLVM turns
 into selects, no early exit or ``continue``; helpers it calls are ``njit(inline="always")``),
@@ -91,6 +97,11 @@ __all__ = ["BLOCK", "ROW", "carray", "make_driver", "make_column_kernel", "make_
 OK, BELOW_STROKE, ABOVE_STROKE, DEGENERATE, NO_SOLUTION, INVALID_INPUT = 0, 1, 2, 3, 4, 5
 # A leg on the other side of its base joint than at the nominal pose (another assembly mode).
 OTHER_MODE = 6
+#: Reason of a pose whose per-pose function wrote another number of legs than the family
+#: declares (``Mechanism.n_actuators``); the mechanism raises on it.
+LEG_FAULT = 7
+#: Status a block's rows hold until the per-pose function writes them.
+UNWRITTEN = -1
 
 #: Poses per block of the inverse-kinematics drivers (the buffers of a block, ~110 kB, stay in
 #: the L2 cache).
@@ -268,28 +279,44 @@ def _frames_bad(p, R, m, bad):
         bad[j] = not math.isfinite(total)
 
 
+def _rows(legs: int) -> int:
+    """Rows of a block's leg buffers: the declared legs, a sentinel row, and at least seven."""
+    return max(legs, 6) + 1
+
+
+@njit(cache=True)
+def _prefill(st, legs, w):
+    """:data:`UNWRITTEN` in the status rows of the ``legs`` declared legs and the one after."""
+    for i in range(legs + 1):
+        for j in range(w):
+            st[i * ROW + j] = UNWRITTEN
+
+
 # ---- stage 3: store a block --------------------------------------------------------------------
 @njit(cache=True)
-def _store(q, st, m, q_out, st_out, reason_out):
-    """Leg-major block buffers → rows of the ``(m, 6)`` outputs (flat) and each pose's reason."""
+def _store(q, st, m, legs, q_out, st_out, reason_out):
+    """Leg-major block buffers → rows of the ``(m, legs)`` outputs (flat) and each pose's
+    reason (:data:`LEG_FAULT` where a declared leg was left unwritten or one more written)."""
     for j in range(m):
         worst = np.int8(OK)
-        for i in range(6):
+        fault = st[legs * ROW + j] != UNWRITTEN
+        for i in range(legs):
             s = st[i * ROW + j]
-            q_out[6 * j + i] = q[i * ROW + j]
-            st_out[6 * j + i] = s
+            q_out[legs * j + i] = q[i * ROW + j]
+            st_out[legs * j + i] = s
             worst = max(worst, s)
-        reason_out[j] = worst
+            fault |= s == UNWRITTEN
+        reason_out[j] = LEG_FAULT if fault else worst
 
 
 @njit(cache=True)
-def _store_invalid(bad, m, q_out, st_out, reason_out):
+def _store_invalid(bad, m, legs, q_out, st_out, reason_out):
     """NaN and ``INVALID_INPUT`` for the flagged poses of a block."""
     for j in range(m):
         if bad[j]:
-            for i in range(6):
-                q_out[6 * j + i] = np.nan
-                st_out[6 * j + i] = INVALID_INPUT
+            for i in range(legs):
+                q_out[legs * j + i] = np.nan
+                st_out[legs * j + i] = INVALID_INPUT
             reason_out[j] = INVALID_INPUT
 
 
@@ -327,19 +354,21 @@ def _legs(one, ng: int):
 
 
 @cache
-def make_driver(one, ng: int, kind: str):
+def make_driver(one, ng: int, kind: str, legs: int = 6):
     """Parallel driver ``kind`` (``"euler"`` or ``"frames"``) for the per-pose function ``one``
-    and geometry tuples of ``ng`` floats, loaded from or compiled into numba's disk cache.
+    of ``legs`` legs and geometry tuples of ``ng`` floats, loaded from or compiled into numba's
+    disk cache.
 
     ``one`` must be a module-level function declared with ``register_jitable``. The driver is
     built by :func:`.._jit.cached_kernel` (see the module notes): its name carries a hash of
     all the source it compiles in, so no two families' drivers can alias and an edit
     recompiles.
 
-    ``euler(poses (N, 6), g, qmin, qmax, q_out (N, 6), st_out (N, 6) int8, reason_out (N,)
-    int8)``; ``frames(p (N, 3), R (N, 3, 3), g, ...)`` likewise. All arrays C-contiguous,
+    ``euler(poses (N, 6), g, qmin, qmax, q_out (N, legs), st_out (N, legs) int8, reason_out
+    (N,) int8)``; ``frames(p (N, 3), R (N, 3, 3), g, ...)`` likewise. All arrays C-contiguous,
     writeable, float64 unless stated (:func:`carray`).
     """
+    nlegs, rows = legs, _rows(legs)
     legs = _legs(one, ng)
 
     def drive_euler(poses, g, qmin, qmax, q_out, st_out, reason_out):
@@ -354,17 +383,19 @@ def make_driver(one, ng: int, kind: str):
             T = np.empty(12 * ROW)
             A = np.empty(3 * ROW)
             C = np.empty(3 * ROW)
-            q = np.empty(6 * ROW)
-            st = np.empty(6 * ROW, dtype=np.int8)
+            q = np.empty(rows * ROW)
+            st = np.empty(rows * ROW, dtype=np.int8)
             slow = _load_euler(xb, m, w, T, A, C)
             bad = np.zeros(BLOCK, dtype=np.bool_)
             if slow:
                 _euler_slow(xb, m, T, bad)
+            _prefill(st, nlegs, w)
             legs(T, w, g, qmin, qmax, q, st)
-            out = slice(6 * k0, 6 * (k0 + m))
-            _store(q, st, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
+            out = slice(nlegs * k0, nlegs * (k0 + m))
+            _store(q, st, m, nlegs, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
             if slow:
-                _store_invalid(bad, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
+                _store_invalid(bad, m, nlegs, q_flat[out], st_flat[out],
+                               reason_out[k0:k0 + m])
 
     def drive_frames(p, R, g, qmin, qmax, q_out, st_out, reason_out):
         """Inverse kinematics over positions ``(N, 3)`` and rotations ``(N, 3, 3)``."""
@@ -377,23 +408,26 @@ def make_driver(one, ng: int, kind: str):
             w = _width(m)
             pb, Rb = pf[3 * k0:3 * (k0 + m)], Rf[9 * k0:9 * (k0 + m)]
             T = np.empty(12 * ROW)
-            q = np.empty(6 * ROW)
-            st = np.empty(6 * ROW, dtype=np.int8)
+            q = np.empty(rows * ROW)
+            st = np.empty(rows * ROW, dtype=np.int8)
             nbad = _load_frames(pb, Rb, m, w, T)
+            _prefill(st, nlegs, w)
             legs(T, w, g, qmin, qmax, q, st)
-            out = slice(6 * k0, 6 * (k0 + m))
-            _store(q, st, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
+            out = slice(nlegs * k0, nlegs * (k0 + m))
+            _store(q, st, m, nlegs, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
             if nbad:
                 bad = np.zeros(BLOCK, dtype=np.bool_)
                 _frames_bad(pb, Rb, m, bad)
-                _store_invalid(bad, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
+                _store_invalid(bad, m, nlegs, q_flat[out], st_flat[out],
+                               reason_out[k0:k0 + m])
 
     g, f8 = nt.UniTuple(nt.float64, ng), nt.float64
     if kind == "euler":
-        return cached_kernel(drive_euler, nt.void(_F2, g, f8, f8, _F2, _I2, _I1), parallel=True)
+        return cached_kernel(drive_euler, nt.void(_F2, g, f8, f8, _F2, _I2, _I1), parallel=True,
+                             extra=("legs", nlegs))
     if kind == "frames":
         return cached_kernel(drive_frames, nt.void(_F2, _F3, g, f8, f8, _F2, _I2, _I1),
-                             parallel=True)
+                             parallel=True, extra=("legs", nlegs))
     raise ValueError(f"kind must be 'euler' or 'frames', got {kind!r}")
 
 
@@ -422,7 +456,7 @@ def _jac_block(jac, ng: int):
 
 @cache
 def make_jacobian_driver(jac, ng: int):
-    """Parallel driver ``jacobian(p (N, 3), R (N, 3, 3), g, q (N, 6), J_out (N, 6, 6))`` for the
+    """Parallel driver ``jacobian(p (N, 3), R (N, 3, 3), g, q (N, L), J_out (N, L, 6))`` for the
     per-pose Jacobian ``jac`` (above) and geometry tuples of ``ng`` floats, built by
     :func:`.._jit.cached_kernel` like :func:`make_driver`."""
     block = _jac_block(jac, ng)
@@ -437,12 +471,13 @@ def make_jacobian_driver(jac, ng: int):
 
 
 @cache
-def make_kinematics_driver(one, jac, ng: int):
+def make_kinematics_driver(one, jac, ng: int, legs: int = 6):
     """Inverse kinematics and Jacobian of frames in one parallel pass: ``kinematics(p, R, g,
     qmin, qmax, q_out, st_out, reason_out, J_out)``, the ``frames`` driver of
     :func:`make_driver` for ``one`` followed, block by block, by ``jac`` (which reads the
     block's stored actuator values). One parallel region instead of two: on a loaded machine
     each region waits for every thread to be scheduled."""
+    nlegs, rows = legs, _rows(legs)
     legs = _legs(one, ng)
     block_jac = _jac_block(jac, ng)
 
@@ -456,21 +491,23 @@ def make_kinematics_driver(one, jac, ng: int):
             w = _width(m)
             pb, Rb = pf[3 * k0:3 * (k0 + m)], Rf[9 * k0:9 * (k0 + m)]
             T = np.empty(12 * ROW)
-            q = np.empty(6 * ROW)
-            st = np.empty(6 * ROW, dtype=np.int8)
+            q = np.empty(rows * ROW)
+            st = np.empty(rows * ROW, dtype=np.int8)
             nbad = _load_frames(pb, Rb, m, w, T)
+            _prefill(st, nlegs, w)
             legs(T, w, g, qmin, qmax, q, st)
-            out = slice(6 * k0, 6 * (k0 + m))
-            _store(q, st, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
+            out = slice(nlegs * k0, nlegs * (k0 + m))
+            _store(q, st, m, nlegs, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
             if nbad:
                 bad = np.zeros(BLOCK, dtype=np.bool_)
                 _frames_bad(pb, Rb, m, bad)
-                _store_invalid(bad, m, q_flat[out], st_flat[out], reason_out[k0:k0 + m])
+                _store_invalid(bad, m, nlegs, q_flat[out], st_flat[out],
+                               reason_out[k0:k0 + m])
             block_jac(p, R, g, q_out, J, k0, k0 + m)
 
     gt, f8 = nt.UniTuple(nt.float64, ng), nt.float64
     return cached_kernel(drive_kinematics, nt.void(_F2, _F3, gt, f8, f8, _F2, _I2, _I1, _F3),
-                         parallel=True, error_model="numpy")
+                         parallel=True, error_model="numpy", extra=("legs", nlegs))
 
 
 # ---- column kernels for the workspace engine --------------------------------------------------

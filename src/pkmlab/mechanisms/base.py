@@ -3,15 +3,21 @@
 Public protocol (what the rest of pkmlab uses; nothing outside :mod:`pkmlab.mechanisms` calls a
 method whose name starts with ``_``):
 
-* ``family``, ``actuator_names``, ``actuator_unit`` (``"mm"`` or ``"rad"``), ``name``,
-  ``stroke``, ``actuator_limits``, ``scale``;
+* ``family``, ``mobility`` (the free pose coordinates, :mod:`.mobility`; spatial unless the
+  family declares another), ``actuator_names`` (one per actuator: ``n_actuators``, the ``L``
+  below), ``actuator_unit`` (``"mm"`` or ``"rad"``), ``name``, ``stroke``, ``actuator_limits``,
+  ``scale``;
 * ``base_points``, ``platform_points``, ``tool_offset`` and ``tool_points`` (mm);
 * ``nominal_pose`` — level, centred, mid-stroke unless given;
 * ``inverse(poses, stroke=None)``, ``jacobian(poses)`` and both at once,
   ``inverse_and_jacobian(poses, stroke=None)``: ``poses`` is ``(N, 6)`` Euler
-  (mm, rad, R = Rz·Ry·Rx), ``(N, 4, 4)`` transforms, or a tuple ``(p (N, 3), R (N, 3, 3))``;
-  ``stroke`` overrides the actuator window (:data:`NO_STROKE` for geometry only);
-* ``forward(q)``, ``assembly_modes(q)``;
+  (mm, rad, R = Rz·Ry·Rx), ``(N, 4, 4)`` transforms, a tuple ``(p (N, 3), R (N, 3, 3))``, or,
+  for a mechanism whose mobility is not spatial, ``(N, width)`` in its free coordinates (the
+  others taken from the nominal pose); ``stroke`` overrides the actuator window
+  (:data:`NO_STROKE` for geometry only). Actuator values are ``(N, L)``; the Jacobian is
+  ``(N, L, width)``, its columns the free components of the twist ``[v; ω]``;
+* ``forward(q)``, ``assembly_modes(q)`` (``q`` of ``L`` values; poses returned with six
+  coordinates, the fixed ones those of the nominal pose);
 * ``footprint()`` — base and platform radii measured from their centres;
 * ``leg_segments(p, R)`` — each leg's moving link, for interference and drawing;
   ``link_segments(p, R)`` — every moving link with the leg it belongs to (default: the
@@ -36,14 +42,16 @@ contract suite in ``tests/test_contract.py`` then runs on it):
 * a frozen dataclass subclassing :class:`Mechanism`, declared with ``eq=False`` so that the
   geometric equality and hash defined here are kept, holding ``base_points``,
   ``platform_points``, ``stroke_window`` and ``tool_offset``, validated in ``__post_init__``;
-* ``_ik_one`` — a numba per-pose inverse kinematics function (see :mod:`._kernels`);
+* ``_ik_one`` — a numba per-pose inverse kinematics function (see :mod:`._kernels`) writing
+  exactly ``L`` legs (the drivers check it and raise otherwise);
 * ``_gparams()`` — the geometry packed as one float array for that function;
-* ``_jacobian(p, R)`` — the analytic velocity Jacobian ``(N, 6, 6)``, or instead
+* ``_jacobian(p, R)`` — the analytic velocity Jacobian ``(N, L, 6)`` over the full twist
+  (the protocol keeps the mobility's columns), or instead
   ``_jac_one``, a numba per-pose Jacobian (see :func:`._kernels.make_jacobian_driver`; with
   ``_jac_uses_q = True`` when it reads the actuator values), which the base ``_jacobian`` runs
   in parallel: ``psu6``, ``ups6`` and ``rss6`` do, at tens of M poses/s;
-* ``_closure(p, R, q)`` — loop-closure residuals ``(N, 6)`` in mm and their derivative with
-  respect to the tool twist ``(N, 6, 6)``, used by Newton's method;
+* ``_closure(p, R, q)`` — loop-closure residuals ``(N, L)`` in mm and their derivative with
+  respect to the tool twist ``(N, L, 6)``, used by Newton's method (on the free columns);
 * ``scale`` and ``leg_segments``; optionally the column hooks above.
 
 Forward kinematics, the assembly-mode search and the nominal-pose search are generic and live
@@ -64,6 +72,7 @@ from ..poses import as_frames, log_so3
 from ..threads import threads_for
 from ..tolerances import TOL
 from . import _kernels, _tiles
+from .mobility import SPATIAL, Mobility
 from .results import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult
 from .solvers import bracketed_root, forward_newton, multistart_modes
 
@@ -143,6 +152,8 @@ class Mechanism:
     """Base of every mechanism family (geometry lives in the subclass)."""
 
     family: ClassVar[str] = ""
+    #: the free pose coordinates (:mod:`.mobility`)
+    mobility: ClassVar[Mobility] = SPATIAL
     actuator_names: ClassVar[tuple[str, ...]] = ("q1", "q2", "q3", "q4", "q5", "q6")
     #: unit of the actuator values: ``"mm"`` (prismatic) or ``"rad"`` (rotary; the CLI and its
     #: JSON show these in degrees)
@@ -284,23 +295,25 @@ class Mechanism:
         return start, end, np.arange(start.shape[1])
 
     def base_joint_axes(self, p: np.ndarray, R: np.ndarray, axes: np.ndarray) -> np.ndarray:
-        """``(N, 6, 3)`` base-frame mounting axes of the base-side passive joints at the poses,
-        given ``axes (6, 3)`` at the nominal pose. Default: the joints are fixed to the base."""
-        return np.broadcast_to(np.asarray(axes, dtype=float), (len(p), 6, 3))
+        """``(N, L, 3)`` base-frame mounting axes of the base-side passive joints at the poses,
+        given ``axes (L, 3)`` at the nominal pose. Default: the joints are fixed to the base."""
+        axes = np.asarray(axes, dtype=float)
+        return np.broadcast_to(axes, (len(p), *axes.shape))
 
     def _gparams(self) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError
 
     def _jacobian(self, p: np.ndarray, R: np.ndarray) -> np.ndarray:
-        """``(N, 6, 6)`` by the family's ``_jac_one`` kernel (families without one override
+        """``(N, L, 6)`` by the family's ``_jac_one`` kernel (families without one override
         this with their own formula)."""
         jac = type(self)._jac_one
         if jac is None:  # pragma: no cover - abstract
             raise NotImplementedError
         p, R = _kernels.carray(p), _kernels.carray(R)
+        L = self.n_actuators
         q = (self._run_ik(p, R, *NO_STROKE).q if self._jac_uses_q
-             else np.empty((len(p), 6)))
-        J = np.empty((len(p), 6, 6))
+             else np.empty((len(p), L)))
+        J = np.empty((len(p), L, 6))
         g = self._ik_geometry
         _kernels.make_jacobian_driver(jac, len(g))(p, R, g, q, J)
         return J
@@ -355,10 +368,15 @@ class Mechanism:
 
     # ---- public API ------------------------------------------------------------------------
     @property
+    def n_actuators(self) -> int:
+        """Number of actuators (and legs of the inverse kinematics), ``L``."""
+        return len(self.actuator_names)
+
+    @property
     def actuator_limits(self) -> np.ndarray:
-        """``(6, 2)`` actuator windows [min, max] in mm."""
+        """``(L, 2)`` actuator windows [min, max] in mm."""
         lo, hi = self.stroke
-        return np.tile([lo, hi], (6, 1))
+        return np.tile([lo, hi], (self.n_actuators, 1))
 
     @property
     def nominal_pose(self) -> np.ndarray:
@@ -375,8 +393,9 @@ class Mechanism:
         """Actuator values of poses → :class:`IKResult`.
 
         Args:
-            poses: ``(N, 6)`` Euler poses (mm, rad), ``(N, 4, 4)`` transforms, or a tuple
-                ``(p (N, 3), R (N, 3, 3))`` of positions and rotation matrices.
+            poses: ``(N, 6)`` Euler poses (mm, rad), ``(N, 4, 4)`` transforms, a tuple
+                ``(p (N, 3), R (N, 3, 3))`` of positions and rotation matrices, or ``(N,
+                width)`` free coordinates of a mechanism whose mobility is not spatial.
             stroke: actuator window ``(min, max)`` in mm to check instead of the mechanism's;
                 :data:`NO_STROKE` checks the geometry only.
         """
@@ -384,28 +403,51 @@ class Mechanism:
         if isinstance(poses, tuple):
             p, R = _frames_tuple(poses)
             return self._run_ik(p, R, lo, hi)
-        X = np.asarray(poses, dtype=float)
+        X = self._free_to_full(np.asarray(poses, dtype=float))
         if X.ndim <= 2 and X.shape[-1] == 6:
             return self._run_ik(np.ascontiguousarray(X.reshape(-1, 6)), None, lo, hi)
         p, R = as_frames(X)
         return self._run_ik(p, R, lo, hi)
 
+    def _free_to_full(self, X: np.ndarray) -> np.ndarray:
+        """Poses given in a non-spatial mobility's free coordinates → six coordinates."""
+        mob = self.mobility
+        if mob.is_spatial or X.ndim == 0 or X.ndim > 2 or X.shape[-1] != mob.width:
+            return X
+        return mob.full(X, self.nominal_pose)
+
+    def _frames(self, poses) -> tuple[np.ndarray, np.ndarray]:
+        if isinstance(poses, tuple):
+            return _frames_tuple(poses)
+        return as_frames(self._free_to_full(np.asarray(poses, dtype=float)))
+
     def _run_ik(self, X_or_p, R, lo: float, hi: float) -> IKResult:
         g = self._ik_geometry
-        n = X_or_p.shape[0]
-        q = np.empty((n, 6))
-        st = np.empty((n, 6), dtype=np.int8)
+        n, L = X_or_p.shape[0], self.n_actuators
+        q = np.empty((n, L))
+        st = np.empty((n, L), dtype=np.int8)
         reason = np.empty(n, dtype=np.int8)
         lo, hi = float(lo), float(hi)
         one, ng = type(self)._ik_one, len(g)
         with threads_for(n):
             if R is None:
-                euler = _kernels.make_driver(one, ng, "euler")
+                euler = _kernels.make_driver(one, ng, "euler", L)
                 euler(_kernels.carray(X_or_p), g, lo, hi, q, st, reason)
             else:
-                frames = _kernels.make_driver(one, ng, "frames")
+                frames = _kernels.make_driver(one, ng, "frames", L)
                 frames(_kernels.carray(X_or_p), _kernels.carray(R), g, lo, hi, q, st, reason)
+        self._check_legs(reason)
         return IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st)
+
+    def _check_legs(self, reason: np.ndarray) -> None:
+        """A family's ``_ik_one`` that wrote another number of legs than it declares is a
+        programming error: raise, never return its buffers as actuator values."""
+        if np.any(reason == _kernels.LEG_FAULT):
+            raise RuntimeError(
+                f"{type(self).__name__}._ik_one did not write exactly the {self.n_actuators} "
+                f"legs its actuator_names declare ({', '.join(self.actuator_names)}) for "
+                f"{int(np.sum(reason == _kernels.LEG_FAULT))} pose(s): set actuator_names (and "
+                "mobility) to what the kernel computes")
 
     @cached_property
     def _ik_geometry(self) -> tuple:
@@ -415,39 +457,45 @@ class Mechanism:
 
     def inverse_and_jacobian(self, poses, *, stroke: tuple[float, float] | None = None
                              ) -> tuple[IKResult, np.ndarray]:
-        """:meth:`inverse` and :meth:`jacobian` of the same poses, ``(IKResult, J (N, 6,
-        6))``: one parallel pass for families with a numba Jacobian (inverse dynamics
+        """:meth:`inverse` and :meth:`jacobian` of the same poses, ``(IKResult, J (N, L,
+        width))``: one parallel pass for families with a numba Jacobian (inverse dynamics
         calls this per chunk of a trajectory)."""
         jac = type(self)._jac_one
         if jac is None or type(self)._jacobian is not Mechanism._jacobian:
             # no kernel, or a subclass's own formula: the two calls, which honour it
             return self.inverse(poses, stroke=stroke), self.jacobian(poses)
-        p, R = _frames_tuple(poses) if isinstance(poses, tuple) else as_frames(poses)
+        p, R = self._frames(poses)
         p, R = _kernels.carray(p), _kernels.carray(R)
         lo, hi = self.stroke if stroke is None else (float(stroke[0]), float(stroke[1]))
-        n, g = len(p), self._ik_geometry
-        q, J = np.empty((n, 6)), np.empty((n, 6, 6))
-        st, reason = np.empty((n, 6), dtype=np.int8), np.empty(n, dtype=np.int8)
-        drive = _kernels.make_kinematics_driver(type(self)._ik_one, jac, len(g))
+        n, g, L = len(p), self._ik_geometry, self.n_actuators
+        q, J = np.empty((n, L)), np.empty((n, L, 6))
+        st, reason = np.empty((n, L), dtype=np.int8), np.empty(n, dtype=np.int8)
+        drive = _kernels.make_kinematics_driver(type(self)._ik_one, jac, len(g), L)
         drive(p, R, g, float(lo), float(hi), q, st, reason, J)
-        return IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st), J
+        self._check_legs(reason)
+        return (IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st),
+                self._free_columns(J))
 
     def jacobian(self, poses) -> np.ndarray:
-        """Analytic velocity Jacobian ``(N, 6, 6)``: ``q̇ = J · [v; ω]``.
+        """Analytic velocity Jacobian ``(N, L, width)``: ``q̇ = J · t``, ``t`` the free
+        components of the twist ``[v; ω]`` (all six for a spatial mechanism).
 
         ``poses`` as for :meth:`inverse`. ``v`` (mm/s) is the velocity of the tool-frame origin
         and ``ω`` (rad/s) the angular velocity, both in the base frame. Rows of legs with no
         real solution are NaN; use :meth:`inverse` for the mask and reason.
         """
-        p, R = _frames_tuple(poses) if isinstance(poses, tuple) else as_frames(poses)
-        return self._jacobian(p, R)
+        return self._free_columns(self._jacobian(*self._frames(poses)))
+
+    def _free_columns(self, J: np.ndarray) -> np.ndarray:
+        mob = self.mobility
+        return J if mob.is_spatial else np.ascontiguousarray(J[:, :, mob.twist_columns])
 
     def forward(self, q: np.ndarray, guess: np.ndarray | None = None, *,
                 tol: float = TOL.fk_residual_mm, max_iter: int = 50) -> FKResult:
         """Forward kinematics by Newton's method with the analytic Jacobian.
 
         Args:
-            q: actuator values ``(6,)`` or ``(N, 6)`` in mm.
+            q: actuator values ``(L,)`` or ``(N, L)`` in mm.
             guess: starting pose(s) ``(6,)`` or ``(N, 6)``; default the nominal pose. Where
                 Newton from the guess fails or lands outside the working mode, the solve is
                 repeated by continuation from the nominal pose along a straight actuator path.
@@ -457,12 +505,13 @@ class Mechanism:
 
     def assembly_modes(self, q: np.ndarray, *, starts: int = 1500, seed: int = 0,
                        tol: float = TOL.fk_residual_mm) -> AssemblyModes:
-        """All real assembly modes for one actuator vector ``(6,)``, by multi-start Newton.
+        """All real assembly modes for one actuator vector ``(L,)``, by multi-start Newton.
 
         Starting points: the nominal pose, plus ``starts`` poses with positions uniform in a
         box of half-size ``2·scale`` around the base centre and orientations uniform on SO(3)
-        (seeded). Solutions are de-duplicated (``TOL.mode_duplicate_rel``·scale mm and rad)
-        and sorted by distance to the nominal pose.
+        (seeded); coordinates the mobility does not free keep their nominal values.
+        Solutions are de-duplicated (``TOL.mode_duplicate_rel``·scale mm and rad) and sorted
+        by distance to the nominal pose.
         """
         return multistart_modes(self, q, starts=starts, seed=seed, tol=tol)
 
@@ -509,6 +558,12 @@ class Mechanism:
         rng = np.random.default_rng(seed)
         S = self.scale
         p = rng.uniform(-2 * S, 2 * S, size=(n, 3))         # box about the base centre
+        mob = self.mobility
+        if not mob.is_spatial:
+            X = np.repeat(self.nominal_pose[None], n, axis=0)
+            X[:, :3] = p
+            X[:, 3:] += rng.uniform(-np.pi, np.pi, size=(n, 3))
+            return as_frames(mob.full(mob.free(X), self.nominal_pose))
         # lazy: scipy.spatial costs 0.25 s at import, and only forward kinematics needs it
         from scipy.spatial.transform import Rotation
 

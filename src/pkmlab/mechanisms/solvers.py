@@ -3,6 +3,8 @@
 Newton's method runs on the family's loop-closure residuals ``f(p, R; q)`` (mm) with their
 analytic derivative ``G = ∂f/∂ξ`` with respect to a base-frame twist displacement ξ = (δp, δφ);
 a step updates ``p ← p + δp`` and ``R ← exp(δφ)·R``, so no Euler-angle singularity is involved.
+Only the twist components the mechanism's mobility frees move (:mod:`.mobility`); a
+mechanism with more actuators than free coordinates takes least-squares steps.
 Everything is batched over starting points; converged entries drop out of the active set.
 """
 
@@ -46,7 +48,7 @@ def _solve(G: np.ndarray, f: np.ndarray) -> np.ndarray:
 
 
 def newton(mech, p, R, q, *, tol: float, max_iter: int, polish: int = 2):
-    """Damped Newton from frames ``p (N,3)``, ``R (N,3,3)`` towards actuator values ``q (N,6)``.
+    """Damped Newton from frames ``p (N,3)``, ``R (N,3,3)`` towards actuator values ``q (N,L)``.
 
     Returns ``(p, R, residual (N,), iterations (N,), finite (N,))``: ``finite`` is False where
     the residual or its derivative became undefined (e.g. a leg with no real solution).
@@ -59,6 +61,7 @@ def newton(mech, p, R, q, *, tol: float, max_iter: int, polish: int = 2):
     finite = np.ones(n, dtype=bool)
     active = np.arange(n)
     max_lin, max_ang = 0.25 * mech.scale, 0.5
+    cols = None if mech.mobility.is_spatial else mech.mobility.twist_columns
     for _ in range(max_iter + polish + 1):
         if active.size == 0:
             break
@@ -72,7 +75,11 @@ def newton(mech, p, R, q, *, tol: float, max_iter: int, polish: int = 2):
         active, f, G = active[keep], f[keep], G[keep]
         if active.size == 0:
             break
-        step = -_solve(G, f)
+        if cols is None:
+            step = -_solve(G, f)
+        else:
+            step = np.zeros((len(active), 6))
+            step[:, cols] = -_solve(G[:, :, cols], f)
         lin = np.linalg.norm(step[:, :3], axis=1)
         ang = np.linalg.norm(step[:, 3:], axis=1)
         scale = np.minimum(1.0, np.minimum(max_lin / np.maximum(lin, 1e-300),
@@ -97,8 +104,10 @@ def forward_newton(mech, q, guess=None, *, tol: float = TOL.fk_residual_mm, max_
                    continuation_steps: int = 12) -> FKResult:
     """Batched forward kinematics; see :meth:`Mechanism.forward`."""
     q = np.atleast_2d(np.asarray(q, dtype=float))
-    if q.shape[1:] != (6,):
-        raise ParameterError("q", "an array of shape (6,) or (N, 6) in mm", q.shape)
+    L = mech.n_actuators
+    if q.ndim != 2 or q.shape[1:] != (L,):
+        raise ParameterError("q", f"an array of shape ({L},) or (N, {L}) in "
+                             f"{mech.actuator_unit}", q.shape)
     n = q.shape[0]
     p0, R0 = as_frames(mech.nominal_pose if guess is None else guess, field="guess")
     if p0.shape[0] == 1 and n > 1:
@@ -136,7 +145,7 @@ def forward_newton(mech, q, guess=None, *, tol: float = TOL.fk_residual_mm, max_
 
 def multistart_modes(mech, q, *, starts: int, seed: int, tol: float) -> AssemblyModes:
     """Multi-start assembly-mode search; see :meth:`Mechanism.assembly_modes`."""
-    q = np.asarray(q, dtype=float).reshape(6)
+    q = np.asarray(q, dtype=float).reshape(mech.n_actuators)
     pr, Rr = mech._random_starts(starts, seed)
     pn, Rn = as_frames(mech.nominal_pose)
     p0 = np.concatenate([pn, pr])

@@ -19,6 +19,7 @@ from ..config import mechanism_spec, read_yaml, validate_model, workspace_spec
 from ..errors import ParameterError
 from ..mechanisms import REGISTRY
 from ..mechanisms.layout import PAIRED_ALIASES as _PAIRED
+from ..mechanisms.mobility import require_spatial
 from ..units import parse_angle, parse_length
 from .definition import (
     Constraint,
@@ -365,7 +366,7 @@ def study_from_mapping(data: Any, base: Path | None = None,
         mech_data = dict(src.inline)
     try:
         mech_spec = mechanism_spec(_merge(mech_data, src.overrides))
-        mech_spec.build()
+        require_spatial(mech_spec.build(), "design studies", "family")
     except ParameterError as exc:     # keeps the position in the file the value came from
         raise ParameterError(f"mechanism.{exc.field}", exc.allowed, exc.got,
                              where=exc.where) from None

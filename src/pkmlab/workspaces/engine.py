@@ -28,6 +28,7 @@ from ..dexterity.metrics import resolve_length
 from ..errors import ParameterError
 from ..limits import RESOLUTION_MM
 from ..mechanisms import NO_STROKE
+from ..mechanisms.mobility import require_spatial
 from ..memory import coarser_resolution, require
 from ..poses import as_frames, matrix_to_euler
 from ..time_budget import coarser_for_time, require_time, workspace_seconds
@@ -98,6 +99,7 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
         :class:`WorkspaceResult`; an empty workspace is a valid result (``result.empty``).
     """
     t0 = time.perf_counter()
+    require_spatial(mech, "workspaces")
     check_request(kind, resolution)
     if method not in ("auto", "columns", "sampled"):
         raise ParameterError("method", "one of ['auto', 'columns', 'sampled']", method)

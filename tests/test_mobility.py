@@ -1,0 +1,155 @@
+"""Mobility as data: a three-leg translational family, written as a plugin, sizes every
+kinematic result from its declaration; a kernel that writes another leg count raises."""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numba.extending import register_jitable
+
+from pkmlab.mechanisms import PLANAR, REGISTRY, SPATIAL, TRANSLATIONAL, _kernels, register_family
+from pkmlab.mechanisms.mobility import Mobility
+from pkmlab.testing import run_contract
+
+sys.path.insert(0, str(Path(__file__).parent / "data" / "plugin3"))
+import pkmlab_tri3_family as tri3  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def tripod():
+    register_family(tri3.Tri3)
+    yield tri3.reporters_tripod()
+    REGISTRY.pop("tri3", None)
+
+
+def test_the_three_leg_family_passes_the_contract_suite(tripod):
+    done = run_contract(tripod)
+    assert done[0] == "declaration" and len(done) == 7, done
+
+
+def test_2000_copies_of_a_reachable_pose_are_all_valid_and_sized_by_the_declaration(tripod):
+    """The issue's reproduction: (N, 6) with legs 4-6 uninitialised, 49.65 % valid, before."""
+    X = np.repeat([[0.0, 0.0, 400.0]], 2000, axis=0)         # free coordinates x, y, z
+    ik = tripod.inverse(X)
+    assert ik.q.shape == (2000, 3) and ik.leg_status.shape == (2000, 3)
+    assert ik.valid.all()
+    # independent: |p + u_i - b_i| by hand
+    expected = np.linalg.norm(np.array([0.0, 0.0, 400.0]) + tri3.circle(60.0)
+                              - tri3.circle(300.0), axis=1)
+    np.testing.assert_allclose(ik.q, np.broadcast_to(expected, (2000, 3)), rtol=0, atol=1e-12)
+    full = np.repeat([[0.0, 0.0, 400.0, 0.0, 0.0, 0.0]], 2000, axis=0)
+    np.testing.assert_array_equal(tripod.inverse(full).q, ik.q)
+
+
+def test_jacobian_forward_and_modes_are_sized_by_the_mobility(tripod):
+    X = np.array([[10.0, -20.0, 380.0], [0.0, 0.0, 400.0]])
+    J = tripod.jacobian(X)
+    assert J.shape == (2, 3, 3)
+    # a translational leg's row is its unit direction
+    s = np.array([10.0, -20.0, 380.0]) + tri3.circle(60.0) - tri3.circle(300.0)
+    np.testing.assert_allclose(J[0], s / np.linalg.norm(s, axis=1)[:, None], atol=1e-14)
+    q = tripod.inverse(X).q
+    fk = tripod.forward(q)
+    assert fk.converged.all() and fk.pose.shape == (2, 6)
+    np.testing.assert_allclose(fk.pose[:, :3], X, atol=1e-9)
+    np.testing.assert_array_equal(fk.pose[:, 3:], 0.0)          # fixed at the nominal pose
+    modes = tripod.assembly_modes(q[1], starts=200)
+    # a translational 3-leg platform has two assembly modes: the mirror below the base plane
+    assert len(modes.pose) == 2 and modes.working_mode[0]
+    np.testing.assert_allclose(modes.pose[1, :3], [0.0, 0.0, -400.0], atol=1e-7)
+    with pytest.raises(ValueError, match=r"q: must be an array of shape \(3,\) or \(N, 3\)"):
+        tripod.forward(np.zeros(6))
+
+
+@register_jitable(inline="always")
+def _four_of_three(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st,
+                   j):
+    for i in range(4):              # one leg more than the three the family declares
+        k = min(i, 2)
+        v = math.sqrt((px - g[3 * k]) ** 2 + (py - g[3 * k + 1]) ** 2 + (pz - g[3 * k + 2]) ** 2)
+        q[i * _kernels.ROW + j] = v
+        st[i * _kernels.ROW + j] = _kernels.stroke_status(v, qmin, qmax)
+
+
+@dataclass(frozen=True, eq=False)
+class _ThreeAsSix(tri3.Tri3):
+    """A three-leg kernel behind the default declaration (six actuators, spatial), as a plugin
+    written from the README's six-leg example would be."""
+    family = "tri3-as-six"
+    mobility = SPATIAL
+    actuator_names = ("q1", "q2", "q3", "q4", "q5", "q6")
+
+
+@dataclass(frozen=True, eq=False)
+class _FourOfThree(tri3.Tri3):
+    family = "tri3-four"
+    _ik_one = _four_of_three
+
+
+@pytest.mark.parametrize("cls, wrote", [(_ThreeAsSix, "fewer"), (_FourOfThree, "more")])
+def test_a_kernel_writing_another_leg_count_raises(cls, wrote):
+    mech = cls(tri3.circle(300.0), tri3.circle(60.0), (250.0, 600.0),
+               nominal=np.array([0.0, 0.0, 400.0, 0.0, 0.0, 0.0]))
+    X = np.repeat([[0.0, 0.0, 400.0, 0.0, 0.0, 0.0]], 2000, axis=0)
+    with pytest.raises(RuntimeError, match=f"did not write exactly the {mech.n_actuators} legs"):
+        mech.inverse(X)
+    with pytest.raises(RuntimeError, match="did not write exactly"):
+        mech.inverse((X[:, :3], np.repeat(np.eye(3)[None], 2000, axis=0)))
+
+
+def test_the_plugin_check_compares_actuators_with_the_mobility():
+    @dataclass(frozen=True, eq=False)
+    class TooFew(tri3.Tri3):
+        family = "tri3-too-few"
+        mobility = SPATIAL
+        actuator_names = ("q1", "q2", "q3")
+
+    with pytest.raises(TypeError, match="at least one distinct actuator per free coordinate"):
+        register_family(TooFew)
+    assert "tri3-too-few" not in REGISTRY
+
+
+def test_mobility_declarations():
+    assert SPATIAL.width == 6 and SPATIAL.is_spatial and SPATIAL.rotations
+    assert TRANSLATIONAL.twist_columns.tolist() == [0, 1, 2] and not TRANSLATIONAL.rotations
+    assert PLANAR.twist_columns.tolist() == [0, 1, 5] and PLANAR.units == ("mm", "mm", "rad")
+    full = PLANAR.full([[1.0, 2.0, 0.5]], [0, 0, 300.0, 0, 0, 0.1])
+    np.testing.assert_array_equal(full, [[1.0, 2.0, 300.0, 0.0, 0.0, 0.5]])
+    np.testing.assert_array_equal(PLANAR.free(full), [[1.0, 2.0, 0.5]])
+    for bad in (("z", "x"), ("x", "x"), ("x", "theta_x"), ("roll",)):
+        with pytest.raises(ValueError):
+            Mobility("bad", bad)
+    with pytest.raises(ValueError, match=r"poses: must be an array of shape \(3,\)"):
+        TRANSLATIONAL.full(np.zeros((2, 4)), np.zeros(6))
+
+
+def test_analyses_that_assume_six_coordinates_refuse_a_lower_mobility_clearly(tripod, tmp_path):
+    """Until workspaces, dexterity and studies size themselves from the mobility, they refuse
+    it with one named error (a shape error or garbage before)."""
+    import pkmlab
+    from pkmlab.dexterity.report import dexterity_report
+    from pkmlab.errors import ParameterError
+    from pkmlab.study import study_from_mapping
+
+    with pytest.raises(ParameterError, match="mechanism: must be a mechanism with six free "
+                       r"pose coordinates for workspaces .*translational mobility \(x, y, z\)"):
+        pkmlab.workspace(tripod, "constant", resolution=10.0)
+    with pytest.raises(ParameterError, match="for dexterity"):
+        dexterity_report(tripod, {"kind": "constant", "resolution": 10.0})
+    study = {"study": "tri3", "seed": 1, "output": str(tmp_path / "out"),
+             "mechanism": {"inline": {"family": "tri3",
+                                      "base_points": tri3.circle(300.0).tolist(),
+                                      "platform_points": tri3.circle(60.0).tolist(),
+                                      "stroke": [250, 600]}},
+             "design": {"stroke_max": {"low": "500 mm", "high": "650 mm",
+                                       "path": "stroke[1]", "quantity": "length"}},
+             "evaluate": {"workspace": {"kind": "constant", "resolution": "10 mm"}},
+             "objectives": [{"maximize": "constant_volume"}],
+             "optimizer": {"method": "sobol", "samples": 4}}
+    with pytest.raises(ParameterError, match="mechanism.family: must be a mechanism with six"):
+        study_from_mapping(study, tmp_path)
