@@ -7,9 +7,11 @@ from .workspaces import Constraints, JointLimits, OrientationSet, WorkspaceResul
 
 __version__ = "0.1.0"
 
+from .export import load_exporter_plugins as _load_exporters  # noqa: E402
 from .mechanisms import load_plugins as _load_plugins  # noqa: E402
 
 _load_plugins()     # family plugins (entry points "pkmlab.families"), now that pkmlab is whole
+_load_exporters()  # exporter plugins (entry points "pkmlab.exporters")
 
 __all__ = ["load_mechanism", "load_study", "ParameterError", "NumericalError", "REGISTRY",
            "Mechanism", "PSU6", "UPS6", "Luzi3", "RSS6", "workspace", "OrientationSet",

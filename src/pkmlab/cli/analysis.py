@@ -12,6 +12,7 @@ import typer
 from rich.markup import escape
 
 from ..errors import ParameterError
+from ..export import exporters
 from ..progress import log_lines
 from ..units import parse_length
 from .common import (
@@ -136,11 +137,12 @@ def dexterity(
             if res.mesh_problem is None:
                 m = res.mesh()
                 colours = mesh_colours(m, mmap)
-                for fmt in ("ply", "glb"):   # PLY in mm with the metric per vertex; GLB in m
+                # every mesh format that takes colours (PLY in mm with the metric per
+                # vertex, GLB in m): the ones that take values get the metric's
+                for fmt in exporters("mesh", option="colors"):
                     files.append(tmp / f"workspace_{metric}.{fmt}")
                     res.save_mesh(files[-1], colors=colours,
-                                  values={metric: vertex_values(m, mmap)} if fmt == "ply"
-                                  else None)
+                                  values={metric: vertex_values(m, mmap)})
         for f in files:
             shutil.move(str(f), out_dir / f.name)
             written.append(out_dir / f.name)

@@ -11,6 +11,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from ..errors import ParameterError
+from ..export import exporters
 from ..progress import log_lines
 from .common import (
     AllComponentsOpt,
@@ -42,8 +43,8 @@ def _write_workspace(res, out_dir: Path, mesh_formats: list[str], slices: dict) 
     ``slices``: the slice layout (``WorkspaceSpec.slice_options()``)."""
     from ..atomic import staged
 
-    for stale in ("workspace.stl", "workspace.ply", "workspace.glb"):
-        (out_dir / stale).unlink(missing_ok=True)
+    for fmt in exporters("mesh"):
+        (out_dir / f"workspace.{fmt}").unlink(missing_ok=True)
     with staged(out_dir) as tmp:
         files = [res.save_npz(tmp / "workspace.npz"), res.save_json(tmp / "workspace.json"),
                  res.plot_slices(tmp / "slices.png", **slices)]
@@ -149,7 +150,8 @@ def workspace(
     bracket_target: Annotated[float, typer.Option(
         help="--bracket: relative width to reach, (upper - lower) / upper")] = 0.01,
     mesh: Annotated[str, typer.Option(
-        help="mesh formats, comma-separated: stl (mm), ply (mm), glb (m, y up)")] = "stl",
+        help="mesh formats, comma-separated, of: " + "; ".join(
+            f"{k} ({e.description})" for k, e in exporters("mesh").items()))] = "stl",
     slice_layout: Annotated[str, typer.Option(
         help="slices.png: auto (window and spacing scaled to the workspace) | paper "
              "(Hopkins & Williams: 152.4 mm every 12.7 mm)")] = "auto",
@@ -168,10 +170,9 @@ def workspace(
                          link_diameter, joint_limit, kappa_max, all_components, stroke,
                          slice_layout)
     formats = [f.strip().lower() for f in mesh.split(",") if f.strip()]
-    bad = [f for f in formats if f not in ("stl", "ply", "glb")]
-    if bad or not formats:
-        _fail(ParameterError("--mesh", "comma-separated formats from ['stl', 'ply', 'glb']",
-                             mesh))
+    known = list(exporters("mesh"))
+    if not formats or any(f not in known for f in formats):
+        _fail(ParameterError("--mesh", f"comma-separated formats from {known}", mesh))
     try:
         with log_lines():                 # the time estimate of a long grid, before it runs
             res = compute(mech, **req, refine=refine)

@@ -35,6 +35,7 @@ import yaml
 from .. import atomic
 from ..config import to_display
 from ..errors import NumericalError, ParameterError
+from ..export import exporters
 from .definition import Study
 from .run import BASELINE, objective_matrix
 from .selection import select_designs
@@ -210,10 +211,10 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
                 if first is None:
                     first = mm
             colours = mesh_colours(mesh, first) if first is not None else None
-            step("meshes (STL, PLY, GLB)")
-            for fmt in ("stl", "ply", "glb"):
-                res.save_mesh(d / f"workspace.{fmt}", colors=None if fmt == "stl" else colours,
-                              values=values if fmt == "ply" else None)
+            formats = exporters("mesh", study=True)
+            step(f"meshes ({', '.join(f.upper() for f in formats)})")
+            for fmt in formats:         # each takes the colours and values it understands
+                res.save_mesh(d / f"workspace.{fmt}", colors=colours, values=values)
                 files.append(f"workspace.{fmt}")
             info["characteristic_length"] = L
             info["vertex_values"] = {n: {"label": MAPS[n][0], "unit": MAPS[n][1]}

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from ..export import exporters
 from ..study.definition import Study
 from ..study.export import read_index
 from ..study.metrics import METRICS
@@ -28,11 +29,19 @@ REPORT_NAME = "report.html"
 _FILES = {
     "mechanism.yaml": "mechanism file (pkmlab inspect / workspace / compare read it)",
     "design.json": "why it was chosen, values, slice layout",
-    "workspace.stl": "workspace hull, binary STL in mm",
-    "workspace.ply": "workspace hull in mm, per-vertex metric values as properties",
-    "workspace.glb": "workspace hull, glTF binary in metres (y up), coloured by the metric",
     "slices.png": "horizontal sections",
 }
+
+
+def _what(name: str) -> str:
+    """The file table's description of an exported design's file: its own, a workspace hull
+    in a registered mesh format (the exporter's description), or a coloured slice picture."""
+    stem, _, fmt = name.rpartition(".")
+    ex = exporters("mesh").get(fmt)
+    if stem == "workspace" and ex is not None:
+        return "workspace hull, " + ex.description
+    return _FILES.get(name, "slices coloured by the metric" if name.endswith("_slices.png")
+                      else "")
 
 
 def _runs(out: Path) -> list[dict]:
@@ -95,10 +104,8 @@ def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
             "build_problem": problem, "slices": [], "files": [], "has_scene": False,
             "colour_options": [], "scene_note": ""}
     for name in info["files"]:
-        what = _FILES.get(name, "slices coloured by the metric" if name.endswith("_slices.png")
-                          else "")
         card["files"].append({"name": name, "href": f"designs/{entry['folder']}/{name}",
-                              "what": what})
+                              "what": _what(name)})
     card["files"].append({"name": "design.json", "href": f"designs/{entry['folder']}/"
                           "design.json", "what": _FILES["design.json"]})
     lay = info.get("slice_layout")

@@ -1,5 +1,5 @@
-"""Boundary meshes of workspaces by marching cubes on the stored signed field, and their
-files in each format's unit convention."""
+"""Boundary meshes of workspaces by marching cubes on the stored signed field; their files are
+written by the exporter registry (:mod:`pkmlab.export`), in each format's unit convention."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import write_bytes
+from ..export.meshes import STL_HEADER, TO_GLTF, stl_bytes
 
 __all__ = ["merged_mesh", "boundary_triangles", "stl_bytes", "write_mesh", "write_scene",
            "STL_HEADER"]
@@ -77,59 +78,13 @@ def merged_mesh(vertices: np.ndarray, faces: np.ndarray):
     return trimesh.Trimesh(vertices=vertices, faces=faces, process=True)
 
 
-def stl_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
-    """Binary STL of a triangle mesh (mm, stated in the header): float32 unit normals (zero
-    for a degenerate triangle) and vertices, as trimesh writes them, without importing trimesh
-    (0.5 s of a cold ``pkmlab workspace``, scipy.spatial included)."""
-    tri = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)]
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    length = np.linalg.norm(normal, axis=1)
-    ok = length > 0
-    normal[ok] /= length[ok, None]
-    normal[~ok] = 0.0
-    rec = np.zeros(len(tri), dtype=[("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)),
-                                    ("attributes", "<u2")])
-    rec["normal"] = normal
-    rec["vertices"] = tri
-    return STL_HEADER.ljust(80, b" ") + np.uint32(len(tri)).tobytes() + rec.tobytes()
-
-
-#: The 80-byte header of the binary STL files pkmlab writes (never starting with "solid").
-STL_HEADER = b"pkmlab workspace boundary; units: mm"
-
-
 def write_mesh(mesh, path, colors=None, values: dict | None = None) -> Path:
-    """Write ``mesh`` (mm) to ``path`` (.stl, .ply, .glb) atomically, in each format's unit.
+    """Write ``mesh`` (mm) to ``path`` atomically, in the registered format of its suffix
+    (:mod:`pkmlab.export`: .stl, .ply, .glb built in), each in its own unit convention;
+    ``colors`` and ``values`` go to the formats that take them."""
+    from ..export import write
 
-    STL: binary, mm, the unit stated in the 80-byte header. PLY: binary, mm (a ``comment
-    units mm`` header line), vertex colours and ``values`` (``{name: (n_vertices,)}``) as
-    float32 vertex properties. GLB: glTF's convention, metres and +y up (x, y, z → x, z, -y).
-    """
-    path = Path(path)
-    suffix = path.suffix.lower()
-    mesh = mesh.copy()
-    if colors is not None:
-        mesh.visual.vertex_colors = colors
-    if suffix == ".stl":
-        data = mesh.export(file_type="stl")
-        data = STL_HEADER.ljust(80, b" ") + data[80:]
-    elif suffix == ".ply":
-        for name, v in (values or {}).items():
-            v = np.asarray(v, dtype=np.float32)
-            if v.shape != (len(mesh.vertices),):
-                raise ValueError(f"vertex values {name!r}: shape {v.shape}, expected "
-                                 f"({len(mesh.vertices)},)")
-            mesh.vertex_attributes[name] = v
-        data = mesh.export(file_type="ply", encoding="binary")
-        head, sep, rest = data.partition(b"\n")            # "ply"
-        fmt, sep2, rest = rest.partition(b"\n")            # "format ..."
-        data = head + sep + fmt + sep2 + b"comment units mm\n" + rest
-    elif suffix == ".glb":
-        mesh.apply_transform([[1e-3, 0, 0, 0], [0, 0, 1e-3, 0], [0, -1e-3, 0, 0], [0, 0, 0, 1]])
-        data = mesh.export(file_type="glb")
-    else:
-        raise ValueError(f"mesh format {suffix!r}: use .stl, .ply or .glb")
-    return write_bytes(path, data)
+    return write(mesh, path, colors=colors, values=values)
 
 
 def write_scene(parts: dict, path) -> Path:
@@ -139,10 +94,9 @@ def write_scene(parts: dict, path) -> Path:
     import trimesh
 
     scene = trimesh.Scene()
-    to_gltf = [[1e-3, 0, 0, 0], [0, 0, 1e-3, 0], [0, -1e-3, 0, 0], [0, 0, 0, 1]]
     for name, (mesh, colour) in parts.items():
         m = mesh.copy()
         m.visual = trimesh.visual.ColorVisuals(m, face_colors=np.tile(colour, (len(m.faces), 1)))
-        m.apply_transform(to_gltf)
+        m.apply_transform(TO_GLTF)
         scene.add_geometry(m, node_name=name, geom_name=name)
     return write_bytes(Path(path), scene.export(file_type="glb"))

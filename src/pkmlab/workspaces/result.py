@@ -12,10 +12,10 @@ import math
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import ParameterError
 from .field import interval_field
 
 __all__ = ["WorkspaceResult"]
@@ -273,24 +273,21 @@ class WorkspaceResult:
         return self._boundary.copy()
 
     def save_mesh(self, path, colors=None, values: dict | None = None) -> Path:
-        """Write the boundary mesh; the format follows the suffix (.stl, .ply, .glb).
+        """Write the boundary mesh; the format follows the suffix, one of the mesh formats of
+        :data:`pkmlab.export.EXPORTERS` (.stl, .ply, .glb built in).
 
         Each format's unit convention: STL in mm (stated in its header), PLY in mm (stated
         in a header comment) with ``values`` — ``{name: (n_vertices,) array}`` for the
         vertices of :meth:`mesh` — as float vertex properties, glTF binary in metres and
-        y up. ``colors``: ``(n_vertices, 4)`` uint8 vertex colours (PLY, GLB). An STL is
-        written straight from the marching-cubes triangles (no trimesh import: cold start).
+        y up. ``colors``: ``(n_vertices, 4)`` uint8 vertex colours (PLY, GLB). A format that
+        needs no trimesh (STL) is written straight from the marching-cubes triangles (no
+        trimesh import: cold start).
         """
-        from ..atomic import write_bytes
-        from .mesh import stl_bytes, write_mesh
+        from ..export import exporter_for, write
 
-        path = Path(path)
-        suffix = path.suffix.lower()
-        if suffix not in (".stl", ".ply", ".glb"):
-            raise ParameterError("mesh file", "a .stl, .ply or .glb path", str(path))
-        if suffix == ".stl":
-            return write_bytes(path, stl_bytes(*self._triangles))
-        return write_mesh(self.mesh(), path, colors=colors, values=values)
+        ex = exporter_for(path)
+        subject = self.mesh() if ex.trimesh else _Triangles(*self._triangles)
+        return write(subject, path, colors=colors, values=values)
 
     def plot_slices(self, path, window: float | None = None, spacing: float | None = None,
                     centre: tuple[float, float] | None = None, columns: int | None = None,
@@ -313,3 +310,10 @@ class WorkspaceResult:
         from .inscribed import inscribed_cylinder
 
         return inscribed_cylinder(self, **kw)
+
+
+class _Triangles(NamedTuple):
+    """Vertices (mm) and faces of a boundary, for exporters that need no trimesh."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
