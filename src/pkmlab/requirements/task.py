@@ -3,29 +3,42 @@
 A :class:`TaskRegion` is a set of tool positions in mm, given relative to the base frame or to
 the nominal pose's position (``frame``). :func:`task_contained` decides whether *every* position
 of the region works at *every* orientation of an :class:`~pkmlab.workspaces.OrientationSet`
-(relative to the nominal orientation, sampled exactly as the workspace engine samples it), and
-:func:`task_margins` measures how much room is left, in mm and in degrees.
+(relative to the nominal orientation), and :func:`task_margins` measures how much room is
+left, in mm and in degrees.
 
 Method (``TaskCheck.method``):
 
 * ``exact`` — families with radial column intervals (``Mechanism.column_radial``: ``psu6``,
-  ``ups6``). At one orientation, leg i admits along the column ``(x, y)`` the z interval
-  ``[a_i(d), b_i(d)]`` (the workspace engine's ``column_leg``), where ``d`` is the horizontal
-  distance from the leg's column axis ``-w_i,xy`` (``w_i = R·u_i - b_i``) and ``a_i``, ``b_i``
+  ``ups6``): proved over the continuous region *and* the continuous orientation set. At one
+  orientation, leg i admits along the column ``(x, y)`` the z interval ``[a_i(d), b_i(d)]``
+  (the workspace engine's ``column_leg``), where ``d`` is the horizontal distance from the
+  leg's column axis ``-w_i,xy`` (``w_i = R·u_i - b_i``) and ``a_i + w_i,z``, ``b_i + w_i,z``
   and the existence flag are monotone in ``d``. A box or cylinder task with z extent
   ``[z0, z1]`` and footprint ``F`` is inside leg i's set iff it is at the two extreme
   distances ``d_min = dist(-w_i,xy, F)`` and ``d_max = max dist(-w_i,xy, F)``: the worst ends
-  of monotone functions over ``[d_min, d_max]`` are at the ends. So containment is decided over
-  the *continuous* footprint — no x-y grid, no sampling of the task — and is exact for the
-  sampled orientation set (the same samples as the dexterous workspace; denser ``samples``
-  converge to the continuous set). A point set is a set of zero-size boxes.
+  of monotone functions over ``[d_min, d_max]`` are at the ends. So the footprint is never
+  sampled. Orientations: the set is covered by the orientation cells of
+  :mod:`pkmlab.workspaces.cells` (as for the volume brackets); on a cell of angle bound α,
+  ``w_i`` stays within ``r_i = 2 sin(α/2)·|u_i|`` of its value at the cell's centre, so the
+  axis moves by at most ``r_i`` (distances in ``[d_min - r_i, d_max + r_i]``) and the ends by
+  at most ``r_i``: the leg is *proved* on the whole cell if ``max a + r_i <= z0`` and
+  ``min b - r_i >= z1`` at those widened distances (and it exists at the larger). A cell
+  whose centre rotation fails the task *refutes* it (the rotation is in the set; so does the
+  set's sample, checked first); any other cell is split (:func:`.cells.split`) until every
+  cell is proved (``contained``) or one is refuted (``not contained``). Past
+  ``CELL_BUDGET`` cells or cells narrower than ``MIN_CELL_RAD`` the answer is ``undecided``
+  (``contained`` False, with a note): never a containment that is not proved. A point set is a
+  set of zero-size boxes.
 * ``sampled`` — other families (``luzi3``) or workspace constraints beyond the stroke
   (joint limits, link diameter, κ): the task is sampled on a grid of spacing at most the
   resolution h, boundary included, and every sample is checked by inverse kinematics at every
   orientation. Stated error: a failure inside a gap of the sample grid can be missed; any
   missed region lies within h·√3/2 mm of a checked sample.
 
-Margins (:func:`task_margins`, the largest verified level of a bisection, kind ``bound``):
+Margins (:func:`task_margins`, the largest verified level of a bisection, kind ``bound``; with
+the ``exact`` method every level is decided over the continuous orientation set, so the lower
+end is proved; a level left ``undecided`` counts as not contained, and the note says that the
+upper end of that bracket is then not proved):
 
 * ``margin_mm`` — the largest δ such that the task grown by δ (box half-sizes + δ, cylinder
   radius and half-height + δ, each point a cube of half-size δ) is contained: a lower bound of
@@ -50,13 +63,19 @@ import numpy as np
 from ..errors import ParameterError
 from ..mechanisms._kernels import make_leg_eval
 from ..poses import as_frames, matrix_to_euler
+from ..workspaces import cells as oc
 from ..workspaces.constraints import Constraints, check
+from ..workspaces.legbounds import EPS
 from ..workspaces.orientations import OrientationSet
 
 __all__ = ["TaskRegion", "TaskCheck", "task_contained", "task_margins", "task_mesh",
            "task_outline", "MARGIN_TOL_MM", "ORIENTATION_TOL_DEG"]
 
 MARGIN_TOL_MM = 0.01
+#: orientation cells of one exact check (all levels together), and the smallest cell
+#: half-width (rad): below either the check says "undecided"
+CELL_BUDGET = 200_000
+MIN_CELL_RAD = 1e-7
 ORIENTATION_TOL_DEG = 0.01
 _SHAPES = ("box", "cylinder", "points")
 _FRAMES = ("nominal", "base")
@@ -149,7 +168,11 @@ class TaskCheck:
 
     ``contained``; ``method`` (``exact`` or ``sampled``); ``resolution`` (mm, the sample
     spacing of the ``sampled`` method, 0 for ``exact``); ``orientations`` (samples used);
-    ``failures`` (count of failing leg × orientation extremes or samples); ``note``.
+    ``failures`` (count of failing leg × orientation extremes or samples); ``note``;
+    ``status`` — ``contained`` (``exact``: proved over the continuous orientation set),
+    ``not contained`` (a rotation of the set fails it) or ``undecided`` (``exact``: orientation
+    cells left undecided at the budget; ``contained`` is then False); ``cells`` (orientation
+    cells of the ``exact`` proof) and ``undecided`` (cells left open).
     """
 
     contained: bool
@@ -158,6 +181,14 @@ class TaskCheck:
     orientations: int
     failures: int
     note: str = ""
+    status: str = ""
+    cells: int = 0
+    undecided: int = 0
+
+    def __post_init__(self):
+        if not self.status:
+            object.__setattr__(self, "status",
+                               "contained" if self.contained else "not contained")
 
 
 # ---- exact check on radial column families ---------------------------------------------------
@@ -177,14 +208,17 @@ def _legs_at(mech, W, dmin, dmax):
     return a.reshape(shape), b.reshape(shape), ok.reshape(shape)
 
 
-def _exact_fail(mech, R, task: TaskRegion, grow: float = 0.0) -> np.ndarray:
-    """``(B, M, 6)`` True where leg × orientation fails some part of the task."""
+def _exact_fail(mech, R, task: TaskRegion, grow: float = 0.0, r=None) -> np.ndarray:
+    """``(B, M, 6)`` True where leg × orientation fails some part of the task. With ``r (M,
+    6)``: where the leg is not *proved* to hold the task at every rotation whose offset ``w_i``
+    lies within ``r`` of its value at ``R`` (the column axis ``-w_i,xy`` and the shift
+    ``-w_i,z`` each move by at most ``r``: the distances widen by ``r``, the ends by ``r``)."""
     W = mech.leg_offsets(R)                                     # (M, 6, 3)
     axis = -W[..., :2]                                          # column axes (M, 6, 2)
     if task.shape == "cylinder":
-        c, r, hz = task.cylinder(mech, grow)
+        c, rad, hz = task.cylinder(mech, grow)
         dc = np.linalg.norm(axis - c[:2], axis=-1)[None]        # (1, M, 6)
-        dmin, dmax = np.maximum(dc - r, 0.0), dc + r
+        dmin, dmax = np.maximum(dc - rad, 0.0), dc + rad
         z0, z1 = np.array([c[2] - hz]), np.array([c[2] + hz])
     else:
         lo, hi = task.boxes(mech, grow)                         # (B, 3)
@@ -193,11 +227,54 @@ def _exact_fail(mech, R, task: TaskRegion, grow: float = 0.0) -> np.ndarray:
         far = np.maximum(np.abs(axis - l), np.abs(h - axis))
         dmin, dmax = np.linalg.norm(gap, axis=-1), np.linalg.norm(far, axis=-1)
         z0, z1 = lo[:, 2], hi[:, 2]
+    rr = 0.0 if r is None else r[None]                          # (1, M, 6)
+    if r is not None:
+        dmin, dmax = np.maximum(dmin - rr, 0.0), dmax + rr
     a, b, ok = _legs_at(mech, W, dmin, dmax)
     z0 = z0[None, :, None, None]
     z1 = z1[None, :, None, None]
-    good = ok & (a <= z0) & (b >= z1)
+    good = ok & (a + rr + EPS <= z0) & (b - rr - EPS >= z1) if r is not None else \
+        ok & (a <= z0) & (b >= z1)
     return ~np.all(good, axis=0)
+
+
+def _exact_cells(mech, oset: OrientationSet, task: TaskRegion, grow: float = 0.0
+                 ) -> TaskCheck:
+    """Containment over the continuous orientation set (module notes): the sample first
+    (a failure there is a proof), then orientation cells (:mod:`pkmlab.workspaces.cells`),
+    each proved, refuted at its centre, or split."""
+    R = oset.rotations()
+    n = int(_exact_fail(mech, R, task, grow).sum())
+    if n:
+        return TaskCheck(False, "exact", 0.0, len(R), n, status="not contained")
+    C, H = oc.initial_cells(oset, 1)
+    unorm = np.linalg.norm(mech.tool_points, axis=1)            # (6,)
+    cells = 0
+    # cells per call: about a million leg evaluations (a point set has one box per point)
+    chunk = max(1, 1_000_000 // (12 * max(len(task.points) if task.shape == "points" else 1,
+                                          1)))
+    while len(C):
+        cells += len(C)
+        keep = np.zeros(len(C), bool)
+        for s in range(0, len(C), chunk):
+            Rc = oset.rotations_at(C[s:s + chunk])
+            fail0 = _exact_fail(mech, Rc, task, grow)
+            if fail0.any():
+                return TaskCheck(False, "exact", 0.0, len(R) + cells, int(fail0.sum()),
+                                 status="not contained", cells=cells)
+            r = oc.chord(oc.angle_bound(oset, C[s:s + chunk], H[s:s + chunk]))[:, None] * unorm
+            keep[s:s + chunk] = _exact_fail(mech, Rc, task, grow, r).any(axis=(0, 2))
+        C, H = C[keep], H[keep]
+        if not len(C):
+            break
+        if cells + 8 * len(C) > CELL_BUDGET or np.max(H) < MIN_CELL_RAD:
+            return TaskCheck(False, "exact", 0.0, len(R) + cells, 0, status="undecided",
+                             cells=cells, undecided=len(C),
+                             note=f"not proved: {len(C)} orientation cell(s) undecided after "
+                                  f"{cells:,} cells (budget {CELL_BUDGET:,}); no sampled "
+                                  "orientation fails")
+        C, H, _ = oc.split(C, H)
+    return TaskCheck(True, "exact", 0.0, len(R) + cells, 0, status="contained", cells=cells)
 
 
 # ---- sampled fallback ------------------------------------------------------------------------
@@ -267,9 +344,7 @@ def _check(mech, oset, task, resolution, cons, grow=0.0, surface=False) -> TaskC
     exact = bool(getattr(mech, "column_radial", False)) and mech.column_method \
         is not None and not cons.extra
     if exact:
-        fail = _exact_fail(mech, R, task, grow)
-        n = int(fail.sum())
-        return TaskCheck(n == 0, "exact", 0.0, len(R), n)
+        return _exact_cells(mech, oset, task, grow)
     why = ("no radial column intervals for family " + repr(mech.family)) if not cons.extra \
         else "constraints beyond the stroke"
     n = _sampled_fail(mech, R, task, resolution, cons, grow, surface)
@@ -299,13 +374,14 @@ def _widened(oset: OrientationSet, delta: float) -> OrientationSet:
             return oset
         return OrientationSet.box((delta,) * 3, "simultaneous", oset.samples,
                                   centre=tuple(np.asarray(oset.centre) + oset.angles))
+    # widened within the set's own limits (box and torsion 180°, tilt 90°)
     if oset.kind == "box":
-        return dataclasses.replace(oset, angles=tuple(max(a + delta, 0.0) if a > 0 else a
-                                                      for a in oset.angles))
-    return dataclasses.replace(oset, tilt=max(oset.tilt + delta, 0.0) if oset.tilt > 0
-                               else oset.tilt,
-                               torsion=max(oset.torsion + delta, 0.0) if oset.torsion > 0
-                               else oset.torsion)
+        return dataclasses.replace(oset, angles=tuple(min(max(a + delta, 0.0), math.pi)
+                                                      if a > 0 else a for a in oset.angles))
+    return dataclasses.replace(oset, tilt=min(max(oset.tilt + delta, 0.0), math.pi / 2)
+                               if oset.tilt > 0 else oset.tilt,
+                               torsion=min(max(oset.torsion + delta, 0.0), math.pi)
+                               if oset.torsion > 0 else oset.torsion)
 
 
 def _bisect(ok, lo: float, hi: float, tol: float) -> tuple[float, float]:
@@ -335,8 +411,15 @@ def task_margins(mech, task: TaskRegion, orientations: OrientationSet | None = N
     tol = max(MARGIN_TOL_MM, resolution / 4) if surface else MARGIN_TOL_MM
     otol = 10 * ORIENTATION_TOL_DEG if surface else ORIENTATION_TOL_DEG
 
+    open_levels: dict = {"task_margin": 0, "task_orientation_margin": 0}
+
+    def decided(c: TaskCheck, key: str) -> bool:
+        open_levels[key] += c.status == "undecided"
+        return c.contained
+
     def fits(g):
-        return _check(mech, oset, task, resolution, cons, grow=g, surface=surface).contained
+        return decided(_check(mech, oset, task, resolution, cons, grow=g, surface=surface),
+                       "task_margin")
 
     if base.contained:
         cap = max_growth if max_growth is not None else 2.0 * mech.scale
@@ -362,8 +445,8 @@ def task_margins(mech, task: TaskRegion, orientations: OrientationSet | None = N
                                     "the task's centre is outside the workspace")
 
     def ofits(d_deg):
-        return _check(mech, _widened(oset, math.radians(d_deg)), task, resolution, cons,
-                      surface=surface).contained
+        return decided(_check(mech, _widened(oset, math.radians(d_deg)), task, resolution,
+                              cons, surface=surface), "task_orientation_margin")
 
     if base.contained:
         if ofits(90.0):
@@ -382,6 +465,11 @@ def task_margins(mech, task: TaskRegion, orientations: OrientationSet | None = N
             out["orientation_margin_deg"] = out["orientation_bracket_deg"] = None
             notes["task_orientation_margin"] = "the task does not fit even at the centre " \
                 "orientation"
+    for key, n in open_levels.items():
+        if n:
+            notes[key] = (notes[key] + "; " if key in notes else "") + (
+                f"{n} level(s) undecided (orientation cell budget {CELL_BUDGET:,}) counted as "
+                "not contained: the margin is proved, the upper end of its bracket is not")
     return out
 
 
