@@ -72,10 +72,12 @@ __all__ = ["TaskRegion", "TaskCheck", "task_contained", "task_margins", "task_me
            "task_outline", "MARGIN_TOL_MM", "ORIENTATION_TOL_DEG"]
 
 MARGIN_TOL_MM = 0.01
-#: orientation cells of one exact check (all levels together), and the smallest cell
-#: half-width (rad): below either the check says "undecided"
-CELL_BUDGET = 200_000
+#: items (orientation cell × task part) of one exact check, all levels together, and the
+#: smallest cell half-width (rad): past either the check says "undecided"
+CELL_BUDGET = 1_000_000
 MIN_CELL_RAD = 1e-7
+#: items per evaluation (about 70 MB of temporaries)
+_CHUNK = 100_000
 ORIENTATION_TOL_DEG = 0.01
 _SHAPES = ("box", "cylinder", "points")
 _FRAMES = ("nominal", "base")
@@ -195,85 +197,111 @@ class TaskCheck:
 
 
 def _legs_at(mech, W, dmin, dmax):
-    """Intervals of every leg at ``dmin`` and ``dmax``: ``W (M, 6, 3)``, ``d* (B, M, 6)`` →
-    ``(a, b, ok)`` each ``(2, B, M, 6)``."""
-    B = dmin.shape[0]
+    """Intervals of every leg at ``dmin`` and ``dmax``: ``W (K, 6, 3)``, ``d* (K, 6)`` →
+    ``(a, b, ok)`` each ``(2, K, 6)``."""
     D = np.stack([dmin, dmax]).ravel()
-    Wf = np.ascontiguousarray(np.broadcast_to(W, (2, B) + W.shape).reshape(-1, 3))
+    Wf = np.ascontiguousarray(np.broadcast_to(W, (2,) + W.shape).reshape(-1, 3))
     P = np.asarray(mech.column_params(), dtype=float)
-    Pf = np.ascontiguousarray(np.broadcast_to(P, (2, B, W.shape[0], 6, 3)).reshape(-1, 3))
+    Pf = np.ascontiguousarray(np.broadcast_to(P, (2,) + W.shape).reshape(-1, 3))
     # the leg's interval on the column at horizontal distance D along its own x axis
     a, b, ok = make_leg_eval(type(mech).column_leg)(D - Wf[:, 0], -Wf[:, 1], Wf, Pf)
-    shape = (2, B) + W.shape[:2]
+    shape = (2,) + W.shape[:2]
     return a.reshape(shape), b.reshape(shape), ok.reshape(shape)
 
 
-def _exact_fail(mech, R, task: TaskRegion, grow: float = 0.0, r=None) -> np.ndarray:
-    """``(B, M, 6)`` True where leg × orientation fails some part of the task. With ``r (M,
-    6)``: where the leg is not *proved* to hold the task at every rotation whose offset ``w_i``
-    lies within ``r`` of its value at ``R`` (the column axis ``-w_i,xy`` and the shift
-    ``-w_i,z`` each move by at most ``r``: the distances widen by ``r``, the ends by ``r``)."""
-    W = mech.leg_offsets(R)                                     # (M, 6, 3)
-    axis = -W[..., :2]                                          # column axes (M, 6, 2)
-    if task.shape == "cylinder":
-        c, rad, hz = task.cylinder(mech, grow)
-        dc = np.linalg.norm(axis - c[:2], axis=-1)[None]        # (1, M, 6)
+def _parts(mech, task: TaskRegion, grow: float):
+    """The task as base-frame boxes ``(lo (B, 3), hi (B, 3))`` or, for a cylinder, one
+    ``(centre, radius, half height)``."""
+    return task.cylinder(mech, grow) if task.shape == "cylinder" else task.boxes(mech, grow)
+
+
+def _fail_items(mech, W, parts, bid, r=None) -> np.ndarray:
+    """``(K, 6)`` True where leg i at offsets ``W (K, 6, 3)`` fails the task part ``bid
+    (K,)``. With ``r (K, 6)``: where the leg is not *proved* to hold it at every rotation
+    whose offset ``w_i`` lies within ``r`` of ``W`` (the column axis ``-w_i,xy`` and the
+    shift ``-w_i,z`` each move by at most ``r``: the distances widen by ``r``, the ends by
+    ``r``)."""
+    axis = -W[..., :2]                                          # column axes (K, 6, 2)
+    if len(parts) == 3:                                         # cylinder
+        c, rad, hz = parts
+        dc = np.linalg.norm(axis - c[:2], axis=-1)
         dmin, dmax = np.maximum(dc - rad, 0.0), dc + rad
-        z0, z1 = np.array([c[2] - hz]), np.array([c[2] + hz])
+        z0, z1 = np.full(len(W), c[2] - hz), np.full(len(W), c[2] + hz)
     else:
-        lo, hi = task.boxes(mech, grow)                         # (B, 3)
-        l, h = lo[:, None, None, :2], hi[:, None, None, :2]
+        lo, hi = parts[0][bid], parts[1][bid]                   # (K, 3)
+        l, h = lo[:, None, :2], hi[:, None, :2]
         gap = np.maximum(np.maximum(l - axis, axis - h), 0.0)
         far = np.maximum(np.abs(axis - l), np.abs(h - axis))
         dmin, dmax = np.linalg.norm(gap, axis=-1), np.linalg.norm(far, axis=-1)
         z0, z1 = lo[:, 2], hi[:, 2]
-    rr = 0.0 if r is None else r[None]                          # (1, M, 6)
+    rr = 0.0 if r is None else r
     if r is not None:
         dmin, dmax = np.maximum(dmin - rr, 0.0), dmax + rr
     a, b, ok = _legs_at(mech, W, dmin, dmax)
-    z0 = z0[None, :, None, None]
-    z1 = z1[None, :, None, None]
-    good = ok & (a + rr + EPS <= z0) & (b - rr - EPS >= z1) if r is not None else \
-        ok & (a <= z0) & (b >= z1)
+    pad = 0.0 if r is None else rr + EPS
+    good = ok & (a + pad <= z0[None, :, None]) & (b - pad >= z1[None, :, None])
     return ~np.all(good, axis=0)
+
+
+def _exact_fail(mech, R, task: TaskRegion, grow: float = 0.0) -> np.ndarray:
+    """``(B, M, 6)`` True where leg × orientation ``R (M, 3, 3)`` fails task part B."""
+    parts = _parts(mech, task, grow)
+    nb = 1 if task.shape == "cylinder" else len(parts[0])
+    W = mech.leg_offsets(R)
+    bid = np.repeat(np.arange(nb), len(R))
+    return _fail_items(mech, np.tile(W, (nb, 1, 1)), parts, bid).reshape(nb, len(R), 6)
 
 
 def _exact_cells(mech, oset: OrientationSet, task: TaskRegion, grow: float = 0.0
                  ) -> TaskCheck:
     """Containment over the continuous orientation set (module notes): the sample first
-    (a failure there is a proof), then orientation cells (:mod:`pkmlab.workspaces.cells`),
-    each proved, refuted at its centre, or split."""
+    (a failure there is a proof), then items (orientation cell × task part; a cylinder is
+    one part, a box one, a point set one per point), each proved, refuted at its cell's
+    centre, or split with the cell (:func:`pkmlab.workspaces.cells.split`)."""
     R = oset.rotations()
     n = int(_exact_fail(mech, R, task, grow).sum())
     if n:
         return TaskCheck(False, "exact", 0.0, len(R), n, status="not contained")
+    parts = _parts(mech, task, grow)
+    nb = 1 if task.shape == "cylinder" else len(parts[0])
     C, H = oc.initial_cells(oset, 1)
+    cid, bid = np.repeat(np.arange(len(C)), nb), np.tile(np.arange(nb), len(C))
     unorm = np.linalg.norm(mech.tool_points, axis=1)            # (6,)
-    cells = 0
-    # cells per call: about a million leg evaluations (a point set has one box per point)
-    chunk = max(1, 1_000_000 // (12 * max(len(task.points) if task.shape == "points" else 1,
-                                          1)))
-    while len(C):
+    cells = items = 0
+    while len(cid):
         cells += len(C)
-        keep = np.zeros(len(C), bool)
-        for s in range(0, len(C), chunk):
-            Rc = oset.rotations_at(C[s:s + chunk])
-            fail0 = _exact_fail(mech, Rc, task, grow)
+        items += len(cid)
+        W = mech.leg_offsets(oset.rotations_at(C))              # (L, 6, 3)
+        r = oc.chord(oc.angle_bound(oset, C, H))[:, None] * unorm
+        keep = np.zeros(len(cid), bool)
+        for s in range(0, len(cid), _CHUNK):
+            c, bb = cid[s:s + _CHUNK], bid[s:s + _CHUNK]
+            fail0 = _fail_items(mech, W[c], parts, bb)
             if fail0.any():
                 return TaskCheck(False, "exact", 0.0, len(R) + cells, int(fail0.sum()),
                                  status="not contained", cells=cells)
-            r = oc.chord(oc.angle_bound(oset, C[s:s + chunk], H[s:s + chunk]))[:, None] * unorm
-            keep[s:s + chunk] = _exact_fail(mech, Rc, task, grow, r).any(axis=(0, 2))
-        C, H = C[keep], H[keep]
-        if not len(C):
+            keep[s:s + _CHUNK] = _fail_items(mech, W[c], parts, bb, r[c]).any(axis=1)
+        cid, bid = cid[keep], bid[keep]
+        if not len(cid):
             break
-        if cells + 8 * len(C) > CELL_BUDGET or np.max(H) < MIN_CELL_RAD:
+        if items + 8 * len(cid) > CELL_BUDGET or np.max(H) < MIN_CELL_RAD:
             return TaskCheck(False, "exact", 0.0, len(R) + cells, 0, status="undecided",
-                             cells=cells, undecided=len(C),
-                             note=f"not proved: {len(C)} orientation cell(s) undecided after "
-                                  f"{cells:,} cells (budget {CELL_BUDGET:,}); no sampled "
-                                  "orientation fails")
-        C, H, _ = oc.split(C, H)
+                             cells=cells, undecided=len(cid),
+                             note=f"not proved: {len(cid)} orientation cell × task part "
+                                  f"item(s) undecided after {items:,} items (budget "
+                                  f"{CELL_BUDGET:,}); no sampled orientation fails")
+        # the open cells' children inherit their parent's open parts
+        live, cid = np.unique(cid, return_inverse=True)
+        C, H = C[live], H[live]
+        order = np.argsort(cid, kind="stable")
+        cid, bid = cid[order], bid[order]
+        counts = np.bincount(cid, minlength=len(C))
+        first = np.cumsum(counts) - counts
+        C, H, par = oc.split(C, H)
+        cnt = counts[par]
+        off = np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        bid = bid[np.repeat(first[par], cnt) + off]
+        cid = np.repeat(np.arange(len(C)), cnt)
     return TaskCheck(True, "exact", 0.0, len(R) + cells, 0, status="contained", cells=cells)
 
 
