@@ -125,11 +125,16 @@ def fk(mech_file: MechArg,
     mech = _load(mech_file)
     q = _parse_actuators(mech, actuators)
     g = None if guess is None else _parse_pose(guess, "--guess")
-    res = mech.forward(q, g)
+    res = mech.forward(q, g, modes=True)
+    amb = bool(res.ambiguous[0])
     data = {"actuator_unit": _act_unit(mech), "actuators": _act_json(mech, q),
             "pose": _pose_json(res.pose[0]),
             "converged": bool(res.converged[0]), "residual_mm": float(res.residual[0]),
-            "iterations": int(res.iterations[0]), "status": str(res.status[0])}
+            "iterations": int(res.iterations[0]), "status": str(res.status[0]),
+            "ambiguous": amb, "mode_starts": int(res.mode_starts),
+            "next_mode": {"pose": _pose_json(res.next_mode[0]),
+                          "distance_mm": float(res.next_mode_mm[0]),
+                          "angle_deg": float(res.next_mode_deg[0])} if amb else None}
     if all_modes:
         modes = mech.assembly_modes(q, starts=starts, seed=seed)
         data["assembly_modes"] = [
@@ -144,6 +149,14 @@ def fk(mech_file: MechArg,
               f"{res.status[0]}[/] after {res.iterations[0]} iterations, "
               f"residual {res.residual[0]:.3g} mm")
     out.print(f"pose: {_pose_str(res.pose[0])}")
+    if amb:
+        out.print(f"[yellow]ambiguous[/]: another working-mode assembly mode has the same "
+                  f"actuator values, {res.next_mode_mm[0]:.4g} mm and "
+                  f"{res.next_mode_deg[0]:.4g}° away: {_pose_str(res.next_mode[0])} "
+                  "(--all lists every mode found)")
+    elif res.converged[0]:
+        out.print(f"no other working-mode assembly mode reached from {res.mode_starts} starts "
+                  "in the working region (a search, not a proof; --all searches wider)")
     if all_modes:
         table = Table("#", "x (mm)", "y (mm)", "z (mm)", "θx (deg)", "θy (deg)", "θz (deg)",
                       "residual (mm)", "working mode",

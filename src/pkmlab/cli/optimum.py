@@ -101,14 +101,17 @@ def capability(
         b = orientation_capability(mech, samples)
     except ParameterError as exc:
         _fail(exc, _OPTIONS)
+    certified = bool(np.all(np.isfinite(b.point)))
     if as_json:
         _emit(b.as_dict() | {"mechanism": mech.name, "family": mech.family,
                              "upper": None if math.isinf(b.upper) else b.upper,
-                             "width": None if math.isinf(b.upper) else b.width})
+                             "width": None if math.isinf(b.upper) else b.width,
+                             "point": list(b.point) if certified else None})
         return
     x, y, z = b.point
     _lines(b, f"{escape(mech.name or mech.family)}: orientation capability (largest ±a "
            "simultaneous Euler box with a dexterous position)",
            f"  a in [{b.lower:.4f}, {b.upper:.4f}] deg (width {b.width:.4f} deg; "
-           f"{samples}³ grid alone: {b.sampled:.4f} deg)\n"
-           f"  certified point ({x:.4f}, {y:.4f}, {z:.4f}) mm")
+           f"{samples}³ grid alone: {b.sampled:.4f} deg)\n" +
+           (f"  certified point for the ±{b.lower:.4f}° box ({x:.4f}, {y:.4f}, {z:.4f}) mm"
+            if certified else "  no certified point (see the note)"))

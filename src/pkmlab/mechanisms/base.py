@@ -78,6 +78,9 @@ from .solvers import bracketed_root, forward_newton, multistart_modes
 
 log = logging.getLogger(__name__)
 
+#: starting poses of the forward-kinematics mode check (``forward(..., modes=True)``)
+_MODE_STARTS = 64
+
 __all__ = [
     "NO_STROKE",
     "LEG_STATUS",
@@ -491,7 +494,8 @@ class Mechanism:
         return J if mob.is_spatial else np.ascontiguousarray(J[:, :, mob.twist_columns])
 
     def forward(self, q: np.ndarray, guess: np.ndarray | None = None, *,
-                tol: float = TOL.fk_residual_mm, max_iter: int = 50) -> FKResult:
+                tol: float = TOL.fk_residual_mm, max_iter: int = 50,
+                modes: bool = False) -> FKResult:
         """Forward kinematics by Newton's method with the analytic Jacobian.
 
         Args:
@@ -500,8 +504,15 @@ class Mechanism:
                 Newton from the guess fails or lands outside the working mode, the solve is
                 repeated by continuation from the nominal pose along a straight actuator path.
             tol: convergence tolerance on the loop-closure residual in mm.
+            modes: also look for *other* working-mode assembly modes of the same actuator
+                values (several can lie near the start, e.g. on the Hexaglide, and Newton
+                then returns one of them with nothing to tell which): Newton from
+                :attr:`_mode_starts` (64 poses of the working region, about 1 ms per actuator
+                vector); the result's ``ambiguous``, ``next_mode``, ``next_mode_mm`` and
+                ``next_mode_deg`` say what was found, and ``status`` is ``"ambiguous"``.
+                Off by default (bulk use); ``pkmlab fk`` runs it.
         """
-        return forward_newton(self, q, guess, tol=tol, max_iter=max_iter)
+        return forward_newton(self, q, guess, tol=tol, max_iter=max_iter, modes=modes)
 
     def assembly_modes(self, q: np.ndarray, *, starts: int = 1500, seed: int = 0,
                        tol: float = TOL.fk_residual_mm) -> AssemblyModes:
@@ -569,6 +580,25 @@ class Mechanism:
 
         R = Rotation.random(n, random_state=rng).as_matrix()
         return p, R
+
+    @cached_property
+    def _mode_starts(self) -> tuple[np.ndarray, np.ndarray]:
+        """Starting poses of the FK mode check (``forward(..., modes=True)``): the nominal pose
+        and up to 63 random poses within the stroke, positions within ±scale/8 and Euler
+        angles within ±30° of the nominal pose (seeded; 20 batches of 4,096 draws at most)."""
+        X0 = np.asarray(self.nominal_pose, float)
+        rng = np.random.default_rng(20221)
+        span = np.array([self.scale / 8] * 3 + [np.radians(30.0)] * 3)
+        keep = [X0[None]]
+        count = 1
+        for _ in range(20):
+            X = X0 + rng.uniform(-1.0, 1.0, (4096, 6)) * span
+            X = X[self.inverse(X).valid][:_MODE_STARTS - count]
+            keep.append(X)
+            count += len(X)
+            if count >= _MODE_STARTS:
+                break
+        return as_frames(np.concatenate(keep))
 
     def _pose_distance(self, p: np.ndarray, R: np.ndarray) -> np.ndarray:
         pn, Rn = as_frames(self.nominal_pose)

@@ -59,7 +59,16 @@ class FKResult:
         converged: ``(N,)`` residual below tolerance in the mechanism's working mode.
         residual: ``(N,)`` largest loop-closure error in mm.
         iterations: ``(N,)`` Newton iterations used (continuation steps add up).
-        status: ``(N,)`` ``"ok"``, ``"not converged"`` or ``"singular"``.
+        status: ``(N,)`` ``"ok"``, ``"not converged"`` or ``"singular"``; with the mode check
+            (``forward(..., modes=True)``) ``"ambiguous"`` where the solution converged but
+            another working-mode assembly mode exists for the same actuator values.
+        ambiguous: ``(N,)`` True where another working-mode assembly mode was found by Newton
+            from the mode-check starts (:func:`pkmlab.mechanisms.solvers.other_modes`);
+            ``None`` when the check was not run.
+        next_mode: ``(N, 6)`` that mode nearest the solution (NaN where none was found).
+        next_mode_mm, next_mode_deg: ``(N,)`` its distance from the solution: position (mm)
+            and rotation angle (deg); inf where none was found.
+        mode_starts: starting poses of the mode check per actuator vector (0: not run).
     """
 
     pose: np.ndarray
@@ -67,6 +76,11 @@ class FKResult:
     residual: np.ndarray
     iterations: np.ndarray
     status: np.ndarray
+    ambiguous: np.ndarray | None = None
+    next_mode: np.ndarray | None = None
+    next_mode_mm: np.ndarray | None = None
+    next_mode_deg: np.ndarray | None = None
+    mode_starts: int = 0
 
 
 @dataclass(frozen=True)

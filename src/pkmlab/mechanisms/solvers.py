@@ -101,7 +101,7 @@ def _working_mode(mech, p, R, q, tol_mode: float) -> np.ndarray:
 
 
 def forward_newton(mech, q, guess=None, *, tol: float = TOL.fk_residual_mm, max_iter: int = 50,
-                   continuation_steps: int = 12) -> FKResult:
+                   continuation_steps: int = 12, modes: bool = False) -> FKResult:
     """Batched forward kinematics; see :meth:`Mechanism.forward`."""
     q = np.atleast_2d(np.asarray(q, dtype=float))
     L = mech.n_actuators
@@ -139,8 +139,48 @@ def forward_newton(mech, q, guess=None, *, tol: float = TOL.fk_residual_mm, max_
     pose = frames_to_poses(p, R)
     pose[~ok] = np.nan
     status = np.where(ok, "ok", np.where(np.isfinite(res), "not converged", "singular"))
+    if not modes:
+        return FKResult(pose=pose, converged=ok, residual=res, iterations=it,
+                        status=status.astype(object))
+    pa, Ra = mech._mode_starts
+    nxt, dmm, ddeg = other_modes(mech, q, p, R, ok, pa, Ra, tol=tol, tol_mode=tol_mode)
+    amb = np.isfinite(dmm)
+    status = np.where(amb, "ambiguous", status)
     return FKResult(pose=pose, converged=ok, residual=res, iterations=it,
-                    status=status.astype(object))
+                    status=status.astype(object), ambiguous=amb, next_mode=nxt,
+                    next_mode_mm=dmm, next_mode_deg=ddeg, mode_starts=len(pa))
+
+
+def other_modes(mech, q, p, R, ok, pa, Ra, *, tol: float, tol_mode: float):
+    """For each converged solution ``(p, R)`` of ``q``: the nearest *other* working-mode
+    assembly mode reached by Newton from the starts ``(pa (K, 3), Ra (K, 3, 3))`` (poses of the
+    working region, :attr:`Mechanism._mode_starts`) → ``(pose (N, 6), distance mm (N,), angle
+    deg (N,))``, NaN / inf where none was found. Two solutions closer than
+    ``TOL.mode_duplicate_rel`` (× scale in mm, and in rad) are one mode; "nearest" by
+    ``|Δp| + scale·angle``, as :meth:`Mechanism.assembly_modes` orders them. A heuristic
+    search: a mode no start reaches is missed (a check that can fail, not a proof)."""
+    n, k = len(q), len(pa)
+    nxt = np.full((n, 6), np.nan)
+    dmm, ddeg = np.full(n, np.inf), np.full(n, np.inf)
+    idx = np.flatnonzero(ok)
+    if idx.size == 0 or k == 0:
+        return nxt, dmm, ddeg
+    Q = np.repeat(q[idx], k, axis=0)
+    ps, Rs, res, _, _ = newton(mech, np.tile(pa, (idx.size, 1)), np.tile(Ra, (idx.size, 1, 1)),
+                               Q, tol=tol, max_iter=50)
+    good = (res < tol) & _working_mode(mech, ps, Rs, Q, tol_mode)
+    dp = np.linalg.norm(ps - np.repeat(p[idx], k, axis=0), axis=1)
+    da = np.linalg.norm(log_so3(np.einsum("nji,njk->nik", Rs, np.repeat(R[idx], k, axis=0))),
+                        axis=1)
+    same = (dp < TOL.mode_duplicate_rel * mech.scale) & (da < TOL.mode_duplicate_rel)
+    score = np.where(good & ~same, dp + mech.scale * da, np.inf).reshape(idx.size, k)
+    j = np.argmin(score, axis=1)
+    found = np.isfinite(score[np.arange(idx.size), j])
+    sel = np.arange(idx.size) * k + j
+    hit, s = idx[found], sel[found]
+    nxt[hit] = frames_to_poses(ps[s], Rs[s])
+    dmm[hit], ddeg[hit] = dp[s], np.degrees(da[s])
+    return nxt, dmm, ddeg
 
 
 def multistart_modes(mech, q, *, starts: int, seed: int, tol: float) -> AssemblyModes:

@@ -3,29 +3,42 @@
 A :class:`TaskRegion` is a set of tool positions in mm, given relative to the base frame or to
 the nominal pose's position (``frame``). :func:`task_contained` decides whether *every* position
 of the region works at *every* orientation of an :class:`~pkmlab.workspaces.OrientationSet`
-(relative to the nominal orientation, sampled exactly as the workspace engine samples it), and
-:func:`task_margins` measures how much room is left, in mm and in degrees.
+(relative to the nominal orientation), and :func:`task_margins` measures how much room is
+left, in mm and in degrees.
 
 Method (``TaskCheck.method``):
 
 * ``exact`` — families with radial column intervals (``Mechanism.column_radial``: ``psu6``,
-  ``ups6``). At one orientation, leg i admits along the column ``(x, y)`` the z interval
-  ``[a_i(d), b_i(d)]`` (the workspace engine's ``column_leg``), where ``d`` is the horizontal
-  distance from the leg's column axis ``-w_i,xy`` (``w_i = R·u_i - b_i``) and ``a_i``, ``b_i``
+  ``ups6``): proved over the continuous region *and* the continuous orientation set. At one
+  orientation, leg i admits along the column ``(x, y)`` the z interval ``[a_i(d), b_i(d)]``
+  (the workspace engine's ``column_leg``), where ``d`` is the horizontal distance from the
+  leg's column axis ``-w_i,xy`` (``w_i = R·u_i - b_i``) and ``a_i + w_i,z``, ``b_i + w_i,z``
   and the existence flag are monotone in ``d``. A box or cylinder task with z extent
   ``[z0, z1]`` and footprint ``F`` is inside leg i's set iff it is at the two extreme
   distances ``d_min = dist(-w_i,xy, F)`` and ``d_max = max dist(-w_i,xy, F)``: the worst ends
-  of monotone functions over ``[d_min, d_max]`` are at the ends. So containment is decided over
-  the *continuous* footprint — no x-y grid, no sampling of the task — and is exact for the
-  sampled orientation set (the same samples as the dexterous workspace; denser ``samples``
-  converge to the continuous set). A point set is a set of zero-size boxes.
+  of monotone functions over ``[d_min, d_max]`` are at the ends. So the footprint is never
+  sampled. Orientations: the set is covered by the orientation cells of
+  :mod:`pkmlab.workspaces.cells` (as for the volume brackets); on a cell of angle bound α,
+  ``w_i`` stays within ``r_i = 2 sin(α/2)·|u_i|`` of its value at the cell's centre, so the
+  axis moves by at most ``r_i`` (distances in ``[d_min - r_i, d_max + r_i]``) and the ends by
+  at most ``r_i``: the leg is *proved* on the whole cell if ``max a + r_i <= z0`` and
+  ``min b - r_i >= z1`` at those widened distances (and it exists at the larger). A cell
+  whose centre rotation fails the task *refutes* it (the rotation is in the set; so does the
+  set's sample, checked first); any other cell is split (:func:`.cells.split`) until every
+  cell is proved (``contained``) or one is refuted (``not contained``). Past
+  ``CELL_BUDGET`` cells or cells narrower than ``MIN_CELL_RAD`` the answer is ``undecided``
+  (``contained`` False, with a note): never a containment that is not proved. A point set is a
+  set of zero-size boxes.
 * ``sampled`` — other families (``luzi3``) or workspace constraints beyond the stroke
   (joint limits, link diameter, κ): the task is sampled on a grid of spacing at most the
   resolution h, boundary included, and every sample is checked by inverse kinematics at every
   orientation. Stated error: a failure inside a gap of the sample grid can be missed; any
   missed region lies within h·√3/2 mm of a checked sample.
 
-Margins (:func:`task_margins`, the largest verified level of a bisection, kind ``bound``):
+Margins (:func:`task_margins`, the largest verified level of a bisection, kind ``bound``; with
+the ``exact`` method every level is decided over the continuous orientation set, so the lower
+end is proved; a level left ``undecided`` counts as not contained, and the note says that the
+upper end of that bracket is then not proved):
 
 * ``margin_mm`` — the largest δ such that the task grown by δ (box half-sizes + δ, cylinder
   radius and half-height + δ, each point a cube of half-size δ) is contained: a lower bound of
@@ -50,13 +63,21 @@ import numpy as np
 from ..errors import ParameterError
 from ..mechanisms._kernels import make_leg_eval
 from ..poses import as_frames, matrix_to_euler
+from ..workspaces import cells as oc
 from ..workspaces.constraints import Constraints, check
+from ..workspaces.legbounds import EPS
 from ..workspaces.orientations import OrientationSet
 
 __all__ = ["TaskRegion", "TaskCheck", "task_contained", "task_margins", "task_mesh",
            "task_outline", "MARGIN_TOL_MM", "ORIENTATION_TOL_DEG"]
 
 MARGIN_TOL_MM = 0.01
+#: items (orientation cell × task part) of one exact check, all levels together, and the
+#: smallest cell half-width (rad): past either the check says "undecided"
+CELL_BUDGET = 1_000_000
+MIN_CELL_RAD = 1e-7
+#: items per evaluation (about 70 MB of temporaries)
+_CHUNK = 100_000
 ORIENTATION_TOL_DEG = 0.01
 _SHAPES = ("box", "cylinder", "points")
 _FRAMES = ("nominal", "base")
@@ -149,7 +170,11 @@ class TaskCheck:
 
     ``contained``; ``method`` (``exact`` or ``sampled``); ``resolution`` (mm, the sample
     spacing of the ``sampled`` method, 0 for ``exact``); ``orientations`` (samples used);
-    ``failures`` (count of failing leg × orientation extremes or samples); ``note``.
+    ``failures`` (count of failing leg × orientation extremes or samples); ``note``;
+    ``status`` — ``contained`` (``exact``: proved over the continuous orientation set),
+    ``not contained`` (a rotation of the set fails it) or ``undecided`` (``exact``: orientation
+    cells left undecided at the budget; ``contained`` is then False); ``cells`` (orientation
+    cells of the ``exact`` proof) and ``undecided`` (cells left open).
     """
 
     contained: bool
@@ -158,46 +183,126 @@ class TaskCheck:
     orientations: int
     failures: int
     note: str = ""
+    status: str = ""
+    cells: int = 0
+    undecided: int = 0
+
+    def __post_init__(self):
+        if not self.status:
+            object.__setattr__(self, "status",
+                               "contained" if self.contained else "not contained")
 
 
 # ---- exact check on radial column families ---------------------------------------------------
 
 
 def _legs_at(mech, W, dmin, dmax):
-    """Intervals of every leg at ``dmin`` and ``dmax``: ``W (M, 6, 3)``, ``d* (B, M, 6)`` →
-    ``(a, b, ok)`` each ``(2, B, M, 6)``."""
-    B = dmin.shape[0]
+    """Intervals of every leg at ``dmin`` and ``dmax``: ``W (K, 6, 3)``, ``d* (K, 6)`` →
+    ``(a, b, ok)`` each ``(2, K, 6)``."""
     D = np.stack([dmin, dmax]).ravel()
-    Wf = np.ascontiguousarray(np.broadcast_to(W, (2, B) + W.shape).reshape(-1, 3))
+    Wf = np.ascontiguousarray(np.broadcast_to(W, (2,) + W.shape).reshape(-1, 3))
     P = np.asarray(mech.column_params(), dtype=float)
-    Pf = np.ascontiguousarray(np.broadcast_to(P, (2, B, W.shape[0], 6, 3)).reshape(-1, 3))
+    Pf = np.ascontiguousarray(np.broadcast_to(P, (2,) + W.shape).reshape(-1, 3))
     # the leg's interval on the column at horizontal distance D along its own x axis
     a, b, ok = make_leg_eval(type(mech).column_leg)(D - Wf[:, 0], -Wf[:, 1], Wf, Pf)
-    shape = (2, B) + W.shape[:2]
+    shape = (2,) + W.shape[:2]
     return a.reshape(shape), b.reshape(shape), ok.reshape(shape)
 
 
-def _exact_fail(mech, R, task: TaskRegion, grow: float = 0.0) -> np.ndarray:
-    """``(B, M, 6)`` True where leg × orientation fails some part of the task."""
-    W = mech.leg_offsets(R)                                     # (M, 6, 3)
-    axis = -W[..., :2]                                          # column axes (M, 6, 2)
-    if task.shape == "cylinder":
-        c, r, hz = task.cylinder(mech, grow)
-        dc = np.linalg.norm(axis - c[:2], axis=-1)[None]        # (1, M, 6)
-        dmin, dmax = np.maximum(dc - r, 0.0), dc + r
-        z0, z1 = np.array([c[2] - hz]), np.array([c[2] + hz])
+def _parts(mech, task: TaskRegion, grow: float):
+    """The task as base-frame boxes ``(lo (B, 3), hi (B, 3))`` or, for a cylinder, one
+    ``(centre, radius, half height)``."""
+    return task.cylinder(mech, grow) if task.shape == "cylinder" else task.boxes(mech, grow)
+
+
+def _fail_items(mech, W, parts, bid, r=None) -> np.ndarray:
+    """``(K, 6)`` True where leg i at offsets ``W (K, 6, 3)`` fails the task part ``bid
+    (K,)``. With ``r (K, 6)``: where the leg is not *proved* to hold it at every rotation
+    whose offset ``w_i`` lies within ``r`` of ``W`` (the column axis ``-w_i,xy`` and the
+    shift ``-w_i,z`` each move by at most ``r``: the distances widen by ``r``, the ends by
+    ``r``)."""
+    axis = -W[..., :2]                                          # column axes (K, 6, 2)
+    if len(parts) == 3:                                         # cylinder
+        c, rad, hz = parts
+        dc = np.linalg.norm(axis - c[:2], axis=-1)
+        dmin, dmax = np.maximum(dc - rad, 0.0), dc + rad
+        z0, z1 = np.full(len(W), c[2] - hz), np.full(len(W), c[2] + hz)
     else:
-        lo, hi = task.boxes(mech, grow)                         # (B, 3)
-        l, h = lo[:, None, None, :2], hi[:, None, None, :2]
+        lo, hi = parts[0][bid], parts[1][bid]                   # (K, 3)
+        l, h = lo[:, None, :2], hi[:, None, :2]
         gap = np.maximum(np.maximum(l - axis, axis - h), 0.0)
         far = np.maximum(np.abs(axis - l), np.abs(h - axis))
         dmin, dmax = np.linalg.norm(gap, axis=-1), np.linalg.norm(far, axis=-1)
         z0, z1 = lo[:, 2], hi[:, 2]
+    rr = 0.0 if r is None else r
+    if r is not None:
+        dmin, dmax = np.maximum(dmin - rr, 0.0), dmax + rr
     a, b, ok = _legs_at(mech, W, dmin, dmax)
-    z0 = z0[None, :, None, None]
-    z1 = z1[None, :, None, None]
-    good = ok & (a <= z0) & (b >= z1)
+    pad = 0.0 if r is None else rr + EPS
+    good = ok & (a + pad <= z0[None, :, None]) & (b - pad >= z1[None, :, None])
     return ~np.all(good, axis=0)
+
+
+def _exact_fail(mech, R, task: TaskRegion, grow: float = 0.0) -> np.ndarray:
+    """``(B, M, 6)`` True where leg × orientation ``R (M, 3, 3)`` fails task part B."""
+    parts = _parts(mech, task, grow)
+    nb = 1 if task.shape == "cylinder" else len(parts[0])
+    W = mech.leg_offsets(R)
+    bid = np.repeat(np.arange(nb), len(R))
+    return _fail_items(mech, np.tile(W, (nb, 1, 1)), parts, bid).reshape(nb, len(R), 6)
+
+
+def _exact_cells(mech, oset: OrientationSet, task: TaskRegion, grow: float = 0.0
+                 ) -> TaskCheck:
+    """Containment over the continuous orientation set (module notes): the sample first
+    (a failure there is a proof), then items (orientation cell × task part; a cylinder is
+    one part, a box one, a point set one per point), each proved, refuted at its cell's
+    centre, or split with the cell (:func:`pkmlab.workspaces.cells.split`)."""
+    R = oset.rotations()
+    n = int(_exact_fail(mech, R, task, grow).sum())
+    if n:
+        return TaskCheck(False, "exact", 0.0, len(R), n, status="not contained")
+    parts = _parts(mech, task, grow)
+    nb = 1 if task.shape == "cylinder" else len(parts[0])
+    C, H = oc.initial_cells(oset, 1)
+    cid, bid = np.repeat(np.arange(len(C)), nb), np.tile(np.arange(nb), len(C))
+    unorm = np.linalg.norm(mech.tool_points, axis=1)            # (6,)
+    cells = items = 0
+    while len(cid):
+        cells += len(C)
+        items += len(cid)
+        W = mech.leg_offsets(oset.rotations_at(C))              # (L, 6, 3)
+        r = oc.chord(oc.angle_bound(oset, C, H))[:, None] * unorm
+        keep = np.zeros(len(cid), bool)
+        for s in range(0, len(cid), _CHUNK):
+            c, bb = cid[s:s + _CHUNK], bid[s:s + _CHUNK]
+            fail0 = _fail_items(mech, W[c], parts, bb)
+            if fail0.any():
+                return TaskCheck(False, "exact", 0.0, len(R) + cells, int(fail0.sum()),
+                                 status="not contained", cells=cells)
+            keep[s:s + _CHUNK] = _fail_items(mech, W[c], parts, bb, r[c]).any(axis=1)
+        cid, bid = cid[keep], bid[keep]
+        if not len(cid):
+            break
+        if items + 8 * len(cid) > CELL_BUDGET or np.max(H) < MIN_CELL_RAD:
+            return TaskCheck(False, "exact", 0.0, len(R) + cells, 0, status="undecided",
+                             cells=cells, undecided=len(cid),
+                             note=f"not proved: {len(cid)} orientation cell × task part "
+                                  f"item(s) undecided after {items:,} items (budget "
+                                  f"{CELL_BUDGET:,}); no sampled orientation fails")
+        # the open cells' children inherit their parent's open parts
+        live, cid = np.unique(cid, return_inverse=True)
+        C, H = C[live], H[live]
+        order = np.argsort(cid, kind="stable")
+        cid, bid = cid[order], bid[order]
+        counts = np.bincount(cid, minlength=len(C))
+        first = np.cumsum(counts) - counts
+        C, H, par = oc.split(C, H)
+        cnt = counts[par]
+        off = np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        bid = bid[np.repeat(first[par], cnt) + off]
+        cid = np.repeat(np.arange(len(C)), cnt)
+    return TaskCheck(True, "exact", 0.0, len(R) + cells, 0, status="contained", cells=cells)
 
 
 # ---- sampled fallback ------------------------------------------------------------------------
@@ -267,9 +372,7 @@ def _check(mech, oset, task, resolution, cons, grow=0.0, surface=False) -> TaskC
     exact = bool(getattr(mech, "column_radial", False)) and mech.column_method \
         is not None and not cons.extra
     if exact:
-        fail = _exact_fail(mech, R, task, grow)
-        n = int(fail.sum())
-        return TaskCheck(n == 0, "exact", 0.0, len(R), n)
+        return _exact_cells(mech, oset, task, grow)
     why = ("no radial column intervals for family " + repr(mech.family)) if not cons.extra \
         else "constraints beyond the stroke"
     n = _sampled_fail(mech, R, task, resolution, cons, grow, surface)
@@ -299,13 +402,14 @@ def _widened(oset: OrientationSet, delta: float) -> OrientationSet:
             return oset
         return OrientationSet.box((delta,) * 3, "simultaneous", oset.samples,
                                   centre=tuple(np.asarray(oset.centre) + oset.angles))
+    # widened within the set's own limits (box and torsion 180°, tilt 90°)
     if oset.kind == "box":
-        return dataclasses.replace(oset, angles=tuple(max(a + delta, 0.0) if a > 0 else a
-                                                      for a in oset.angles))
-    return dataclasses.replace(oset, tilt=max(oset.tilt + delta, 0.0) if oset.tilt > 0
-                               else oset.tilt,
-                               torsion=max(oset.torsion + delta, 0.0) if oset.torsion > 0
-                               else oset.torsion)
+        return dataclasses.replace(oset, angles=tuple(min(max(a + delta, 0.0), math.pi)
+                                                      if a > 0 else a for a in oset.angles))
+    return dataclasses.replace(oset, tilt=min(max(oset.tilt + delta, 0.0), math.pi / 2)
+                               if oset.tilt > 0 else oset.tilt,
+                               torsion=min(max(oset.torsion + delta, 0.0), math.pi)
+                               if oset.torsion > 0 else oset.torsion)
 
 
 def _bisect(ok, lo: float, hi: float, tol: float) -> tuple[float, float]:
@@ -335,8 +439,15 @@ def task_margins(mech, task: TaskRegion, orientations: OrientationSet | None = N
     tol = max(MARGIN_TOL_MM, resolution / 4) if surface else MARGIN_TOL_MM
     otol = 10 * ORIENTATION_TOL_DEG if surface else ORIENTATION_TOL_DEG
 
+    open_levels: dict = {"task_margin": 0, "task_orientation_margin": 0}
+
+    def decided(c: TaskCheck, key: str) -> bool:
+        open_levels[key] += c.status == "undecided"
+        return c.contained
+
     def fits(g):
-        return _check(mech, oset, task, resolution, cons, grow=g, surface=surface).contained
+        return decided(_check(mech, oset, task, resolution, cons, grow=g, surface=surface),
+                       "task_margin")
 
     if base.contained:
         cap = max_growth if max_growth is not None else 2.0 * mech.scale
@@ -362,8 +473,8 @@ def task_margins(mech, task: TaskRegion, orientations: OrientationSet | None = N
                                     "the task's centre is outside the workspace")
 
     def ofits(d_deg):
-        return _check(mech, _widened(oset, math.radians(d_deg)), task, resolution, cons,
-                      surface=surface).contained
+        return decided(_check(mech, _widened(oset, math.radians(d_deg)), task, resolution,
+                              cons, surface=surface), "task_orientation_margin")
 
     if base.contained:
         if ofits(90.0):
@@ -382,6 +493,11 @@ def task_margins(mech, task: TaskRegion, orientations: OrientationSet | None = N
             out["orientation_margin_deg"] = out["orientation_bracket_deg"] = None
             notes["task_orientation_margin"] = "the task does not fit even at the centre " \
                 "orientation"
+    for key, n in open_levels.items():
+        if n:
+            notes[key] = (notes[key] + "; " if key in notes else "") + (
+                f"{n} level(s) undecided (orientation cell budget {CELL_BUDGET:,}) counted as "
+                "not contained: the margin is proved, the upper end of its bracket is not")
     return out
 
 

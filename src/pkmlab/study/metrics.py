@@ -155,8 +155,9 @@ _ALL = [
            "smallest stroke margin along that motion (negative: the overshoot)"),
     # requirements: the task (a required workspace)
     Metric("task_contained", "task", "", "flag",
-           "1 if every position of the task region works at every orientation sample of its "
-           "set (exact over the continuous region for psu6/ups6; sampled for luzi3, see notes)"),
+           "1 if every position of the task region works at every orientation of its set "
+           "(psu6/ups6: proved over the continuous region and the continuous orientation set, "
+           "0 with a note if undecided; luzi3: sampled, see notes)"),
     Metric("task_margin", "task", "mm", "bound",
            "largest growth of the task region that stays contained (a lower bound of its "
            "distance to the workspace boundary, bracket 0.01 mm); negative: the erosion needed"),

@@ -34,6 +34,25 @@ dexterous workspace of the continuous box is non-empty). One compiled call
 * ``sampled``: the largest ``θ`` whose ``samples³`` grid has a position (a witness), to
   ``tol``; ``upper`` may lie below it.
 
+**The whole rotation group.** A ±180° Euler box is all of SO(3), so the capability is at
+most 180°. When the ±180° sample admits a position, :func:`whole_group_margin` tries to prove
+180° by the *sphere argument*: as ``R`` ranges over SO(3), leg i's platform joint relative to
+its base joint, ``v = p - b_i + R·u_i``, ranges over the sphere of radius ``|u_i|`` about
+``p - b_i``, and the leg is feasible iff ``v`` lies in the leg's set ``{ρ = |v_xy|: ok(ρ),
+A(ρ) <= v_z <= B(ρ)}`` (the radial column ends at ``w = 0``, monotone in ρ). The sphere is cut
+into horizontal slabs ``v_z - (p - b_i)_z ∈ [t0, t1]``; on a slab ρ lies in ``[max(0, ρ_c -
+h_max, h_min - ρ_c), ρ_c + h_max]`` (``h = sqrt(|u_i|² - t²)``, ρ_c the centre's), so the slab
+is inside if the ends at those two distances satisfy ``max A <= z0``, ``min B >= z1``. A
+positive smallest slack over legs and slabs proves that every rotation keeps every leg in its
+window at ``p``: the answer is then ``[180, 180]`` with that point (searched from the sample's
+witness, the certified point and the nominal position, by Nelder–Mead on the slack). Otherwise
+the upper end is 180° and the lower end what the certification reached.
+
+**The reported point** is checked once more by inverse kinematics at random rotations of its
+box (a check that can fail; the proof is the certification or the sphere argument); a point
+that fails it is not reported (``point`` NaN, with a note), nor is one when no level above 0
+was certified and it fails the nominal orientation.
+
 ``upper`` and ``sampled`` are bisected to ``tol`` (0.01°). The bracket ``upper - lower`` is
 wider than ``tol`` when the cuts miss orientations that bind or the cell bounds are loose
 (links near horizontal): certification then fails or runs out of budget above ``lower``.
@@ -78,12 +97,13 @@ from ..limits import CAPABILITY_MAX_DEG
 from ..mechanisms import _kernels, _search
 from ..poses import as_frames, euler_to_matrix, matrix_to_euler
 from .binding import binding_orientations, column_ends
+from .legbounds import EPS, Legs
 from .orientations import OrientationSet
 
 log = logging.getLogger(__name__)
 
 __all__ = ["OptimumBracket", "orientation_capability", "stroke_needed", "supports_continuous",
-           "CAPABILITY_TOL_DEG", "STROKE_TOL_MM"]
+           "whole_group_margin", "point_failures", "CAPABILITY_TOL_DEG", "STROKE_TOL_MM"]
 
 #: bisection tolerance of the capability (deg)
 CAPABILITY_TOL_DEG = 0.01
@@ -104,6 +124,10 @@ STROKE_ROUNDS = 8
 #: the witness column of a sample is its best one to this margin (mm)
 WITNESS_EPS_MM = 1e-3
 CAPABILITY_CELL_BUDGET = 600_000
+#: slabs per sphere of the whole-group (sphere) argument
+SPHERE_SLABS = 512
+#: random rotations of the check of a reported point
+CHECK_ROTATIONS = 20_000
 
 
 @dataclass(frozen=True)
@@ -199,17 +223,99 @@ def orientation_capability(mech, samples: int = 7, tol_deg: float = CAPABILITY_T
         notes.append(f"certification stopped by its budget ({CAPABILITY_CELL_BUDGET:,} "
                      "orientation cells): the lower end is certified, the truth may lie higher")
     lower, upper, sampled = (math.degrees(v) for v in out[:3])
+    point = tuple(map(float, out[6:9]))
+    method = (f"branch and bound over continuous positions ({samples}^3 orientation samples "
+              f"and {int(out[12])} cut orientations, upper end) and a point certified for the "
+              f"continuous box (lower end), bisected to {tol_deg:g}°; {int(out[10])} searches, "
+              f"{int(out[11])} orientation cells")
     if flags & 1:
         upper = math.inf
+        if max_deg >= 180.0:
+            # a ±180° Euler box is the whole rotation group
+            upper = 180.0
+            notes[notes.index(next(n for n in notes if n.startswith("not bounded")))] = (
+                "the ±180° box (the whole rotation group) has a dexterous position in its "
+                f"{samples}^3 sample")
+            cands = [point, tuple(out[3:6]), tuple(np.asarray(mech.nominal_pose[:3]))]
+            slack, p = best_whole_group_point(mech, cands)
+            if slack > 0.0:
+                lower, point = 180.0, p
+                notes = [n for n in notes if not n.startswith("certification stopped")]
+                method = ("the sphere argument: at the point, every leg's platform joint stays "
+                          "in its window on the whole sphere it sweeps under all rotations "
+                          f"(slack {slack:.4f} mm over {SPHERE_SLABS} slabs per sphere; "
+                          "module notes)")
+            else:
+                notes.append(f"the sphere argument proves no point (best slack {slack:.4f} mm):"
+                             " the upper end is 180°, the lower end what the cells certified")
+    fails = point_failures(mech, point, math.radians(lower))
+    if fails:
+        notes.append(f"the point {tuple(round(v, 4) for v in point)} fails {fails} of "
+                     f"{CHECK_ROTATIONS:,} random rotations of the ±{lower:g}° box: not "
+                     "reported")
+        point = (math.nan,) * 3
     return OptimumBracket(
-        "orientation_capability", "deg", lower, upper, sampled, tuple(out[6:9]), samples,
-        f"branch and bound over continuous positions ({samples}^3 orientation samples and "
-        f"{int(out[12])} cut orientations, upper end) and a point certified for the "
-        f"continuous box (lower end), bisected to {tol_deg:g}°; {int(out[10])} searches, "
-        f"{int(out[11])} orientation cells",
+        "orientation_capability", "deg", lower, upper, sampled, point, samples, method,
         "; ".join(notes), time.perf_counter() - t0,
         binding=tuple(tuple(map(float, c)) for c in cuts[:int(out[12])] * out[1])
-        if math.isfinite(upper) else ())
+        if math.isfinite(upper) and not flags & 1 else ())
+
+
+def whole_group_margin(mech, p) -> float:
+    """Smallest slack (mm) over the legs and the slabs of the sphere argument at position
+    ``p`` (module notes): positive proves that every rotation keeps every leg in its window
+    at ``p``; -inf where a slab leaves a leg's reach."""
+
+    c = np.asarray(p, float) - mech.base_points                      # (6, 3) sphere centres
+    r = np.linalg.norm(mech.tool_points, axis=1)[:, None]            # (6, 1) radii
+    t = np.linspace(-1.0, 1.0, SPHERE_SLABS + 1)[None] * r           # (6, S + 1) slab ends
+    t0, t1 = t[:, :-1], t[:, 1:]
+    h = np.sqrt(np.maximum(r**2 - t**2, 0.0))
+    hmax = np.where((t0 <= 0) & (t1 >= 0), r, np.maximum(h[:, :-1], h[:, 1:]))
+    hmin = np.minimum(h[:, :-1], h[:, 1:])
+    rc = np.hypot(c[:, 0], c[:, 1])[:, None]
+    d = np.stack([np.maximum.reduce([np.zeros_like(hmax), rc - hmax, hmin - rc]), rc + hmax])
+    A, B, ok = Legs(mech, None).ends(np.moveaxis(d, 1, -1))          # (2, S, 6)
+    A, B, ok = (np.moveaxis(x, -1, 1) for x in (A, B, ok))           # (2, 6, S)
+    z0, z1 = c[:, 2, None] + t0, c[:, 2, None] + t1
+    slack = np.minimum(z0 - A.max(axis=0), B.min(axis=0) - z1) - EPS
+    return float(np.min(np.where(ok.all(axis=0), slack, -np.inf)))
+
+
+def best_whole_group_point(mech, candidates) -> tuple[float, tuple]:
+    """The candidate with the largest :func:`whole_group_margin`, improved by Nelder–Mead:
+    ``(slack, point)``."""
+    from scipy.optimize import minimize  # lazy: only for a machine whose whole group fits
+
+    cands = [np.asarray(c, float) for c in candidates if np.all(np.isfinite(c))]
+    vals = [whole_group_margin(mech, c) for c in cands]
+    k = int(np.argmax(vals))
+    res = minimize(lambda x: -max(whole_group_margin(mech, x), -1e9), cands[k],
+                   method="Nelder-Mead", options={"xatol": 1e-3, "fatol": 1e-4,
+                                                  "maxfev": 400, "initial_simplex":
+                                                  cands[k] + np.vstack([np.zeros(3),
+                                                                        5.0 * np.eye(3)])})
+    best = whole_group_margin(mech, res.x)
+    if best > vals[k]:
+        return best, tuple(map(float, res.x))
+    return vals[k], tuple(map(float, cands[k]))
+
+
+def point_failures(mech, point, theta: float, n: int | None = None, seed: int = 0) -> int:
+    """How many of ``n`` random rotations of the ±theta box about the nominal orientation
+    (uniform in the Euler offsets, corners and the centre included) put a leg of ``point``
+    outside its window: the check that can fail of a certified point."""
+    if not np.all(np.isfinite(point)):
+        return 0
+    n = CHECK_ROTATIONS if n is None else n
+    rng = np.random.default_rng(seed)
+    corners = np.array([[i, j, k] for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)])
+    E = np.vstack([corners, rng.uniform(-1.0, 1.0, (n - len(corners), 3))]) * theta
+    _, Rn = as_frames(mech.nominal_pose)
+    e0 = np.asarray(matrix_to_euler(Rn[0]))
+    R = euler_to_matrix(e0 + E)
+    P = np.broadcast_to(np.asarray(point, float), (n, 3)).copy()
+    return int(np.sum(~mech.inverse((P, R)).valid))
 
 
 def _box_sample(theta: float, n: int) -> np.ndarray:
