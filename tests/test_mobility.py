@@ -153,3 +153,9 @@ def test_analyses_that_assume_six_coordinates_refuse_a_lower_mobility_clearly(tr
              "optimizer": {"method": "sobol", "samples": 4}}
     with pytest.raises(ParameterError, match="mechanism.family: must be a mechanism with six"):
         study_from_mapping(study, tmp_path)
+
+
+def test_the_fk_mode_check_moves_the_free_coordinates_only(tripod):
+    fk = tripod.forward(tripod.inverse([[5.0, 5.0, 390.0]]).q, modes=True)
+    assert fk.converged.all() and not fk.ambiguous.any()     # the mirror is below the base
+    assert fk.mode_starts > 1 and np.isnan(fk.next_mode).all()
