@@ -45,6 +45,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..poses import as_frames
+from ..tolerances import TOL
 from ._linalg import singular_values
 
 log = logging.getLogger(__name__)
@@ -67,8 +68,9 @@ __all__ = [
     "LENGTH_STATUS",
 ]
 
-#: A Jacobian counts as singular when σmin(J_h) <= SINGULAR_RTOL · σmax(J_h).
-SINGULAR_RTOL = 1e-12
+#: A Jacobian counts as singular when σmin(J_h) <= SINGULAR_RTOL · σmax(J_h)
+#: (:data:`pkmlab.tolerances.TOL`'s ``singular_rtol``).
+SINGULAR_RTOL = TOL.singular_rtol
 #: κ at and above which a Jacobian is singular (``1 / SINGULAR_RTOL``); reported as ``inf``.
 KAPPA_SINGULAR = 1.0 / SINGULAR_RTOL
 

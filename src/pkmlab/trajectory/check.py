@@ -26,6 +26,7 @@ from ..dexterity.metrics import CharacteristicLength, condition_number, resolve_
 from ..errors import ParameterError
 from ..mechanisms.base import LEG_STATUS, Mechanism
 from ..poses import as_frames
+from ..tolerances import TOL
 from ._args import limit6 as _limit6
 from ._args import positive as _positive
 
@@ -210,7 +211,7 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
                      gravity: Sequence[float] = (0.0, 0.0, -9810.0),
                      max_speed: float | Sequence[float] | None = None,
                      max_force: float | Sequence[float] | None = None,
-                     stroke_tolerance: float = 1e-9,
+                     stroke_tolerance: float = TOL.stroke_roundoff_mm,
                      characteristic_length: float | CharacteristicLength | None = None
                      ) -> TrajectoryReport:
     """Check a trajectory against the stroke, an optional speed and an optional force limit.
