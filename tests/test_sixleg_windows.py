@@ -179,7 +179,8 @@ def test_random_sixleg_columns_and_bracket_against_the_ik(family, lower, seed):
     """On a random machine: every column method agrees with the IK (dexterous and reachable
     columns over a small orientation box, at columns around the nominal position), and where
     the bracket applies (radial columns) it holds against the IK voxel count, constant and
-    dexterous; elsewhere it is refused."""
+    dexterous, and the exact task check agrees with the IK; elsewhere the bracket is
+    refused."""
     m = _draw(family, lower, seed)
     rng = np.random.default_rng(seed)
     assert m.column_method is not None             # exact columns for every leg kind
@@ -197,6 +198,15 @@ def test_random_sixleg_columns_and_bracket_against_the_ik(family, lower, seed):
         with pytest.raises(ParameterError, match="bracket"):
             volume_bracket(m, "constant")
         return
+    # exact task check: the nominal position (valid by construction) is contained; a 10 mm
+    # box is contained only if every point of its 1 mm grid is valid
+    point = task_contained(m, TaskRegion("points", points=np.zeros((1, 3))))
+    assert point.method == "exact" and point.contained, point
+    g = np.linspace(-5.0, 5.0, 11)
+    G = np.stack(np.meshgrid(g, g, g, indexing="ij"), axis=-1).reshape(-1, 3)
+    G += m.nominal_pose[:3]
+    if task_contained(m, TaskRegion("box", size=(10.0, 10.0, 10.0))).contained:
+        assert m.inverse((G, np.broadcast_to(Rn[0], (len(G), 3, 3)))).valid.all()
     free = Constraints(connected=False)
     b = volume_bracket(m, "constant", None, 8.0, free, budget_s=10, max_evaluations=2e5)
     _check_constant_bracket(m, b)
