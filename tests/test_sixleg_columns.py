@@ -19,6 +19,7 @@ from scipy.spatial.transform import Rotation
 import pkmlab
 from pkmlab.mechanisms import RSS6, SixLeg
 from pkmlab.requirements.task import TaskRegion, task_contained
+from pkmlab.testing import check_columns
 from pkmlab.workspaces import Constraints, OrientationSet, workspace
 from pkmlab.workspaces.optima import supports_continuous
 
@@ -149,30 +150,7 @@ def test_slider_columns_match_dense_ik(name, mode):
     R = oset.centred(tuple(pkmlab.poses.matrix_to_euler(Rn[0]))).rotations()
     c = m.nominal_pose[:2]
     xs, ys = c[0] + np.linspace(-60.0, 60.0, 3), c[1] + np.linspace(-50.0, 50.0, 3)
-    lo, hi, over = m.column_intervals(xs, ys, R, mode)
-    assert over == 0
-    agg = np.all if mode == "all" else np.any
-    zb = m.position_bounds(R)[:, :, 2]
-    zs = np.arange(zb[:, 0].min() - 1.0, zb[:, 1].max() + 1.0, DZ)
-    pieces = 0
-    for ix, iy in np.ndindex(len(xs), len(ys)):
-        p = np.tile([xs[ix], ys[iy], 0.0], (len(zs), 1))
-        p[:, 2] = zs
-        v = m.inverse((np.repeat(p, len(R), axis=0), np.tile(R, (len(zs), 1, 1)))).valid
-        v = v.reshape(len(zs), len(R))
-        inside = agg(v, axis=1)
-        sel = lo[ix, iy] <= hi[ix, iy]
-        a, b = lo[ix, iy][sel], hi[ix, iy][sel]
-        assert np.all(a > zs[0]) and np.all(b < zs[-1])
-        assert abs(inside.sum() * DZ - np.sum(b - a)) <= 2 * len(a) * DZ + 1e-9
-        for a_k, b_k in zip(a, b, strict=True):
-            probe = np.array([a_k + EPS, b_k - EPS, a_k - EPS, b_k + EPS])
-            q = np.repeat(np.array([[xs[ix], ys[iy], 0.0]]), 4, axis=0)
-            q[:, 2] = probe
-            vv = np.stack([m.inverse((q, np.broadcast_to(Rm, (4, 3, 3)).copy())).valid
-                           for Rm in R], axis=1)
-            assert agg(vv[:2], axis=1).all() and not agg(vv[2:], axis=1).any()
-        pieces += len(a)
+    pieces = check_columns(m, R, xs, ys, mode, dz=DZ, eps=EPS)
     assert pieces >= 5
 
 

@@ -28,7 +28,10 @@ The checks:
 * :func:`check_bad_shapes` — malformed pose arrays raise a named error.
 
 :func:`cell_points` draws test points inside position × orientation cells, for checking a
-family's cell bounds (``leg_cell_bounds``, ``leg_cell_margins``) against its kinematics.
+family's cell bounds (``leg_cell_bounds``, ``leg_cell_margins``) against its kinematics;
+:func:`check_columns` checks a family's exact columns (``column_intervals``) against its IK,
+and :func:`random_sixleg` draws a ``sixleg`` machine of given leg kinds around a valid nominal
+pose, for property tests.
 """
 
 from __future__ import annotations
@@ -41,7 +44,7 @@ from .poses import as_frames, euler_to_matrix, exp_so3, log_so3
 __all__ = ["random_valid_poses", "rotation_error", "check_declaration", "check_round_trip",
            "check_jacobian",
            "check_batching", "check_statuses", "check_assembly_modes", "check_bad_shapes",
-           "CHECKS", "run_contract", "cell_points"]
+           "CHECKS", "run_contract", "cell_points", "check_columns", "random_sixleg"]
 
 REASON = {v: k for k, v in LEG_STATUS.items()}
 
@@ -260,3 +263,130 @@ def cell_points(rng, p, R, delta, alpha, *, ball: bool = False):
     dp = u * (np.where(edge, 1.0, r ** (1 / 3) if ball else r) * delta)[:, None]
     ang = np.where(edge, 1.0, rng.uniform(size=n)) * alpha
     return p + dp, exp_so3(ax * ang[:, None]) @ R, dp
+
+
+def check_columns(mech, R, xs, ys, mode: str = "all", dz: float = 0.1,
+                  eps: float = 1e-9) -> int:
+    """The exact columns of ``mech`` (``column_intervals`` over ``xs × ys``, orientations ``R
+    (M, 3, 3)``, ``mode`` "all" or "any") against its own per-pose IK; returns the number of
+    pieces checked.
+
+    Per column, the z set where the IK is valid at every (``"all"``) or some (``"any"``)
+    orientation, on a grid of step ``dz`` mm over the position bounds (``position_bounds``,
+    widened 1 mm), has the intervals' total length to ``2·dz`` per piece (none: no valid grid
+    point); every end lies inside the grid, and the IK holds ``eps`` mm inside each end and
+    fails ``eps`` mm outside it."""
+    agg = np.all if mode == "all" else np.any
+    lo, hi, over = mech.column_intervals(np.asarray(xs, float), np.asarray(ys, float), R, mode)
+    assert over == 0, f"{over} columns overflowed"
+    zb = mech.position_bounds(R)[:, :, 2]
+    zs = np.arange(zb[:, 0].min() - 1.0, zb[:, 1].max() + 1.0, dz)
+    M = len(R)
+
+    def valid(x, y, z):
+        p = np.column_stack([np.full(len(z), x), np.full(len(z), y), z])
+        v = mech.inverse((np.repeat(p, M, axis=0), np.tile(R, (len(z), 1, 1)))).valid
+        return agg(v.reshape(len(z), M), axis=1)
+
+    pieces = 0
+    for ix, iy in np.ndindex(len(xs), len(ys)):
+        sel = lo[ix, iy] <= hi[ix, iy]
+        a, b = lo[ix, iy][sel], hi[ix, iy][sel]
+        where = f"column ({xs[ix]:.6g}, {ys[iy]:.6g}) mm, intervals {list(zip(a, b))}"
+        assert np.all(a > zs[0]) and np.all(b < zs[-1]), f"{where}: outside the z grid"
+        ik = valid(xs[ix], ys[iy], zs).sum() * dz
+        assert abs(ik - np.sum(b - a)) <= 2 * len(a) * dz + 1e-9, \
+            f"{where}: length {np.sum(b - a):.6g} mm, IK on a {dz} mm grid {ik:.6g} mm"
+        for a_k, b_k in zip(a, b, strict=True):
+            inside = valid(xs[ix], ys[iy], np.array([a_k + eps, b_k - eps]))
+            outside = valid(xs[ix], ys[iy], np.array([a_k - eps, b_k + eps]))
+            assert inside.all() and not outside.any(), \
+                f"{where}: IK {eps} mm inside {inside}, outside {outside} at [{a_k}, {b_k}]"
+        pieces += len(a)
+    return pieces
+
+
+def _unit(v):
+    v = np.asarray(v, dtype=float)
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def random_sixleg(rng, kinds, lower: str, rails: str = "any", tries: int = 50):
+    """A random ``sixleg`` machine (:class:`~pkmlab.mechanisms.SixLeg`) whose leg ``i`` has
+    the kind ``kinds[i]`` (``"prismatic"``, ``"slider"`` or ``"crank"``; cranks with no other
+    kind), built around a nominal pose at which every leg is valid.
+
+    The shared window's lower limit is ``lower``: ``"negative"``, ``"zero"`` or ``"positive"``
+    (mm; rad for cranks). Each leg takes, at the nominal pose, an actuator value in the middle
+    half of its feasible window (a prismatic leg: lengths ``[max(min, 0), max]``), a random
+    leg (link, rod) direction pointing up from the base side, and a random rail or servo axis.
+    ``rails``: ``"vertical"`` (±z exactly), ``"inclined"`` (10°-80° above the horizontal),
+    ``"horizontal"`` or ``"any"`` (one of the three per slider). Prismatic legs hang below
+    their base joint (working side -1) with probability 1/4."""
+    from .mechanisms.sixleg import SixLeg
+
+    kinds = list(kinds)
+    crank = kinds[0] == "crank"
+    for _ in range(tries):
+        if crank:
+            lo = {"negative": -rng.uniform(0.3, 1.2), "zero": 0.0,
+                  "positive": rng.uniform(0.1, 0.8)}[lower]
+            hi = min(lo + rng.uniform(1.0, 2.0), np.pi)
+        else:
+            lo = {"negative": -rng.uniform(50.0, 400.0), "zero": 0.0,
+                  "positive": rng.uniform(50.0, 250.0)}[lower]
+            hi = lo + rng.uniform(300.0, 700.0)
+        X0 = np.concatenate([rng.uniform(-20, 20, 2), [rng.uniform(200, 500)],
+                             np.radians(rng.uniform(-5, 5, 3))])
+        ang = np.arange(6) * np.pi / 3 + rng.uniform(-0.3, 0.3, 6)
+        radial = np.column_stack([np.cos(ang), np.sin(ang), np.zeros(6)])
+        P = radial * rng.uniform(60.0, 200.0, (6, 1))
+        W = X0[:3] + P @ euler_to_matrix(X0[3:]).T
+        B, axes, zero = np.zeros((6, 3)), np.zeros((6, 3)), np.zeros((6, 3))
+        crank_len, link, branch = np.zeros(6), np.zeros(6), -np.ones(6)
+        for i, kind in enumerate(kinds):
+            qlo = max(lo, 0.0) if kind == "prismatic" else lo
+            q = qlo + rng.uniform(0.25, 0.75) * (hi - qlo)
+            tilt = rng.uniform(0.1, 1.1)              # leg direction: up, leaning inwards
+            az = ang[i] + np.pi + rng.uniform(-0.8, 0.8)
+            d = np.array([np.sin(tilt) * np.cos(az), np.sin(tilt) * np.sin(az), np.cos(tilt)])
+            if kind == "prismatic":
+                if rng.random() < 0.25:
+                    d[2] = -d[2]
+                B[i] = W[i] - q * d
+            elif kind == "slider":
+                style = rng.choice(["vertical", "inclined", "horizontal"]) if rails == "any" \
+                    else rails
+                elev = {"vertical": np.pi / 2, "horizontal": 0.0}.get(
+                    style, rng.uniform(np.radians(10), np.radians(80)))
+                head = rng.uniform(0, 2 * np.pi)
+                e = np.array([np.cos(elev) * np.cos(head), np.cos(elev) * np.sin(head),
+                              np.sin(elev)]) * rng.choice([-1.0, 1.0])
+                if style == "vertical":
+                    e = np.array([0.0, 0.0, e[2] / abs(e[2])])
+                if abs(d @ e) < 0.2:                  # far from the serial singularity
+                    d = _unit(d + 0.5 * np.sign(d @ e or 1.0) * e)
+                link[i] = rng.uniform(150.0, 400.0)
+                branch[i] = -np.sign(d @ e)
+                axes[i] = e
+                B[i] = W[i] - link[i] * d - q * e
+            else:
+                n = _unit(rng.normal(size=3))
+                u = _unit(np.cross(n, rng.normal(size=3)))
+                v = np.cross(n, u)
+                crank_len[i], link[i] = rng.uniform(20.0, 80.0), rng.uniform(150.0, 350.0)
+                C = crank_len[i] * (np.cos(q) * u + np.sin(q) * v)
+                B[i] = W[i] - link[i] * d - C
+                axes[i], zero[i] = n, u
+                # the branch whose closed form gives back q
+                dd = W[i] - B[i]
+                E, F = 2 * crank_len[i] * dd @ u, 2 * crank_len[i] * dd @ v
+                G = dd @ dd + crank_len[i] ** 2 - link[i] ** 2
+                h = np.sqrt(max(E * E + F * F - G * G, 0.0))
+                branch[i] = min((1.0, -1.0), key=lambda b: abs(np.angle(np.exp(1j * (
+                    np.arctan2(F * G + b * E * h, E * G - b * F * h) - q)))))
+        m = SixLeg(B, P, kinds, axes, zero, crank_len, link, (lo, hi), branch, nominal=X0,
+                   name=f"random-{'-'.join(k[0] for k in kinds)}-{lower}")
+        if m.inverse(X0[None]).valid[0]:
+            return m
+    raise AssertionError(f"no valid random sixleg with legs {kinds} in {tries} tries")

@@ -27,6 +27,10 @@ the tool offset); ``d_i = W_i - B_i``. The actuator is one of three kinds:
 All legs share one actuator window (``stroke``), in mm when every leg is prismatic or a slider
 (the two may be mixed: a slider's ``B`` is where its actuator reads 0) and in rad when every leg
 is a crank. Mixing cranks with linear legs is refused (the protocol has one actuator unit).
+The window's lower limit must be > 0 when every leg is prismatic (a window of lengths, as
+``ups6``). Mixed with sliders it may be <= 0 (a rail coordinate may be negative); a prismatic
+leg's value is its length, >= 0, so such a limit bounds nothing on it: its feasible lengths
+are ``[max(min, 0), max]`` (none when ``max <= 0``), in the IK and in the columns alike.
 
 Workspace: every leg's feasible z set along an (x, y) column has closed form, and the engine
 gets the exact column method (``column_method``):
@@ -67,7 +71,7 @@ from ._slider import K_MIN, slider_interval
 from .base import NO_STROKE, Mechanism, as_points, as_stroke, as_vector3
 from .layout import PAIRED_ALIASES
 from .rss6 import _atan2
-from .ups6 import working_sides
+from .ups6 import _ups_column_leg, working_sides
 
 __all__ = ["SixLeg", "KINDS"]
 
@@ -139,23 +143,20 @@ def _sixleg_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin
 def _linear_interval(x, y, wx, wy, wz, k, p1, p2):
     """One leg's z interval on the column (x, y) (see :func:`._kernels.make_column_kernel`).
 
-    Slider on a vertical rail (``k != 0``): ``|k| = l²``, ``sign(k) = c`` and the interval is
-    ``[p1 - w_z + c·h, p2 - w_z + c·h]`` with ``h = sqrt(l² - |a_xy|²)`` (``psu6``'s for
-    ``c = 1``). Prismatic (``k == 0``): ``p1 = side·qmin²``, ``p2 = side·qmax²``; the interval
-    of ``ups6`` on the working-mode side."""
+    Prismatic (``k = ±inf``: the tag of a leg without a link, its sign the working-mode side):
+    ``p1 = max(qmin, 0)²``, ``p2 = qmax²`` (``-1`` when ``qmax <= 0``: never feasible); the
+    interval of ``ups6`` (:func:`.ups6._ups_column_leg`). The limits are stored apart from the
+    side because a leg length is >= 0: a window lower limit <= 0 bounds nothing
+    (:meth:`SixLeg._linear_params`). Slider on a vertical rail (finite ``k``): ``|k| = l² >
+    0``, ``sign(k) = c`` and the interval is ``[p1 - w_z + c·h, p2 - w_z + c·h]`` with ``h =
+    sqrt(l² - |a_xy|²)`` (``psu6``'s for ``c = 1``)."""
+    if math.isinf(k):
+        return _ups_column_leg(x, y, wx, wy, wz, k, p1, p2)
     ax = x + wx
     ay = y + wy
-    d2 = ax * ax + ay * ay
-    h2 = abs(k) - d2
+    h2 = abs(k) - (ax * ax + ay * ay)
     s = math.sqrt(h2 if h2 > 0.0 else 0.0)
     c = 1.0 if k > 0.0 else -1.0
-    A = abs(p2) - d2
-    B = abs(p1) - d2
-    ro = math.sqrt(A if A > 0.0 else 0.0)
-    ri = math.sqrt(B if B > 0.0 else 0.0)
-    up = p1 > 0.0
-    if k == 0.0:
-        return (-wz + ri if up else -wz - ro), (-wz + ro if up else -wz - ri), A >= 0.0
     return p1 - wz + c * s, p2 - wz + c * s, h2 >= 0.0
 
 
@@ -495,13 +496,25 @@ class SixLeg(Mechanism):
         return self._linear_params(lo, hi)
 
     def _linear_params(self, lo, hi) -> np.ndarray:
-        """``(6, 3)`` rows of :func:`_sixleg_column_leg` (meaningful for prismatic legs and
-        vertical rails)."""
+        """``(6, 3)`` rows ``(k, p1, p2)`` of :func:`_sixleg_column_leg` (meaningful for
+        prismatic legs and vertical rails; zero rows for the other legs).
+
+        Vertical rail: ``k = c·l²``, ``(p1, p2)`` the window along +z. Prismatic leg: ``k =
+        side·inf`` and the squared length window ``(max(lo, 0)², hi²)``, ``p2 = -1`` (no
+        length) when ``hi <= 0``. The actuator value of a prismatic leg is its length, which
+        is >= 0, so a shared window whose lower limit is <= 0 (for the sliders it is a rail
+        coordinate, which may be negative) puts no lower limit on the leg: the IK's
+        ``qmin <= |d|`` holds for every length, and the column keeps every length down to 0.
+        """
         sigma = self.axes[:, 2]                              # ±1 on vertical rails
         c = -sigma * self.branch
-        k = np.where(self._vertical, c * self.link_length**2, 0.0)
-        p1 = np.where(self._vertical, np.where(sigma > 0, lo, -hi), self._sides * lo * lo)
-        p2 = np.where(self._vertical, np.where(sigma > 0, hi, -lo), self._sides * hi * hi)
+        prism = self._mask("prismatic")
+        k = np.where(self._vertical, c * self.link_length**2,
+                     np.where(prism, self._sides * np.inf, 0.0))
+        lo2 = max(lo, 0.0) ** 2
+        hi2 = hi * hi if hi > 0.0 else -1.0
+        p1 = np.where(self._vertical, np.where(sigma > 0, lo, -hi), np.where(prism, lo2, 0.0))
+        p2 = np.where(self._vertical, np.where(sigma > 0, hi, -lo), np.where(prism, hi2, 0.0))
         return np.stack([k, p1, p2], axis=1)
 
     def column_intervals(self, xs, ys, R, mode, allowed=None, K=8):
