@@ -187,7 +187,7 @@ def ups_pruning(columns: int = 300, seed: int = 0) -> None:
     2.5 mm: the public call (tile pruning, :mod:`pkmlab.mechanisms._tiles`), the plain column
     kernel without pruning, and a plain NumPy brute force (every voxel × orientation × leg)
     run on ``columns`` random columns of the same grid and extrapolated to all of them."""
-    from pkmlab.mechanisms import _kernels
+    from pkmlab.mechanisms import _kernels, column_kernels
 
     big = load_mechanism(ROOT / "studies/mechanisms/gough-stewart-6ups.yaml")
     box = OrientationSet.box(np.radians([10.0] * 3), "simultaneous", samples=7)
@@ -200,7 +200,7 @@ def ups_pruning(columns: int = 300, seed: int = 0) -> None:
     W = _kernels.carray(W[np.argsort(-np.linalg.norm(R - np.eye(3), axis=(1, 2)),
                                      kind="stable")])
     lo, hi = np.empty((len(xs), len(ys), 1)), np.empty((len(xs), len(ys), 1))
-    plain = _kernels.make_column_kernel(type(big).column_leg, "all")
+    plain = column_kernels.make_column_kernel(type(big).column_leg, "all")
     t_plain, _ = timed(lambda: plain(_kernels.carray(xs), _kernels.carray(ys), W,
                                      _kernels.carray(big.column_params()), lo, hi), 3)
     tlo, thi, _ = big.column_intervals(xs, ys, R, "all")

@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 from pkmlab import load_mechanism
 from pkmlab.cli import app
 from pkmlab.errors import ParameterError
-from pkmlab.mechanisms._kernels import make_leg_eval
+from pkmlab.mechanisms.column_kernels import make_leg_eval
 from pkmlab.mechanisms.sixleg import SixLeg
 from pkmlab.mechanisms.ups6 import working_sides
 from pkmlab.study import evaluators as ev_mod

@@ -40,7 +40,7 @@ SCRIPT = '''
 import json, sys
 import numpy as np
 import pkmlab
-from pkmlab.mechanisms import _kernels
+from pkmlab.mechanisms import column_kernels, _kernels
 from pkmlab.poses import euler_to_matrix
 
 from numba.extending import register_jitable
@@ -100,7 +100,7 @@ for task in args["tasks"]:
         Wk = W.reshape(-1, 3)
         Pk = np.tile(m.column_params(), (len(R), 1))
         x = np.linspace(-60, 60, len(Wk))
-        a, b, ok = _kernels.make_leg_eval(type(m).column_leg)(x, x[::-1], Wk, Pk)
+        a, b, ok = column_kernels.make_leg_eval(type(m).column_leg)(x, x[::-1], Wk, Pk)
         fin = lambda v: np.where(np.isfinite(v), v, np.nan).tolist()
         out[task] = {"volume": ws.volume, "xs": xs.tolist(), "W": W.tolist(),
                      "P": m.column_params().tolist(), "all": [fin(lo), fin(hi)],
@@ -354,15 +354,15 @@ FAMILY_SCRIPT = '''
 import json
 import numpy as np
 import famx
-from pkmlab.mechanisms import _kernels
+from pkmlab.mechanisms import column_kernels, _kernels
 
 X = np.array([[0.0, 0.0, 10.0, 0.0, 0.0, 0.0]])
 q, st, reason = np.empty((1, 6)), np.empty((1, 6), np.int8), np.empty(1, np.int8)
 _kernels.make_driver(famx.one, 6, "euler")(X, (1., 2., 3., 4., 5., 6.), -1e9, 1e9, q, st, reason)
-a, _, _ = _kernels.make_leg_eval(famx.leg)(np.ones(1), np.ones(1), np.zeros((1, 3)),
+a, _, _ = column_kernels.make_leg_eval(famx.leg)(np.ones(1), np.ones(1), np.zeros((1, 3)),
                                            np.full((1, 3), 2.0))
 lo, hi = np.empty((1, 1, 1)), np.empty((1, 1, 1))
-_kernels.make_column_kernel(famx.leg, "all")(np.ones(1), np.ones(1), np.zeros((1, 6, 3)),
+column_kernels.make_column_kernel(famx.leg, "all")(np.ones(1), np.ones(1), np.zeros((1, 6, 3)),
                                             np.full((6, 3), 2.0), lo, hi)
 print("RESULT " + json.dumps([q[0].tolist(), float(a[0]), float(lo[0, 0, 0])]))
 '''
@@ -430,14 +430,15 @@ def test_compiling_a_kernel_shows_no_numba_ir_warning(monkeypatch):
 
 
 _RELOAD = """
-from pkmlab.mechanisms import _kernels, _search, _tiles, psu6, ups6
+from pkmlab.mechanisms import column_kernels, _kernels, _search, _tiles, psu6, ups6
 
 missed = []
 for fam in (psu6.PSU6, ups6.UPS6):
     leg = fam.column_leg
     for k in (_search.make_capability(leg), _search.make_branch_bound(leg),
               _search.make_certify(leg), _tiles.make_tiled_all(leg),
-              _kernels.make_column_kernel(leg, "all"), _kernels.make_column_kernel(leg, "any")):
+              column_kernels.make_column_kernel(leg, "all"),
+              column_kernels.make_column_kernel(leg, "any")):
         if sum(k.stats.cache_misses.values()) or not sum(k.stats.cache_hits.values()):
             missed.append(k.py_func.__name__)
 print(len(missed), " ".join(missed))

@@ -17,7 +17,7 @@ from conftest import assert_point_holds
 from scipy.optimize import minimize
 
 from pkmlab import UPS6, load_mechanism
-from pkmlab.mechanisms import NO_STROKE, _kernels, _tiles
+from pkmlab.mechanisms import NO_STROKE, _kernels, _tiles, column_kernels
 from pkmlab.poses import euler_to_matrix
 from pkmlab.workspaces import OrientationSet
 from pkmlab.workspaces.engine import _grid_xy
@@ -36,7 +36,7 @@ def _plain_and_tiled(mech, R, h):
                                      kind="stable")])
     P = _kernels.carray(mech.column_params())
     out = [np.empty((len(xs), len(ys), 1)) for _ in range(4)]
-    _kernels.make_column_kernel(type(mech).column_leg, "all")(
+    column_kernels.make_column_kernel(type(mech).column_leg, "all")(
         _kernels.carray(xs), _kernels.carray(ys), W, P, out[0], out[1])
     _tiles.make_tiled_all(type(mech).column_leg)(
         _kernels.carray(xs), _kernels.carray(ys), W, P, out[2], out[3])

@@ -60,7 +60,7 @@ import numpy as np
 from numba import types as nt
 
 from .._jit import cached_kernel, identity, jitable
-from . import _kernels
+from . import _kernels, column_kernels
 from ._tiles import DPAD, tile_distances  # DPAD: padding of distance ranges (mm)
 
 __all__ = ["make_branch_bound", "make_certify", "make_capability", "DPAD"]
@@ -89,7 +89,7 @@ FEASIBLE, EMPTY, UNDECIDED = 1.0, 0.0, -1.0
 def _core(leg):
     """The jitable building blocks for ``leg`` (margin, tile bound, sample, branch and bound,
     certification), named after their identity like the IK stage functions."""
-    leg = _kernels._inlined(leg)
+    leg = column_kernels.inlined(leg)
 
     def sample(U, Bp, e0, theta, n, W):
         """``W (n³, 6, 3)`` of the ±theta box sampled with n angles per axis about e0."""

@@ -24,7 +24,8 @@ from numba.extending import register_jitable
 from .._intervals import union_merge
 from .._jit import cached_kernel
 from ._crank import PIECES
-from ._kernels import _inlined, carray
+from ._kernels import carray
+from .column_kernels import inlined
 
 __all__ = ["make_set_column_kernel", "set_column_intervals", "intersect_sets"]
 
@@ -59,13 +60,13 @@ def intersect_sets(alo, ahi, na, blo, bhi, nb, out_lo, out_hi, K):
 @cache
 def make_set_column_kernel(leg, mode: str):
     """Parallel ``columns_all`` (``mode="all"``) or ``columns_any`` (``"any"``) for the set leg
-    ``leg``; cached like :func:`._kernels.make_column_kernel`.
+    ``leg``; cached like :func:`.column_kernels.make_column_kernel`.
 
     ``columns_all(xs (nx,), ys (ny,), W (M, 6, 3), P (6, np), out_lo, out_hi (nx, ny, K),
     count (nx, ny) int64)``; ``columns_any(xs, ys, W, P, allowed (nx, ny, M) bool, out_lo,
     out_hi, count)``. ``count`` is the number of pieces, ``K + 1`` on overflow.
     """
-    leg = _inlined(leg)
+    leg = inlined(leg)
 
     def columns_all(xs, ys, W, P, out_lo, out_hi, count):
         """Intersection over orientations ``W (M, 6, 3)`` and legs, column by column; a column

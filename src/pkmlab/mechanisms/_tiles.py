@@ -19,8 +19,8 @@ A tile's columns keep ``[max a, min b]`` over every leg × orientation. With
 
 The kept pairs give each column the same maximum and minimum as all pairs (a max or min over a
 subset that contains the extreme element is that element, bit for bit), so the intervals are
-identical to :func:`._kernels.make_column_kernel`'s ``columns_all`` (tested on the 6-PSU and the
-6-UPS). The distances are padded by :data:`DPAD` and the comparisons by :data:`SLACK`, so that
+identical to :func:`.column_kernels.make_column_kernel`'s ``columns_all`` (tested on the 6-PSU
+and the 6-UPS). The distances are padded by :data:`DPAD` and the comparisons by :data:`SLACK`, so that
 rounding in the distance of a column cannot make a pruned pair the extreme one (the leg
 functions are monotone in the computed distance under rounding, too: squares, differences and
 ``sqrt`` are). Top-level tiles of :data:`TILE` × :data:`TILE` columns are visited in parallel;
@@ -40,7 +40,7 @@ from numba import types as nt
 from numba.extending import register_jitable
 
 from .._jit import cached_kernel
-from . import _kernels
+from . import column_kernels
 
 __all__ = ["MIN_COLUMNS", "TILE", "make_tiled_all", "tile_distances"]
 
@@ -79,8 +79,8 @@ def tile_distances(x0, x1, y0, y1, cx, cy):
 def make_tiled_all(leg):
     """Parallel ``columns_all(xs, ys, W (M, 6, 3), P (6, 3), out_lo, out_hi (nx, ny, 1))`` for
     a radial per-leg interval ``leg``, with the tile pruning of the module notes; the same
-    signature and results as :func:`._kernels.make_column_kernel` ``(leg, "all")``."""
-    leg = _kernels._inlined(leg)
+    signature and results as :func:`.column_kernels.make_column_kernel` ``(leg, "all")``."""
+    leg = column_kernels.inlined(leg)
 
     def tiled_all(xs, ys, W, P, out_lo, out_hi):
         nx, ny, M = xs.shape[0], ys.shape[0], W.shape[0]

@@ -71,7 +71,7 @@ from ..errors import ParameterError
 from ..poses import as_frames, log_so3
 from ..threads import threads_for
 from ..tolerances import TOL
-from . import _kernels, _tiles
+from . import _kernels, _tiles, column_kernels
 from .mobility import SPATIAL, Mobility
 from .results import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult
 from .solvers import bracketed_root, forward_newton, multistart_modes
@@ -135,7 +135,7 @@ class Mechanism:
     column_radial: ClassVar[bool] = False
 
     #: numba per-leg column interval ``leg(x, y, wx, wy, wz, p0, p1, p2) -> (a, b, ok)`` (see
-    #: :func:`._kernels.make_column_kernel`); families with it set ``column_method``. Test
+    #: :func:`.column_kernels.make_column_kernel`); families with it set ``column_method``. Test
     #: ``mech.column_leg is None`` (per instance); kernels are built from ``type(mech)``'s.
     column_leg: ClassVar[Any] = None
 
@@ -209,7 +209,7 @@ class Mechanism:
             # leg × orientation pairs pruned (exact, :mod:`._tiles`)
             tiled = self.column_radial and nx * ny >= _tiles.MIN_COLUMNS
             columns_all = (_tiles.make_tiled_all(type(self).column_leg) if tiled
-                           else _kernels.make_column_kernel(type(self).column_leg, "all"))
+                           else column_kernels.make_column_kernel(type(self).column_leg, "all"))
             with threads_for(nx * ny * len(W)):
                 columns_all(xs, ys, _kernels.carray(W), P, lo, hi)
             return lo, hi, 0
@@ -217,7 +217,7 @@ class Mechanism:
             allowed = np.ones((nx, ny, len(R)), dtype=np.bool_)
         lo, hi = np.empty((nx, ny, K)), np.empty((nx, ny, K))
         count = np.empty((nx, ny), dtype=np.int64)
-        columns_any = _kernels.make_column_kernel(type(self).column_leg, "any")
+        columns_any = column_kernels.make_column_kernel(type(self).column_leg, "any")
         with threads_for(nx * ny * len(W)):
             columns_any(xs, ys, _kernels.carray(W), P, _kernels.carray(allowed, np.bool_), lo,
                         hi, count)

@@ -141,7 +141,7 @@ def _sixleg_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin
 
 @register_jitable
 def _linear_interval(x, y, wx, wy, wz, k, p1, p2):
-    """One leg's z interval on the column (x, y) (see :func:`._kernels.make_column_kernel`).
+    """One leg's z interval on the column (x, y) (see :func:`.column_kernels.make_column_kernel`).
 
     Prismatic (``k = ±inf``: the tag of a leg without a link, its sign the working-mode side):
     ``p1 = max(qmin, 0)²``, ``p2 = qmax²`` (``-1`` when ``qmax <= 0``: never feasible); the

@@ -61,7 +61,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..mechanisms._kernels import make_leg_eval
+from ..mechanisms.column_kernels import make_leg_eval
 from ..poses import as_frames, matrix_to_euler
 from ..workspaces import cells as oc
 from ..workspaces.constraints import Constraints, check

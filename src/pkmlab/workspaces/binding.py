@@ -21,7 +21,7 @@ import logging
 
 import numpy as np
 
-from ..mechanisms._kernels import make_leg_eval
+from ..mechanisms.column_kernels import make_leg_eval
 from ..poses import euler_to_matrix
 
 log = logging.getLogger(__name__)

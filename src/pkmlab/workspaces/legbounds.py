@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..mechanisms._kernels import make_leg_eval
+from ..mechanisms.column_kernels import make_leg_eval
 from . import cells as oc
 
 __all__ = ["Legs", "EPS"]
