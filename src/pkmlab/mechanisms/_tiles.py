@@ -20,14 +20,13 @@ A tile's columns keep ``[max a, min b]`` over every leg × orientation. With
 The kept pairs give each column the same maximum and minimum as all pairs (a max or min over a
 subset that contains the extreme element is that element, bit for bit), so the intervals are
 identical to :func:`.column_kernels.make_column_kernel`'s ``columns_all`` (tested on the 6-PSU
-and the 6-UPS). The distances are padded by :data:`DPAD` and the comparisons by
-:data:`SLACK`, so that rounding in the distance of a column cannot make a pruned pair the extreme one (the leg
+and the 6-UPS). The distances are padded by :data:`DPAD` and the comparisons by :data:`SLACK`,
+so that rounding in the distance of a column cannot make a pruned pair the extreme one (the leg
 functions are monotone in the computed distance under rounding, too: squares, differences and
 ``sqrt`` are). Top-level tiles of :data:`TILE` × :data:`TILE` columns are visited in parallel;
 each is split in four, depth first, down to :data:`LEAF` × :data:`LEAF`, every level bounding
 only the pairs its parent kept; at a leaf the kept pairs run over its columns, the hardest
-(most tilted) orientations first as in ``columns_all``.
-"""
+(most tilted) orientations first as in ``columns_all``. """
 
 from __future__ import annotations
 
