@@ -72,7 +72,7 @@ import numpy as np
 from ..poses import matrix_to_euler
 from ._boundary import column_ends
 from ._linalg import KAPPA_BRACKET, KAPPA_ROUND, kappa_upper, sweep_bounds
-from .aggregate import _CHUNK, _ik_valid, _units, _voxels
+from .aggregate import _CHUNK, _ik_valid, _units, _voxels, orientation_batches
 from .force import _fmax, max_force_all_directions
 from .metrics import KAPPA_SINGULAR, CharacteristicLength, condition_number, resolve_length
 
@@ -345,9 +345,9 @@ def worst_case(mech, result, L: float | CharacteristicLength | None = None,
         log.debug("worst_case: %d of %d (unit, orientation) pairs infeasible",
                   U * M - n_feasible, U * M)
     end_pos = np.empty((0, 3)) if ends is None else ends.pos
-    feas_end = (np.zeros((0, M), dtype=bool) if not E else
-                _ik_valid(mech, np.tile(ends.probe, (M, 1)),
-                          np.repeat(Rs, E, axis=0)).reshape(M, E).T)
+    feas_end = np.zeros((E, M), dtype=bool)
+    for m0, n, p, Rr in (orientation_batches(ends.probe, Rs) if E else ()):
+        feas_end[:, m0:m0 + n] = _ik_valid(mech, p, Rr).reshape(n, E).T
 
     vox = _sweep(mech, unit_pos, Rs, feas, L, fmax)
     bnd = _sweep(mech, end_pos, Rs, feas_end, L, fmax)

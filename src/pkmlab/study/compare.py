@@ -12,7 +12,8 @@ request, so a compare row can be reproduced with the other commands:
 * L: :func:`pkmlab.dexterity.resolve_length` (Angeles'), with its status;
 * GCI: :func:`pkmlab.dexterity.gci_grid` (every voxel × orientation sample, singular poses
   counting 0); κ range: the grid's smallest κ … :func:`pkmlab.dexterity.worst_case`'s worst κ
-  (inf with a singular pose found inside or on the boundary); force: ``worst_case``'s smallest all-direction force;
+  (inf with a singular pose found inside or on the boundary); force: ``worst_case``'s
+  smallest all-direction force;
 * the paper's ±2 in / ±30° motion: :func:`pkmlab.trajectory.check_trajectory`.
 
 The inscribed shapes, GCI, κ and force are over the dexterous workspace, or over the level one
