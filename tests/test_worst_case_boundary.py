@@ -137,3 +137,62 @@ def test_a_singularity_free_workspace_stays_not_excluded_and_its_kappa_converges
     assert ok[inner].all()                            # the slots are feasible inside
     assert kap.max() <= w[10.0].worst_kappa * (1 + 1e-9)
     assert kap.max() > w[10.0].grid_max_kappa * 1.01   # beyond the voxel centres alone
+
+
+def test_sign_changes_at_the_column_ends_are_counted_and_genuine():
+    """The 6-UPS ±10° dexterous workspace at 20 mm (a parallel singularity crosses it): the sign
+    changes of det J between each column end and the nearest voxel centre of its slot, and
+    between neighbouring orientation samples at an end, recounted with LAPACK determinants and
+    a search of the slot for its voxel centres; one such pair bisected to κ > 1e10."""
+    from pkmlab.workspaces import OrientationSet
+
+    res = workspace(UPS, "dexterous", OrientationSet.box(np.radians([10] * 3), samples=3), 20.0)
+    L = dx.resolve_length(UPS).length
+    w = dx.worst_case(UPS, res, L)
+    Rs = res.orientations.rotations()
+    M = len(Rs)
+
+    def sign(p, valid_at):
+        P, R = np.repeat(p, M, axis=0), np.tile(Rs, (len(p), 1, 1))
+        ok = UPS.inverse((valid_at if valid_at is not None else P, R)).valid
+        return np.where(ok, np.sign(np.linalg.det(UPS.jacobian((P, R)))), 0).reshape(-1, M)
+
+    n = 0
+    first = None
+    for i, j, k in np.argwhere(res.lo <= res.hi):
+        z0, z1 = res.lo[i, j, k], res.hi[i, j, k]
+        inside = np.flatnonzero((res.zs >= z0) & (res.zs <= z1) & res.occupancy[i, j])
+        ends = np.array([[res.xs[i], res.ys[j], z0], [res.xs[i], res.ys[j], z1]])
+        d = min(1e-6, (z1 - z0) / 2)
+        probe = np.repeat(ends + [[0, 0, d], [0, 0, -d]], M, axis=0)
+        se = sign(ends, probe)
+        if len(inside):
+            near = np.array([[res.xs[i], res.ys[j], res.zs[inside[0]]],
+                             [res.xs[i], res.ys[j], res.zs[inside[-1]]]])
+        else:
+            near = ends[::-1][:1]                   # lower end ↔ upper end, once
+            se = se[:1]
+        sn = sign(near, None)
+        hit = se * sn < 0
+        n += int(hit.sum())
+        if first is None and hit.any():
+            q, m = np.argwhere(hit)[0]
+            first = (ends[q], near[q], Rs[m])
+        g = sign(ends, probe).reshape(2, 3, 3, 3)
+        for ax in (1, 2, 3):
+            a = np.take(g, range(2), axis=ax)
+            b = np.take(g, range(1, 3), axis=ax)
+            n += int(np.sum(a * b < 0))
+    assert w.boundary_sign_changes == n > 0
+    a, b, R = first
+
+    def det(t):
+        return np.linalg.det(UPS.jacobian((((1 - t) * a + t * b)[None], R[None]))[0])
+
+    lo, hi = 0.0, 1.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if det(lo) * det(mid) > 0 else (lo, mid)
+    Jh = UPS.jacobian(((((1 - lo) * a + lo * b))[None], R[None]))[0]
+    Jh[:, 3:] /= L
+    assert np.linalg.cond(Jh) > 1e10
