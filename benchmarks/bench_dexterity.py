@@ -102,7 +102,8 @@ def bench_worst_case(mech, res, length, runs: int = 7) -> None:
         w = dx.worst_case(mech, res, length)
         wall.append(time.perf_counter() - t)
         cpu.append(time.process_time() - c)
-    worst = "inf (singular)" if not np.isfinite(w.worst_kappa) else f"{w.worst_kappa:.4f}"
+    worst = ("inf (singular)" if not np.isfinite(w.worst_kappa) else
+             f"{w.worst_kappa:.4f} (singularity {w.singularity})")
     print(f"worst case, {mech.name}: κ {worst}, force {w.min_force:.2f} N; wall median "
           f"{np.median(wall) * 1e3:.0f} ms, CPU median {np.median(cpu) * 1e3:.0f} ms "
           f"({runs} runs)\n  {w.method}" + (f"\n  {w.reason}" if w.reason else ""))

@@ -58,7 +58,7 @@ def test_compare_gci_counts_singular_poses_as_zero():
     assert row["worst_case"]["singular"] and row["worst_case"]["singular_samples"] > 0
     assert row["characteristic_length"]["status"] == "angeles"
     md = comparison_markdown([row])
-    assert "singular pose inside" in md and "±5° simultaneous" in md
+    assert "singular pose (inside or on the boundary)" in md and "±5° simultaneous" in md
 
 
 def test_compare_inscribed_shapes_are_those_of_the_workspace_command(tmp_path):

@@ -76,6 +76,33 @@ def brute_sign_changes(res, det, valid) -> int:
     return n
 
 
+def brute_ends(mech, res, L):
+    """κ (np.linalg.cond, inf above 1e12 or for a non-finite J) at both ends of every column
+    slot, masked where the inverse kinematics fails 1e-6 mm inside the slot; for a family
+    whose J does not depend on z, only the columns without an occupied voxel. ``(E, M)``."""
+    i, j, k = np.nonzero(res.lo <= res.hi)
+    if mech.column_invariant:
+        keep = ~res.occupancy.any(axis=2)[i, j]
+        i, j, k = i[keep], j[keep], k[keep]
+    z0, z1 = res.lo[i, j, k], res.hi[i, j, k]
+    d = np.minimum(1e-6, (z1 - z0) / 2)
+    ends = np.concatenate([np.column_stack([res.xs[i], res.ys[j], z0]),
+                           np.column_stack([res.xs[i], res.ys[j], z1])])
+    probe = ends + np.concatenate([d, -d])[:, None] * [0, 0, 1]
+    Rs = res.orientations.rotations()
+    E, M = len(ends), len(Rs)
+    if not E:
+        return np.ma.masked_array(np.empty((0, M)), np.zeros((0, M), dtype=bool))
+    J = mech.jacobian((np.tile(ends, (M, 1)), np.repeat(Rs, E, axis=0)))
+    fin = np.all(np.isfinite(J), axis=(1, 2))
+    J[..., 3:] /= L
+    kap = np.full(len(J), np.inf)
+    kap[fin] = np.linalg.cond(J[fin])
+    kap[kap >= 1e12] = np.inf
+    ok = mech.inverse((np.tile(probe, (M, 1)), np.repeat(Rs, E, axis=0))).valid
+    return np.ma.masked_array(kap.reshape(M, E).T, ~ok.reshape(M, E).T)
+
+
 @pytest.fixture(scope="module")
 def psu_small():
     return workspace(PSU, "dexterous", OrientationSet.box(np.radians([15] * 3), samples=3), 5.0)
@@ -184,14 +211,29 @@ def test_worst_case_is_the_extreme_of_every_grid_sample(case, psu_small):
         assert w.grid_max_kappa == math.inf
     assert w.grid_min_force == pytest.approx(np.nanmin(fv), rel=1e-9, abs=1e-12)
     assert w.sign_changes == brute_sign_changes(res, det, valid)
-    assert w.singular == (n_sing > 0 or w.sign_changes > 0)
+    # the column ends (the exact z ends of every slot; for the 6-PSU only of columns without
+    # a voxel, whose J is not already evaluated): κ by LAPACK at the end, feasibility by the
+    # inverse kinematics 1e-6 mm inside the slot
+    bk = brute_ends(mech, res, L.length)
+    assert w.boundary_points == bk.shape[0] and w.boundary_feasible == int(bk.count())
+    kb = bk.compressed()
+    assert w.boundary_singular == int(np.sum(~np.isfinite(kb)))
+    if len(kb) and np.isfinite(kb).all():
+        assert w.boundary_max_kappa == pytest.approx(kb.max(), rel=1e-9)
+    assert w.singular == (n_sing > 0 or w.sign_changes > 0 or w.boundary_singular > 0
+                          or w.boundary_sign_changes > 0)
+    assert w.singularity == ("singular" if w.singular else "not excluded")
+    if case == "ups-constant":               # all six legs horizontal on the base plane
+        assert w.singular and w.boundary_singular > 0 and "column end" in w.reason
     if w.singular:
         assert w.worst_kappa == math.inf and w.min_force == 0.0 and w.reason
     else:
-        assert w.worst_kappa == w.grid_max_kappa and w.min_force == w.grid_min_force
-    # the reported poses are grid samples with those values
-    X = w.worst_kappa_pose[None]
-    assert dx.condition_number(mech.jacobian(X), L)[0] == pytest.approx(w.grid_max_kappa)
+        top = max(w.grid_max_kappa, kb.max()) if len(kb) else w.grid_max_kappa
+        assert w.worst_kappa == pytest.approx(top, rel=1e-12)
+        assert w.min_force <= w.grid_min_force
+        # the reported pose is a sample or a column end with that value
+        X = w.worst_kappa_pose[None]
+        assert dx.condition_number(mech.jacobian(X), L)[0] == pytest.approx(w.worst_kappa)
     assert w.voxels == len(pos) and w.orientations == kap.shape[1]
     assert w.length.status == "angeles" and w.L == L.length
     assert f"{w.voxels:,} voxels × {w.orientations:,} orientations" in w.method

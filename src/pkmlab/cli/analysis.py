@@ -185,9 +185,10 @@ def _print_dexterity(rep, force_limit, well_conditioned, force_required, written
                   f"{g(agg['gci_monte_carlo_std_error'], '.4f')} (Monte-Carlo, "
                   f"{agg['gci_samples']} samples)")
         worst = "inf" if w["worst_kappa"] is None else f"{w['worst_kappa']:.4g}"
-        out.print(f"  worst case over every voxel × orientation: κ {worst}, force "
-                  f"{g(w['min_force_N'], '.1f')} N"
-                  + ("" if not w["singular"] else escape(f" — singular: {w['reason']}")),
+        out.print(f"  worst case over every voxel and column end × orientation: κ {worst}, "
+                  f"force {g(w['min_force_N'], '.1f')} N"
+                  + (" — singularity not excluded between samples" if not w["singular"]
+                     else escape(f" — singular: {w['reason']}")),
                   highlight=False)
         out.print(f"  κ min {g(k['min'], '.3g')}, mean {g(k['mean'], '.3g')}, p95 "
                   f"{g(k['p95'], '.3g')}; κ ≤ {well_conditioned:g} in "

@@ -12,7 +12,8 @@ request, so a compare row can be reproduced with the other commands:
 * L: :func:`pkmlab.dexterity.resolve_length` (Angeles'), with its status;
 * GCI: :func:`pkmlab.dexterity.gci_grid` (every voxel × orientation sample, singular poses
   counting 0); κ range: the grid's smallest κ … :func:`pkmlab.dexterity.worst_case`'s worst κ
-  (inf with a singular pose inside); force: ``worst_case``'s smallest all-direction force;
+  (inf with a singular pose found inside or on the boundary); force: ``worst_case``'s
+  smallest all-direction force;
 * the paper's ±2 in / ±30° motion: :func:`pkmlab.trajectory.check_trajectory`.
 
 The inscribed shapes, GCI, κ and force are over the dexterous workspace, or over the level one
@@ -46,7 +47,7 @@ COLUMNS = [
     ("gci", "GCI (grid; singular poses count 0)", "{:.4f}"),
     ("kappa_range", "κ range (grid min … worst case)", "{}"),
     ("force_N", "force, every direction: worst case (N)", "{:.1f}"),
-    ("singular", "singular pose inside", "{}"),
+    ("singular", "singular pose (inside or on the boundary)", "{}"),
     ("paper_motion", "paper motion: stroke used / margin", "{}"),
 ]
 
@@ -120,7 +121,8 @@ def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
             "kappa_range": (f"{kmin:.2f} … {wc.worst_kappa:.2f}" if wc.ok and not wc.singular
                             else f"{kmin:.2f} … inf" if wc.ok else wc.reason),
             "force_N": wc.min_force if wc.ok else wc.reason,
-            "singular": ("no" if not wc.singular else f"yes: {wc.reason}") if wc.ok
+            "singular": ("not found (not excluded between samples)" if not wc.singular
+                         else f"yes: {wc.reason}") if wc.ok
             else wc.status,
             "worst_case": wc.as_dict(),
             "paper_motion": (f"{100 * used:.0f} % / {margin:.2f} mm"
@@ -146,9 +148,10 @@ def comparison_markdown(rows: list[dict], box_deg: float | None = None) -> str:
     lines += ["", f"Inscribed shapes: {req.get('inscribed', '')}, the call of "
               "`pkmlab workspace --inscribed`. L: Angeles' characteristic length (status in "
               "brackets). GCI: every voxel × orientation sample. κ range and force: the grid's "
-              "smallest κ and `pkmlab.dexterity.worst_case` (every voxel × orientation sample; "
-              "inf / 0 N when a singular pose lies inside, found at a sample or by a sign change "
-              "of det J between neighbouring samples)."]
+              "smallest κ and `pkmlab.dexterity.worst_case` (every voxel and column end × "
+              "orientation sample; inf / 0 N when a singular pose is found inside or on the "
+              "boundary, at a sample or column end or by a sign change of det J between "
+              "neighbours; otherwise a singular pose between samples is not excluded)."]
     return "\n".join(lines) + "\n"
 
 

@@ -269,7 +269,8 @@ def _dexterity(mech, ctx: Context) -> dict:
     out["min_force"] = float(wc.min_force)
     out["singularity_free"] = float(not wc.singular)
     if wc.singular:
-        ctx.notes["worst_kappa"] = f"singular pose inside the workspace: {wc.reason}"
+        ctx.notes["worst_kappa"] = (f"singular pose in the workspace or on its boundary: "
+                                    f"{wc.reason}")
     # one Monte-Carlo sample serves every sampled statistic
     p, R = dx.aggregate.sample_poses(res, plan.gci_samples, np.random.default_rng(ctx.seed))
     g = dx.gci_monte_carlo(mech, res, length, poses=(p, R))

@@ -134,12 +134,17 @@ _ALL = [
     Metric("characteristic_length", "dexterity", "mm", "exact",
            "length L homogenising the Jacobian (Angeles' or the one given)"),
     Metric("worst_kappa", "dexterity", "", "worst-case",
-           "largest κ over every voxel of the workspace × every orientation sample "
-           "(inf when a singular pose lies inside: stored as null with a note)"),
+           "largest κ over every voxel of the workspace and every end of its exact columns × "
+           "every orientation sample (inf when a singular pose is found inside or on the "
+           "boundary: stored as null with a note)"),
     Metric("min_force", "dexterity", "N", "worst-case",
-           "smallest force held in every direction over every voxel × orientation sample"),
+           "smallest force held in every direction over every voxel and column end × "
+           "orientation sample"),
     Metric("singularity_free", "dexterity", "", "flag",
-           "1 when no voxel × orientation sample of the workspace is singular"),
+           "0 when a singular pose is certified in the workspace or on its boundary (a "
+           "singular voxel or column end, or a sign change of det J between neighbours); 1 "
+           "when none was found — a search, not a proof: a singularity between samples is "
+           "not excluded"),
     Metric("gci", "dexterity", "", "sampled",
            "global conditioning index: Monte-Carlo mean of 1/κ over the workspace "
            "(singular poses count 0); standard error in gci_std_error"),
