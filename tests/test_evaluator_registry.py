@@ -159,6 +159,15 @@ def test_an_actuator_of_the_wrong_kind_is_refused_at_load(tmp_path):
                        r"column \d+\): must be a block this mechanism can serve \(actuators "
                        r"needs linear actuators; family 'rss6' has rotary actuators"):
         load_study(write(tmp_path, data))
+    # the needed stroke is a prismatic travel (mm): a servo family is refused, not given a
+    # null with a note for every candidate
+    data["evaluate"] = {"workspace": {"kind": "dexterous", "box": [5, 5, 5], "samples": 3},
+                        "needed_stroke": True}
+    data["objectives"] = [{"minimize": "needed_stroke"}]
+    with pytest.raises(ParameterError, match=r"^evaluate\.needed_stroke \(study\.yaml, line "
+                       r"\d+, column \d+\): must be a block this mechanism can serve "
+                       r"\(needed_stroke needs linear actuators; family 'rss6' has rotary"):
+        load_study(write(tmp_path, data))
 
 
 # ---- 3. an evaluator from outside the package ----

@@ -16,7 +16,8 @@ class NeededStroke(Evaluator):
     description = ("the smallest actuator travel at which the workspace's simultaneous Euler "
                    "box (equal half-ranges) has a dexterous position, bracketed "
                    "(needed_stroke, _lower, _bracket)")
-    requires = frozenset({"rotations", "workspace"})
+    # a travel in mm of prismatic actuators over an orientation box
+    requires = frozenset({"rotations", "linear actuator", "workspace"})
     after = ("workspace",)
     metrics = (
         metric("needed_stroke", "mm", "bound",
