@@ -151,7 +151,8 @@ def test_analyses_that_assume_six_coordinates_refuse_a_lower_mobility_clearly(tr
              "evaluate": {"workspace": {"kind": "constant", "resolution": "10 mm"}},
              "objectives": [{"maximize": "constant_volume"}],
              "optimizer": {"method": "sobol", "samples": 4}}
-    with pytest.raises(ParameterError, match="mechanism.family: must be a mechanism with six"):
+    with pytest.raises(ParameterError, match=r"evaluate.workspace: must be a block this "
+                       r"mechanism can serve \(workspace needs six free pose coordinates"):
         study_from_mapping(study, tmp_path)
 
 

@@ -594,7 +594,7 @@ def test_rod_legs_need_fixed_base_joints():
         leg_rod_masses(mech, 1.0)
 
 
-def test_rotary_servo_fit_on_rss6_and_kind_mismatch_is_invalid(tmp_path):
+def test_rotary_servo_fit_on_rss6_and_kind_mismatch_is_refused(tmp_path):
     mech = load_mechanism(MECH_DIR / "instructables-servo-6rss.yaml")
     m = sinusoid_motion(mech, [0, 0, 5, 0.05, 0, 0], [0, 0, 1.0, 0.7, 0, 0], duration=1.5,
                         rate=200)
@@ -611,7 +611,8 @@ def test_rotary_servo_fit_on_rss6_and_kind_mismatch_is_invalid(tmp_path):
     assert out.torque_speed_margin == pytest.approx(100 * np.min(avail - T) / (4 * tmax))
     used = np.max(res.q.max(0) - res.q.min(0))
     assert out.stroke_margin == pytest.approx(math.degrees(math.pi - used))
-    # a linear actuator on a rotary family: the design is invalid, and says why
+    # a linear actuator on a rotary family: refused at load, naming the block (issue 23:
+    # before, it validated and every design came back invalid)
     data = {"study": "servo", "mechanism": {"file": str(MECH_DIR /
                                                         "instructables-servo-6rss.yaml")},
             "design": {"crank_length": {"low": "20 mm", "high": "30 mm"}},
@@ -622,9 +623,9 @@ def test_rotary_servo_fit_on_rss6_and_kind_mismatch_is_invalid(tmp_path):
                          "actuators": {"spec": {"name": "lin", "force": "10 N",
                                                 "speed": "10 mm/s"}}},
             "objectives": [{"minimize": "peak_actuator_force"}], "optimizer": {"method": "grid"}}
-    s = study_from_mapping(data, tmp_path)
-    rec = evaluate_design(s.space, None, s.evaluation, 0)
-    assert rec["status"] == "invalid" and "rotary actuator" in rec["reason"], rec["reason"]
+    with pytest.raises(ParameterError, match=r"evaluate.actuators: must be a block this "
+                       r"mechanism can serve \(actuators needs linear actuators"):
+        study_from_mapping(data, tmp_path)
 
 
 def test_motion_metrics_carry_the_actuators_units(tmp_path):

@@ -144,7 +144,7 @@ def test_resolved_study_reloads_to_the_same_study_in_its_stated_units(tmp_path):
 
 
 def test_readme_metric_table_is_the_registry():
-    from pkmlab.study.metrics import metrics_markdown
+    from pkmlab.study.evaluators.registry import metrics_markdown
 
     readme = (ROOT / "README.md").read_text()
     assert metrics_markdown() in readme, "regenerate the README table: pkmlab metrics"
@@ -154,8 +154,8 @@ def test_every_evaluator_writes_exactly_its_declared_metrics(monkeypatch, tmp_pa
     s = load_study(write(tmp_path, study(tmp_path)))
     metrics, _ = ev_mod.evaluate_mechanism(s.baseline(), s.evaluation, 0)
     assert set(metrics) == set(s.evaluation.metrics)
-    real = ev_mod.EVALUATORS["workspace"]
-    monkeypatch.setitem(ev_mod.EVALUATORS, "workspace",
+    real = ev_mod.EVALUATORS["workspace"].compute
+    monkeypatch.setattr(ev_mod.EVALUATORS["workspace"], "compute",
                         lambda m, c: {**real(m, c), "bogus": 1.0})
     with pytest.raises(AssertionError, match="bogus"):
         ev_mod.evaluate_mechanism(s.baseline(), s.evaluation, 0)
@@ -189,7 +189,7 @@ def test_a_programming_error_stops_the_run_after_it_is_recorded(monkeypatch, tmp
     def broken(mech, ctx):
         raise TypeError("unsupported operand")            # a bug, not a numerical failure
 
-    monkeypatch.setitem(ev_mod.EVALUATORS, "workspace", broken)
+    monkeypatch.setattr(ev_mod.EVALUATORS["workspace"], "compute", broken)
     with pytest.raises(CandidateError) as exc:
         run_study(s, SerialRunner())
     assert "TypeError" in str(exc.value) and "Traceback" in exc.value.details
@@ -220,10 +220,10 @@ def test_capability_search_is_not_capped_silently(monkeypatch):
 
     req = {"orientations": OrientationSet.box(np.radians([5.0] * 3), samples=3),
            "resolution": 5.0, "constraints": None}
-    monkeypatch.setattr(ev_mod, "workspace", fake_workspace(75.0))
+    monkeypatch.setattr(ev_mod.orientation_capability, "workspace", fake_workspace(75.0))
     a, bracket, note = ev_mod.capability(None, req)
     assert a <= 75.0 < a + bracket and bracket <= 0.25 and note == ""
-    monkeypatch.setattr(ev_mod, "workspace", fake_workspace(1000.0))
+    monkeypatch.setattr(ev_mod.orientation_capability, "workspace", fake_workspace(1000.0))
     a, bracket, note = ev_mod.capability(None, req)
     assert a == 180.0 and "not bounded" in note
 

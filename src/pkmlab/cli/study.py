@@ -83,7 +83,8 @@ def schema() -> None:
 @app.command()
 def metrics(as_json: JsonOpt = False) -> None:
     """List every study metric: unit, evaluate block, kind of number, meaning."""
-    from ..study.metrics import METRICS, metrics_markdown
+    from ..study.evaluators.registry import metrics_markdown
+    from ..study.metrics import METRICS
 
     if as_json:
         _emit({m.name: {"unit": m.unit, "evaluator": m.evaluator, "statistic": m.statistic,

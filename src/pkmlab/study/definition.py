@@ -9,73 +9,77 @@ from __future__ import annotations
 
 import hashlib
 import json
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
+from typing import Any
 
 from ..config import to_display
+from .evaluators import EVALUATORS, OMIT
 from .metrics import KIND_VOLUMES, METRICS
 from .space import DesignSpace, Variable
 
-__all__ = ["Study", "Evaluation", "DexterityPlan", "TrajectoryPlan", "Objective",
-           "Constraint", "PENALTY"]
+__all__ = ["Study", "Evaluation", "Objective", "Constraint", "PENALTY"]
 
 #: Objective / constraint value of a candidate without the metric (failed, invalid, undefined).
 PENALTY = 1.0e12
 
 
 @dataclass(frozen=True)
-class DexterityPlan:
-    characteristic_length: float | None     # mm; None: Angeles'
-    gci_samples: int
-    force_limit: float                      # N
-
-
-@dataclass(frozen=True)
-class TrajectoryPlan:
-    segment_time: float                     # s
-    payload: float                          # kg
-
-
-@dataclass(frozen=True)
 class Evaluation:
-    """What to compute for each candidate; ``request`` is the built workspace request."""
+    """What to compute for each candidate: ``plans`` maps each given ``evaluate`` block to its
+    plan (what its evaluator built from the block, :mod:`.evaluators`); ``request`` is the
+    built workspace request. A block's plan reads as an attribute (``evaluation.dexterity``,
+    ``None`` when the block is not given)."""
 
-    workspace: object | None                # config.WorkspaceSpec
-    request: dict | None
-    inscribed: bool
-    orientation_capability: bool
-    dexterity: DexterityPlan | None
-    trajectory: TrajectoryPlan | None
-    task: object | None = None              # requirements.spec.TaskPlan
-    motions: object | None = None           # requirements.spec.MotionsPlan
-    payload: object | None = None           # requirements.spec.PayloadPlan
-    actuators: object | None = None         # requirements.spec.ActuatorsPlan
-    volume_bracket: object | None = None    # spec.VolumeBracketSpec
-    needed_stroke: bool = False
+    plans: Mapping[str, Any]
+    request: dict | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "plans", MappingProxyType(dict(self.plans)))
+
+    def plan(self, name: str) -> Any:
+        """The plan of block ``name``, or None when it is not given."""
+        return self.plans.get(name)
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_") or name == "plans":
+            raise AttributeError(name)
+        if name in EVALUATORS:
+            return self.plans.get(name)
+        raise AttributeError(f"{type(self).__name__!s} has no attribute {name!r}")
+
+    def __getstate__(self):
+        return {"plans": dict(self.plans), "request": self.request}
+
+    def __setstate__(self, state):
+        object.__setattr__(self, "plans", MappingProxyType(state["plans"]))
+        object.__setattr__(self, "request", state["request"])
 
     @property
     def evaluators(self) -> tuple[str, ...]:
-        """Evaluator names in evaluation order."""
-        names = ["geometry"]
-        if self.workspace is not None:
-            names.append("workspace")
-            names += [n for n in ("inscribed", "orientation_capability", "needed_stroke",
-                                  "volume_bracket") if getattr(self, n)]
-            if self.dexterity is not None:
-                names.append("dexterity")
-            if self.payload is not None:
-                names.append("payload")
-        if self.trajectory is not None:
-            names.append("trajectory")
-        names += [n for n in ("task", "motions", "actuators") if getattr(self, n) is not None]
-        return tuple(names)
+        """Evaluator names in evaluation order (the registry's order)."""
+        return tuple(n for n, ev in EVALUATORS.items() if ev.runs(self))
 
     @property
     def metrics(self) -> tuple[str, ...]:
         """Every metric this evaluation writes a value for."""
         kind = None if self.workspace is None else self.workspace.kind
-        return tuple(m.name for m in METRICS.values() if m.evaluator in self.evaluators
+        names = self.evaluators
+        return tuple(m.name for m in METRICS.values() if m.evaluator in names
                      and KIND_VOLUMES.get(m.name, kind) == kind)
+
+    def written(self) -> dict:
+        """The ``evaluate`` mapping of the resolved study file."""
+        out = {}
+        for name, ev in EVALUATORS.items():
+            plan = self.plans.get(name)
+            if plan is not None and plan is not False:
+                out[name] = ev.written(plan)
+            elif ev.absent is not OMIT and ev.block is not None:
+                out[name] = ev.absent
+        return out
 
 
 @dataclass(frozen=True)
@@ -140,27 +144,7 @@ class Study:
             else:
                 d.update(low=_quantity(v, v.low), high=_quantity(v, v.high), levels=v.levels)
             design[v.name] = d
-        ev = self.evaluation
-        evaluate: dict = {
-            "workspace": None if ev.workspace is None else to_display(ev.workspace),
-            "inscribed": ev.inscribed, "orientation_capability": ev.orientation_capability,
-            "dexterity": None if ev.dexterity is None else {
-                "characteristic_length": ("auto" if ev.dexterity.characteristic_length is None
-                                          else f"{ev.dexterity.characteristic_length:.12g} mm"),
-                "gci_samples": ev.dexterity.gci_samples,
-                "force_limit": ev.dexterity.force_limit},
-            "trajectory": None if ev.trajectory is None else {
-                "paper_motion": True, "segment_time": ev.trajectory.segment_time,
-                "payload": ev.trajectory.payload},
-        }
-        for block in ("task", "motions", "payload", "actuators"):
-            plan = getattr(ev, block)
-            if plan is not None:
-                evaluate[block] = plan.source
-        if ev.volume_bracket is not None:
-            evaluate["volume_bracket"] = ev.volume_bracket.model_dump()
-        if ev.needed_stroke:
-            evaluate["needed_stroke"] = True
+        evaluate = self.evaluation.written()
         return {
             "study": self.name, "description": self.description,
             "mechanism": {"inline": to_display(self.space.base_spec)},

@@ -10,25 +10,17 @@ load, through the same functions the library uses. Errors are
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Any, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSchema
+from pydantic import BaseModel, ConfigDict, Field
 
-from .. import limits
-from ..config import mechanism_spec, read_yaml, validate_model, workspace_spec
-from ..errors import ParameterError
+from ..config import mechanism_spec, read_yaml, validate_model
+from ..errors import ParameterError, Shown
 from ..mechanisms import REGISTRY
 from ..mechanisms.layout import PAIRED_ALIASES as _PAIRED
-from ..mechanisms.mobility import require_spatial
 from ..units import parse_angle, parse_length
-from .definition import (
-    Constraint,
-    DexterityPlan,
-    Evaluation,
-    Objective,
-    Study,
-    TrajectoryPlan,
-)
+from .definition import Constraint, Evaluation, Objective, Study
+from .evaluators import EVALUATORS, check_requirements
 from .metrics import KIND_VOLUMES, METRICS
 from .optimisers import check_memory
 from .space import Derived, DesignSpace, Expression, Variable, get_path, parse_path
@@ -82,63 +74,6 @@ class DesignVariableSpec(_Model):
     levels: int = Field(5, ge=2, le=1000, description="grid optimiser: values per variable")
 
 
-def _auto_length(v: Any) -> float | None:
-    if isinstance(v, str) and v.strip().lower() == "auto":
-        return None
-    x = parse_length(v, "")
-    if not x > 0:
-        raise ValueError(f"must be 'auto' or a length > 0 mm; got {v!r}")
-    return x
-
-
-class DexteritySpec(_Model):
-    characteristic_length: Annotated[float | None, BeforeValidator(_auto_length),
-                                     WithJsonSchema({"anyOf": [{"const": "auto"},
-                                                               {"type": "number"},
-                                                               {"type": "string"}]})] = Field(
-        None, description="'auto' (Angeles' length, the default) or a length > 0")
-    gci_samples: int = Field(2000, ge=limits.GCI_SAMPLES[0], le=limits.GCI_SAMPLES[1])
-    force_limit: float = Field(150.0, gt=0, allow_inf_nan=False,
-                               description="actuator force limit (N)")
-
-
-class TrajectorySpec(_Model):
-    paper_motion: Literal[True] = True
-    segment_time: float = Field(1.0, gt=0, allow_inf_nan=False, description="s per segment")
-    payload: float = Field(0.0, ge=0, allow_inf_nan=False, description="payload mass (kg)")
-
-
-class VolumeBracketSpec(_Model):
-    budget: float = Field(2.0, gt=0, le=3600, allow_inf_nan=False,
-                          description="wall-time budget per candidate (s)")
-    target: float = Field(0.01, gt=0, lt=1, allow_inf_nan=False,
-                          description="relative width (upper - lower) / upper to reach")
-
-
-class EvaluateSpec(_Model):
-    workspace: dict[str, Any] | None = Field(None, description="a workspace request (see "
-                                             "'pkmlab workspace'): kind, box or tilt, ...")
-    inscribed: bool = False
-    orientation_capability: bool = False
-    needed_stroke: bool = Field(False, description="the smallest actuator travel at which the "
-                                "workspace's simultaneous Euler box (equal half-ranges) has a "
-                                "dexterous position, bracketed (needed_stroke, _lower, "
-                                "_bracket)")
-    volume_bracket: VolumeBracketSpec | None = Field(
-        None, description="guaranteed volume bracket over the continuous orientation set "
-        "(workspace_volume_lower / _upper): budget (s), target (relative width)")
-    dexterity: DexteritySpec | None = None
-    trajectory: TrajectorySpec | None = None
-    task: dict[str, Any] | None = Field(None, description="a required workspace: shape (box, "
-                                        "cylinder, points), size / radius + height / points "
-                                        "or file, frame, centre, and an orientation set")
-    motions: list[dict[str, Any]] | None = Field(None, description="required motions: "
-                                                 "[{name, file | sinusoid | paper: true}]")
-    payload: dict[str, Any] | None = Field(None, description="mass, com, inertia; platform; "
-                                           "legs")
-    actuators: dict[str, Any] | None = Field(None, description="catalogue + use, or spec")
-
-
 class OptimizerSpec(_Model):
     method: Literal["grid", "sobol", "lhs", "nsga2", "de"]
     samples: int = Field(64, ge=1, le=10_000_000, description="sobol / lhs designs")
@@ -164,7 +99,9 @@ class StudySpec(_Model):
     design: dict[str, DesignVariableSpec] = Field(min_length=1)
     derived: dict[str, Any] = Field(default_factory=dict, description="mechanism fields "
                                     "computed from the variables: {alias or path: expression}")
-    evaluate: EvaluateSpec
+    evaluate: dict[str, Any] = Field(description="what to compute for each candidate: one "
+                                     "block per evaluator ('pkmlab metrics' lists their "
+                                     "metrics)")
     objectives: list[dict[Literal["maximize", "minimize"], str]] = Field(min_length=1)
     constraints: list[dict[str, Any]] = Field(default_factory=list)
     optimizer: OptimizerSpec
@@ -179,12 +116,32 @@ class StudySpec(_Model):
 def study_schema() -> dict:
     """JSON Schema of the study file (for editors); metric names are enumerated."""
     schema = StudySpec.model_json_schema()
+    schema["properties"]["evaluate"] = _evaluate_schema(schema.setdefault("$defs", {}))
     names = sorted(METRICS)
     schema["properties"]["objectives"]["items"] = {
         "type": "object", "minProperties": 1, "maxProperties": 1,
         "properties": {s: {"enum": names} for s in ("maximize", "minimize")},
         "additionalProperties": False}
     return schema
+
+
+def _evaluate_schema(defs: dict) -> dict:
+    """The ``evaluate`` mapping: one property per registered block, typed by its model."""
+    from pydantic import TypeAdapter
+
+    props = {}
+    for name, ev in EVALUATORS.items():
+        if ev.block is None:
+            continue
+        sub = TypeAdapter(ev.block).json_schema(ref_template="#/$defs/{model}")
+        for k, d in sub.pop("$defs", {}).items():
+            if defs.setdefault(k, d) != d:
+                raise ValueError(f"evaluate.{name}: two block models named {k!r}")
+        if ev.description and "description" not in sub:
+            sub["description"] = ev.description
+        props[name] = {"anyOf": [sub, {"type": "null"}]}
+    return {"type": "object", "description": StudySpec.model_fields["evaluate"].description,
+            "properties": props, "additionalProperties": False}
 
 
 # ---- building the typed study -------------------------------------------------------------
@@ -291,54 +248,34 @@ def _metric(name: Any, where: str, evaluation: Evaluation) -> str:
         raise ParameterError(where, f"the volume of the evaluated kind "
                              f"('{evaluation.workspace.kind}_volume')", name)
     if name not in evaluation.metrics:
-        need = METRICS[name].evaluator
-        raise ParameterError(where, f"a metric the evaluation computes (add evaluate.{need}"
-                             + (" and evaluate.workspace" if need in ("inscribed",
-                                "orientation_capability", "dexterity", "payload",
-                                "volume_bracket", "needed_stroke") else "") + ")", name)
+        need = EVALUATORS[METRICS[name].evaluator].hint()
+        raise ParameterError(where, f"a metric the evaluation computes (add {need})", name)
     return name
 
 
-def _evaluation(ev: EvaluateSpec, base: Path) -> Evaluation:
-    ws = None if ev.workspace is None else workspace_spec(ev.workspace,
-                                                          prefix="evaluate.workspace.")
-    for block in ("inscribed", "orientation_capability", "dexterity", "volume_bracket"):
-        if getattr(ev, block) not in (None, False) and ws is None:
-            raise ParameterError(f"evaluate.{block}", "used with an evaluate.workspace block "
-                                 "(it is computed over that workspace)", "no workspace")
-    if ev.needed_stroke:
-        o = ws.build()["orientations"]
-        if o.kind != "box" or o.semantics != "simultaneous" or len(set(o.angles)) != 1:
-            raise ParameterError("evaluate.needed_stroke", "used with a simultaneous Euler box "
-                                 "with equal half-ranges in evaluate.workspace",
-                                 o.describe())
-    dx = ev.dexterity
-    return Evaluation(
-        workspace=ws, request=None if ws is None else ws.build(),
-        inscribed=ev.inscribed, orientation_capability=ev.orientation_capability,
-        dexterity=None if dx is None else DexterityPlan(dx.characteristic_length,
-                                                        dx.gci_samples, dx.force_limit),
-        trajectory=None if ev.trajectory is None else TrajectoryPlan(
-            ev.trajectory.segment_time, ev.trajectory.payload),
-        volume_bracket=ev.volume_bracket, needed_stroke=ev.needed_stroke,
-        **_requirements(ev, base))
+def _evaluation(data: dict, base: Path, mech) -> Evaluation:
+    """The ``evaluate`` mapping → :class:`Evaluation`: each block built by its evaluator
+    (:mod:`.evaluators`), then checked against what ``mech`` (the baseline) offers."""
+    from difflib import get_close_matches
 
+    from ..yamlio import where
 
-def _requirements(ev: EvaluateSpec, base: Path) -> dict:
-    """The requirement blocks (pkmlab.requirements.spec), files read and checked now."""
-    from ..requirements import spec as rq
-
-    if ev.motions is not None and ev.payload is None:
-        raise ParameterError("evaluate.payload", "given with evaluate.motions (the mass the "
-                             "motions move: payload and platform)", None)
-    if ev.actuators is not None and ev.motions is None:
-        raise ParameterError("evaluate.actuators", "used with evaluate.motions (the actuators "
-                             "are checked along the required motions)", "no motions")
-    return {"task": None if ev.task is None else rq.build_task(ev.task, base),
-            "motions": None if ev.motions is None else rq.build_motions(ev.motions, base),
-            "payload": None if ev.payload is None else rq.build_payload(ev.payload),
-            "actuators": None if ev.actuators is None else rq.build_actuators(ev.actuators,
-                                                                            base)}
+    blocks = [n for n, ev in EVALUATORS.items() if ev.block is not None]
+    for key in data:
+        if key not in blocks:
+            close = get_close_matches(str(key), blocks, n=1, cutoff=0.6)
+            hint = f"did you mean {close[0]!r}? " if close else ""
+            raise ParameterError(f"evaluate.{key}", f"a known key ({hint}known keys: "
+                                 f"{', '.join(sorted(blocks))})", Shown(repr(key)),
+                                 where=where(("evaluate", key)))
+    plans = {}
+    for name in blocks:
+        if data.get(name) is not None:
+            plans[name] = EVALUATORS[name].plan(data[name], base)
+    ws = plans.get("workspace")
+    evaluation = Evaluation(plans, None if ws is None else ws.build())
+    check_requirements(evaluation, mech, data)
+    return evaluation
 
 
 def study_from_mapping(data: Any, base: Path | None = None,
@@ -366,12 +303,12 @@ def study_from_mapping(data: Any, base: Path | None = None,
         mech_data = dict(src.inline)
     try:
         mech_spec = mechanism_spec(_merge(mech_data, src.overrides))
-        require_spatial(mech_spec.build(), "design studies", "family")
+        baseline = mech_spec.build()
     except ParameterError as exc:     # keeps the position in the file the value came from
         raise ParameterError(f"mechanism.{exc.field}", exc.allowed, exc.got,
                              where=exc.where) from None
     family = mech_spec.family
-    evaluation = _evaluation(spec.evaluate, base)
+    evaluation = _evaluation(spec.evaluate, base, baseline)
     variables = tuple(_variable(n, v, family, mech_spec, evaluation)
                       for n, v in spec.design.items())
     names = {v.name for v in variables}

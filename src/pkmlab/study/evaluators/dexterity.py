@@ -1,0 +1,131 @@
+"""``dexterity``: κ, force and the global conditioning index over the workspace
+(:mod:`pkmlab.dexterity`): worst cases over every voxel × orientation sample, sampled
+statistics from one Monte-Carlo sample."""
+
+from __future__ import annotations
+
+from typing import Annotated, Any
+
+import numpy as np
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSchema
+
+from ... import dexterity as dx
+from ... import limits
+from ...errors import NumericalError
+from ...units import parse_length
+from .registry import Evaluator, finite, metric, register_evaluator
+
+
+def _auto_length(v: Any) -> float | None:
+    if isinstance(v, str) and v.strip().lower() == "auto":
+        return None
+    x = parse_length(v, "")
+    if not x > 0:
+        raise ValueError(f"must be 'auto' or a length > 0 mm; got {v!r}")
+    return x
+
+
+class DexteritySpec(BaseModel):
+    """Conditioning and force over the workspace: characteristic length, GCI samples, force
+    limit."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    characteristic_length: Annotated[float | None, BeforeValidator(_auto_length),
+                                     WithJsonSchema({"anyOf": [{"const": "auto"},
+                                                               {"type": "number"},
+                                                               {"type": "string"}]})] = Field(
+        None, description="'auto' (Angeles' length, the default) or a length > 0")
+    gci_samples: int = Field(2000, ge=limits.GCI_SAMPLES[0], le=limits.GCI_SAMPLES[1])
+    force_limit: float = Field(150.0, gt=0, allow_inf_nan=False,
+                               description="actuator force limit (N)")
+
+
+_OVER_WORKSPACE = ("worst_kappa", "min_force", "singularity_free", "gci", "gci_std_error",
+                   "sampled_max_kappa", "sampled_min_force")
+
+
+class Dexterity(Evaluator):
+    name = "dexterity"
+    block = DexteritySpec
+    description = DexteritySpec.__doc__
+    requires = frozenset({"spatial", "workspace"})   # dexterity.report: six coordinates
+    after = ("workspace",)
+    absent = None
+    metrics = (
+        metric("nominal_kappa", "", "exact",
+               "κ of the homogenised Jacobian at the nominal pose"),
+        metric("characteristic_length", "mm", "exact",
+               "length L homogenising the Jacobian (Angeles' or the one given)"),
+        metric("worst_kappa", "", "worst-case",
+               "largest κ over every voxel of the workspace and every end of its exact "
+               "columns × every orientation sample (inf when a singular pose is found inside "
+               "or on the boundary: stored as null with a note)"),
+        metric("min_force", "N", "worst-case",
+               "smallest force held in every direction over every voxel and column end × "
+               "orientation sample"),
+        metric("singularity_free", "", "flag",
+               "0 when a singular pose is certified in the workspace or on its boundary (a "
+               "singular voxel or column end, or a sign change of det J between neighbours); "
+               "1 when none was found — a search, not a proof: a singularity between samples "
+               "is not excluded"),
+        metric("gci", "", "sampled",
+               "global conditioning index: Monte-Carlo mean of 1/κ over the workspace "
+               "(singular poses count 0); standard error in gci_std_error"),
+        metric("gci_std_error", "", "sampled", "standard error of gci"),
+        metric("sampled_max_kappa", "", "sampled",
+               "largest κ among the GCI's random poses (a sample statistic, ≤ worst_kappa)"),
+        metric("sampled_min_force", "N", "sampled",
+               "smallest all-direction force among the GCI's random poses (≥ min_force)"),
+    )
+
+    def written(self, plan):
+        L = plan.characteristic_length
+        return {"characteristic_length": "auto" if L is None else f"{L:.12g} mm",
+                "gci_samples": plan.gci_samples, "force_limit": plan.force_limit}
+
+    def compute(self, mech, ctx) -> dict:
+        plan, res = ctx.evaluation.dexterity, ctx.result
+        length = dx.resolve_length(mech, plan.characteristic_length)
+        if length.status == "fallback":
+            raise NumericalError("characteristic length", length.reason)
+        L = length.length
+        ctx.L = L
+        J0 = mech.jacobian(mech.nominal_pose)
+        out = {"characteristic_length": float(L),
+               "nominal_kappa": finite(dx.condition_number(J0, L)[0])}
+        if out["nominal_kappa"] is None:
+            ctx.notes["nominal_kappa"] = "singular at the nominal pose"
+        if res.empty:
+            for n in _OVER_WORKSPACE:
+                ctx.notes[n] = "workspace empty"
+            out.update(dict.fromkeys(_OVER_WORKSPACE))
+            return out
+        wc = dx.worst_case(res.mechanism, res, length, plan.force_limit)
+        if wc.status != "ok":
+            raise NumericalError("worst case over the workspace", wc.reason)
+        out["worst_kappa"] = finite(wc.worst_kappa)
+        out["min_force"] = float(wc.min_force)
+        out["singularity_free"] = float(not wc.singular)
+        if wc.singular:
+            ctx.notes["worst_kappa"] = (f"singular pose in the workspace or on its boundary: "
+                                        f"{wc.reason}")
+        # one Monte-Carlo sample serves every sampled statistic
+        p, R = dx.aggregate.sample_poses(res, plan.gci_samples,
+                                         np.random.default_rng(ctx.seed))
+        g = dx.gci_monte_carlo(mech, res, length, poses=(p, R))
+        out["gci"] = g.gci if g.ok else None
+        out["gci_std_error"] = finite(g.std_error) if g.ok else None
+        out["sampled_max_kappa"] = finite(g.sampled_max_kappa) if g.ok else None
+        valid = mech.inverse((p, R)).valid
+        F = dx.max_force_all_directions(mech.jacobian((p[valid], R[valid])),
+                                        plan.force_limit, L=L)
+        out["sampled_min_force"] = float(np.min(F)) if len(F) else None
+        for n in ("gci", "gci_std_error", "sampled_max_kappa", "sampled_min_force"):
+            if out[n] is None:
+                ctx.notes.setdefault(n, "a sampled pose is singular" if g.ok and
+                                     n == "sampled_max_kappa" else "no valid Monte-Carlo pose")
+        return out
+
+
+register_evaluator(Dexterity())

@@ -1,0 +1,86 @@
+"""``motions``: required motions with the payload, by inverse dynamics
+(:mod:`pkmlab.requirements.dynamics`); the results are kept in the context for ``actuators``."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import ParameterError
+from ...requirements.dynamics import inverse_dynamics
+from ...requirements.spec import MotionSpec, build_motions
+from .registry import Evaluator, metric, register_evaluator
+
+#: (linear actuators' metric, rotary actuators' metric, DynamicsResult.summary() key)
+MOTION_METRICS = (("peak_actuator_force", "peak_actuator_torque", "peak_force"),
+                  ("rms_actuator_force", "rms_actuator_torque", "rms_force"),
+                  ("peak_actuator_speed", "peak_actuator_angular_speed", "peak_speed"),
+                  ("peak_actuator_power", "peak_actuator_power", "peak_power"))
+
+
+class Motions(Evaluator):
+    name = "motions"
+    block = list[MotionSpec]
+    description = "required motions: [{name, file | sinusoid | paper: true}]"
+    requires = frozenset({"spatial"})        # Newton–Euler on six coordinates
+    metrics = (
+        metric("motions_feasible", "", "flag",
+               "1 if every sample of every required motion is within the stroke and not "
+               "singular"),
+        metric("peak_actuator_force", "N", "worst-case",
+               "largest |actuator force| over every sample of every required motion "
+               "(Newton–Euler of platform + payload + legs, f = J⁻ᵀ·w); linear actuators "
+               "only, null for rotary ones (peak_actuator_torque)"),
+        metric("rms_actuator_force", "N", "worst-case",
+               "largest RMS actuator force (time-weighted, per actuator and motion); linear "
+               "actuators only"),
+        metric("peak_actuator_speed", "mm/s", "worst-case",
+               "largest |actuator speed| over every sample of every required motion; linear "
+               "actuators only, null for rotary ones (peak_actuator_angular_speed)"),
+        metric("peak_actuator_torque", "N·mm", "worst-case",
+               "largest |servo torque| over every sample of every required motion "
+               "(τ = J⁻ᵀ·w); rotary actuators only, null for linear ones"),
+        metric("rms_actuator_torque", "N·mm", "worst-case",
+               "largest RMS servo torque (time-weighted, per actuator and motion); rotary "
+               "actuators only"),
+        metric("peak_actuator_angular_speed", "rad/s", "worst-case",
+               "largest |servo angular speed| over every sample of every required motion; "
+               "rotary actuators only"),
+        metric("peak_actuator_power", "W", "worst-case",
+               "largest |actuator force × speed| (rotary: torque × angular speed) over every "
+               "sample of every required motion"),
+    )
+
+    def plan(self, data, base):
+        return build_motions(data, base)
+
+    def written(self, plan):
+        return plan.source
+
+    def check(self, plan, evaluation, mech) -> None:
+        if evaluation.payload is None:
+            raise ParameterError("evaluate.payload", "given with evaluate.motions (the mass "
+                                 "the motions move: payload and platform)", None)
+
+    def compute(self, mech, ctx) -> dict:
+        ev = ctx.evaluation
+        body = ev.payload.for_mechanism(mech)
+        ctx.dynamics = [inverse_dynamics(mech, m, body) for m in ev.motions.motions(mech)]
+        bad = [r.first_problem() for r in ctx.dynamics if not np.all(r.ok)]
+        out = {"motions_feasible": float(not bad)}
+        if bad:
+            ctx.notes["motions_feasible"] = bad[0]
+        sums = [r.summary() for r in ctx.dynamics if np.any(r.ok)]
+        rotary = mech.actuator_unit == "rad"
+        for linear, turning, key in MOTION_METRICS:
+            name, other = (turning, linear) if rotary else (linear, turning)
+            out[name] = float(max(np.max(s[key]) for s in sums)) if sums else None
+            if not sums:
+                ctx.notes[name] = "no feasible sample in any motion"
+            if other != name:
+                out[other] = None
+                ctx.notes[other] = (f"{'rotary' if rotary else 'linear'} actuators: see "
+                                    f"{name}")
+        return out
+
+
+register_evaluator(Motions())

@@ -1,0 +1,51 @@
+"""``trajectory``: Hopkins & Williams' ±2 in / ±30° paper motion against the stroke."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from ...trajectory import check_trajectory, paper_motion
+from .registry import Evaluator, finite, metric, register_evaluator
+
+
+class TrajectorySpec(BaseModel):
+    """The paper motion: seconds per segment, payload mass."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    paper_motion: Literal[True] = True
+    segment_time: float = Field(1.0, gt=0, allow_inf_nan=False, description="s per segment")
+    payload: float = Field(0.0, ge=0, allow_inf_nan=False, description="payload mass (kg)")
+
+
+class Trajectory(Evaluator):
+    name = "trajectory"
+    block = TrajectorySpec
+    description = TrajectorySpec.__doc__
+    # the motion turns the platform ±30° about each axis, on all six coordinates
+    requires = frozenset({"rotations", "spatial"})
+    absent = None
+    metrics = (
+        metric("paper_motion_fits", "", "flag",
+               "1 if Hopkins & Williams' ±2 in / ±30° motion stays within the stroke"),
+        metric("paper_motion_margin", "mm", "exact",
+               "smallest stroke margin along that motion (negative: the overshoot)"),
+    )
+
+    def compute(self, mech, ctx) -> dict:
+        plan = ctx.evaluation.trajectory
+        t, X = paper_motion(mech, segment_time=plan.segment_time)
+        rep = check_trajectory(mech, t, X, payload_mass_kg=plan.payload)
+        margins = np.concatenate([rep.margin_low, rep.margin_high])
+        out = {"paper_motion_fits": float(rep.fits),
+               "paper_motion_margin": finite(np.min(margins))
+               if np.all(np.isfinite(margins)) else None}
+        if out["paper_motion_margin"] is None:
+            ctx.notes["paper_motion_margin"] = "a pose of the motion has no inverse kinematics"
+        return out
+
+
+register_evaluator(Trajectory())
