@@ -44,8 +44,8 @@ from ..metrics import METRICS, Metric
 log = logging.getLogger(__name__)
 
 __all__ = ["Evaluator", "Context", "EVALUATORS", "PLUGIN_GROUP", "PLUGIN_ERRORS",
-           "metrics_markdown", "MECHANISM_NEEDS", "register_evaluator", "unregister_evaluator", "metric",
-           "load_evaluator_plugins", "check_requirements", "finite", "OMIT"]
+           "metrics_markdown", "MECHANISM_NEEDS", "register_evaluator", "unregister_evaluator",
+           "metric", "load_evaluator_plugins", "check_requirements", "finite", "OMIT"]
 
 #: entry point group of evaluator plugins (each names an :class:`Evaluator` class or instance)
 PLUGIN_GROUP = "pkmlab.evaluators"
