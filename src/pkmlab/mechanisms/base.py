@@ -72,6 +72,7 @@ from ..poses import as_frames, log_so3
 from ..threads import threads_for
 from ..tolerances import TOL
 from . import _kernels, _tiles
+from .joints import JointsMixin
 from .mobility import SPATIAL, Mobility
 from .results import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult
 from .solvers import bracketed_root, forward_newton, multistart_modes
@@ -97,8 +98,9 @@ __all__ = [
 
 
 @dataclass(frozen=True, eq=False)
-class Mechanism:
-    """Base of every mechanism family (geometry lives in the subclass)."""
+class Mechanism(JointsMixin):
+    """Base of every mechanism family (geometry lives in the subclass; joints and parameters:
+    :class:`.joints.JointsMixin`)."""
 
     family: ClassVar[str] = ""
     #: the free pose coordinates (:mod:`.mobility`)
@@ -228,13 +230,6 @@ class Mechanism:
         p = self.nominal_pose[:3]
         S = 2.0 * self.scale
         return np.broadcast_to(np.stack([p - S, p + S]), (len(R), 2, 3)).copy()
-
-    def leg_segments(self, p: np.ndarray, R: np.ndarray):  # pragma: no cover - abstract
-        """End points ``(start, end)``, each ``(N, 6, 3)``, of each leg's moving link.
-
-        ``start`` carries the base-side passive joint and ``end`` the platform-side one.
-        """
-        raise NotImplementedError
 
     def link_segments(self, p: np.ndarray, R: np.ndarray):
         """``(start, end, leg)``: end points ``(N, S, 3)`` of every moving link and the leg
