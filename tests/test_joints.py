@@ -132,7 +132,8 @@ class _RailSign(PSU6):
     """The rails' direction reversed (the actuated coordinate is then -q)."""
     def _joint_arrays(self, p, R, axes=True):
         arr = super()._joint_arrays(p, R, axes)
-        arr.axes[:, :, 0, 0] *= -1.0
+        if axes:
+            arr.axes[:, :, 0, 0] *= -1.0
         return arr
 
 
@@ -140,7 +141,8 @@ class _SkewU(PSU6):
     """Platform U axes not orthogonal."""
     def _joint_arrays(self, p, R, axes=True):
         arr = super()._joint_arrays(p, R, axes)
-        arr.axes[:, :, 2, 0] = arr.axes[:, :, 2, 1]
+        if axes:
+            arr.axes[:, :, 2, 0] = arr.axes[:, :, 2, 1]
         return arr
 
 

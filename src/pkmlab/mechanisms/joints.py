@@ -123,7 +123,8 @@ class LegTemplate(NamedTuple):
 
 class JointArrays(NamedTuple):
     """All legs' joints over N poses: ``centre (N, L, J, 3)`` (P joints: ``location``),
-    ``axes (N, L, J, 2, 3)`` (unused rows NaN) and the actuator values ``q (N, L)``."""
+    ``axes (N, L, J, 2, 3)`` (unused rows NaN; ``None`` when not asked for) and the actuator
+    values ``q (N, L)``."""
 
     centre: np.ndarray
     axes: np.ndarray
@@ -191,7 +192,7 @@ def kind_arrays(mech, kind, start, W, q, R, axes, legs=None, rail=None) -> Joint
     first = (np.broadcast_to(mech.base_points if legs is None else mech.base_points[legs],
                              W.shape) if kind == "crank" else start)
     centre = np.stack([first, W if kind == "prismatic" else start, W], axis=2)
-    ax = np.full((n, L, 3, 2, 3), np.nan)
+    ax = np.full((n, L, 3, 2, 3), np.nan) if axes else None
     if axes:
         nom = mech._nominal_centres if legs is None else mech._nominal_centres[legs]
         d = W - start
@@ -246,7 +247,7 @@ def build_legs(mech, pose=None) -> tuple[Leg, ...]:
 
 def joint_segments(mech, p: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``leg_segments`` from the joints: each leg's ``segment`` joint centres ``(N, L, 3)``."""
-    centre = mech._joint_arrays(p, R).centre
+    centre = mech._joint_arrays(p, R, axes=False).centre
     seg = np.array([t.segment for t in mech._leg_templates()])
     legs = np.arange(len(seg))
     return centre[:, legs, seg[:, 0]], centre[:, legs, seg[:, 1]]
@@ -323,14 +324,14 @@ class ParamField:
     """A dataclass field of a family in its parameter vector: ``label`` the name stem (or a
     tuple of the elements' names), ``unit`` ``"mm"``, ``"rad"``, ``"1"`` or ``"actuator"``
     (the mechanism's actuator unit), ``text`` the description (``{i}`` the row number, from
-    1), ``rows`` the name of a method giving the ``(K,)`` mask of rows that are parameters
-    (the others are kept)."""
+    1), ``rows`` a function of the mechanism giving the ``(K,)`` mask of rows that are
+    parameters (the others are kept)."""
 
     field: str
     label: Any
     unit: str
     text: str
-    rows: str | None = None
+    rows: Any = None
 
 
 #: the protocol's fields, every family's default parameter vector
@@ -376,7 +377,7 @@ def _field_entries(mech, f: ParamField):
     arr = np.array(value, dtype=float)
     mask = np.ones(arr.shape[:1] if arr.ndim else (), dtype=bool)
     if f.rows is not None:
-        mask = np.asarray(getattr(mech, f.rows)(), dtype=bool)
+        mask = np.asarray(f.rows(mech), dtype=bool)
     names, texts, take = [], [], []
     if isinstance(f.label, tuple):
         names, texts = list(f.label), [f"{f.text} ({n})" for n in f.label]

@@ -43,7 +43,7 @@ from .joints import DEFAULT_FIELDS, JointArrays, LegTemplate, ParamField, unit
 from .results import NO_STROKE
 
 __all__ = ["Luzi3", "pose_to_psi", "psi_to_pose", "reduced_dpa", "ReducedDPAResult",
-           "working_branches"]
+           "four_bar_theta", "working_branches"]
 
 
 def working_branches(mech) -> np.ndarray:
@@ -394,7 +394,7 @@ class Luzi3(Mechanism):
         B = np.stack([C - half * t, C + half * t], axis=2).reshape(-1, 6, 3)
         A = np.broadcast_to(self.base_points, B.shape)
         C2 = np.repeat(C, 2, axis=1)
-        ax = np.full((len(p), 6, 4, 2, 3), np.nan)
+        ax = np.full((len(p), 6, 4, 2, 3), np.nan) if axes else None
         if axes:
             u2 = np.repeat(unit(u), 2, axis=1)
             ax[:, :, 0, 0] = np.repeat(unit(A2 - A1), 2, axis=0)
@@ -430,6 +430,7 @@ class Luzi3(Mechanism):
 
 from .luzi3_psi import (  # noqa: E402  (re-exported; the module needs Luzi3 only for types)
     ReducedDPAResult,
+    four_bar_theta,
     pose_to_psi,
     psi_to_pose,
     reduced_dpa,

@@ -438,38 +438,36 @@ class SixLeg(Mechanism):
         return norm - target, np.concatenate([n, np.cross(r, n)], axis=-1)
 
     # ---- joints (:mod:`.joints`): UPS, PSU or RSS legs by kind -------------------------------
+    _moving_rows, _crank_rows = (lambda m: ~m._mask("prismatic")), (lambda m: m._mask("crank"))
     parameter_fields = (
         joints.ParamField("base_points", "base", "mm", "leg {i}'s base U joint, slider position at "
                    "actuator value 0 or crank pivot (base frame)"),
         joints.DEFAULT_FIELDS[1],
         joints.ParamField("axes", "axis", "1", "leg {i}'s rail or servo axis direction",
-                   rows="_moving_axes"),
+                   rows=_moving_rows),
         joints.ParamField("zero_directions", "zero_direction", "1", "leg {i}'s crank direction at "
-                   "angle 0 (the actuator zero)", rows="_crank_rows"),
+                   "angle 0 (the actuator zero)", rows=_crank_rows),
         joints.ParamField("crank_length", "crank_length", "mm", "leg {i}'s crank length",
-                   rows="_crank_rows"),
+                   rows=_crank_rows),
         joints.ParamField("link_length", "link_length", "mm", "leg {i}'s slider link or crank rod "
-                   "length", rows="_moving_axes"),
+                   "length", rows=_moving_rows),
         *joints.DEFAULT_FIELDS[2:])
-
-    def _moving_axes(self):
-        return ~self._mask("prismatic")
-
-    def _crank_rows(self):
-        return self._mask("crank")
 
     def _joint_arrays(self, p, R, axes=True):
         q = self.inverse((p, R), stroke=NO_STROKE).q
         _, _, start = self._legs(p, R, q)
         start = np.broadcast_to(start, (len(p), 6, 3))
         W = joints.platform_joints(self, p, R)
-        centre, ax = np.empty((len(p), 6, 3, 3)), np.empty((len(p), 6, 3, 2, 3))
+        centre = np.empty((len(p), 6, 3, 3))
+        ax = np.empty((len(p), 6, 3, 2, 3)) if axes else None
         for kind in KINDS:
             m = self._mask(kind)
             if m.any():
                 part = joints.kind_arrays(self, kind, start[:, m], W[:, m], q, R, axes,
                                    legs=np.flatnonzero(m), rail=self.axes[m])
-                centre[:, m], ax[:, m] = part.centre, part.axes
+                centre[:, m] = part.centre
+                if axes:
+                    ax[:, m] = part.axes
         return joints.JointArrays(centre, ax, q)
 
     def _leg_templates(self):

@@ -84,7 +84,8 @@ class Tri3(Mechanism):
         q = self.inverse((p, R), stroke=NO_STROKE).q
         W = joints.platform_joints(self, p, R)
         arr = joints.kind_arrays(self, "prismatic", self.base_points, W, q, R, axes)
-        arr.axes[:, :, 2] = arr.axes[:, :, 0, ::-1]
+        if axes:
+            arr.axes[:, :, 2] = arr.axes[:, :, 0, ::-1]
         return arr
 
     def _leg_templates(self):
