@@ -15,7 +15,7 @@ from conftest import MECHANISMS
 
 from pkmlab import testing
 from pkmlab.mechanisms import NO_STROKE, PSU6, RSS6, UPS6, Luzi3
-from pkmlab.mechanisms.joints import chain_errors
+from pkmlab.mechanisms.joints import JointsMixin, chain_errors
 from pkmlab.poses import as_frames
 
 DATA = Path(__file__).parent / "data"
@@ -288,3 +288,14 @@ def test_rss6_link_segments_are_cranks_and_rods():
         [np.broadcast_to(m.base_points, C.shape), C], axis=1))
     np.testing.assert_array_equal(end, np.concatenate([C, W], axis=1))
     np.testing.assert_array_equal(leg, np.tile(np.arange(6), 2))
+
+
+def test_a_family_without_joints_fails_the_contract_by_name():
+    class NoJoints(UPS6):
+        _joint_arrays = JointsMixin._joint_arrays          # the protocol's: not declared
+
+    m = MECHANISMS["gough-stewart-6ups"]
+    bad = NoJoints(**{f.name: getattr(m, f.name) for f in dataclasses.fields(m) if f.init})
+    with pytest.raises(AssertionError, match="declares no joints"):
+        testing.check_joints(bad)
+

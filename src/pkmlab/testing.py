@@ -237,6 +237,10 @@ def check_joints(mech, n: int = 12, rel: float = 1e-9):
     ``leg_segments`` are the legs' ``segment`` joint centres."""
     from .mechanisms.joints import chain_errors
 
+    try:
+        mech.legs()
+    except NotImplementedError as exc:
+        raise AssertionError(str(exc)) from exc
     X = np.concatenate([mech.nominal_pose[None], random_valid_poses(mech, n, seed=6)])
     mm = rel * mech.scale
     tol = {"link_mm": mm, "platform_mm": mm, "platform_point_mm": mm, "base_mm": mm,
