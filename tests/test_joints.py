@@ -117,8 +117,9 @@ class _WrongPoint(UPS6):
     """Puts leg 1's platform joint on platform point 2."""
     def _joint_arrays(self, p, R, axes=True):
         arr = super()._joint_arrays(p, R, axes)
-        arr.centre[:, 0, 1:] = arr.centre[:, 1, 1:]            # P location and S
-        return arr
+        c = [x.copy() for x in arr.centre]
+        c[1][:, 0], c[2][:, 0] = c[1][:, 1], c[2][:, 1]         # P location and S
+        return arr._replace(centre=tuple(c))
 
 
 class _WrongZero(PSU6):

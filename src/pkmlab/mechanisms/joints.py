@@ -122,13 +122,14 @@ class LegTemplate(NamedTuple):
 
 
 class JointArrays(NamedTuple):
-    """All legs' joints over N poses: ``centre (N, L, J, 3)`` (P joints: ``location``),
+    """All legs' joints over N poses: ``centre``, a tuple of J arrays ``(N, L, 3)``, joint
+    j's centres (P joints: ``location``; read-only broadcast views allowed),
     ``axes (N, L, J, 2, 3)`` (unused rows NaN; ``None`` when not asked for) and the actuator
-    values ``q (N, L)``."""
+    values ``q (N, L)`` (``None`` allowed when the axes are not asked for)."""
 
-    centre: np.ndarray
-    axes: np.ndarray
-    q: np.ndarray
+    centre: tuple[np.ndarray, ...]
+    axes: np.ndarray | None
+    q: np.ndarray | None
 
 
 def unit(v: np.ndarray) -> np.ndarray:
@@ -191,7 +192,7 @@ def kind_arrays(mech, kind, start, W, q, R, axes, legs=None, rail=None) -> Joint
     start = np.broadcast_to(start, W.shape)
     first = (np.broadcast_to(mech.base_points if legs is None else mech.base_points[legs],
                              W.shape) if kind == "crank" else start)
-    centre = np.stack([first, W if kind == "prismatic" else start, W], axis=2)
+    centre = (first, W if kind == "prismatic" else start, W)
     ax = np.full((n, L, 3, 2, 3), np.nan) if axes else None
     if axes:
         nom = mech._nominal_centres if legs is None else mech._nominal_centres[legs]
@@ -223,7 +224,8 @@ def build_legs(mech, pose=None) -> tuple[Leg, ...]:
     """The :class:`Leg` objects of ``mech`` at one pose (module docstring)."""
     p, R = _frame(mech, pose)
     arr = mech._joint_arrays(p, R)
-    centre, axes, q = arr.centre[0], arr.axes[0], arr.q[0]
+    centre = np.stack([c[0] for c in arr.centre], axis=1)             # (L, J, 3)
+    axes, q = arr.axes[0], arr.q[0]
     nrows = {"R": 1, "P": 1, "U": 2, "S": 0}
     legs = []
     for i, t in enumerate(mech._leg_templates()):
@@ -249,8 +251,14 @@ def joint_segments(mech, p: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.n
     """``leg_segments`` from the joints: each leg's ``segment`` joint centres ``(N, L, 3)``."""
     centre = mech._joint_arrays(p, R, axes=False).centre
     seg = np.array([t.segment for t in mech._leg_templates()])
-    legs = np.arange(len(seg))
-    return centre[:, legs, seg[:, 0]], centre[:, legs, seg[:, 1]]
+    out = []
+    for k in (0, 1):
+        if np.all(seg[:, k] == seg[0, k]):
+            x = centre[seg[0, k]]
+        else:                                   # legs of different kinds (sixleg)
+            x = np.choose(seg[:, k][None, :, None], centre)
+        out.append(x if x.flags.writeable else x.copy())
+    return tuple(out)
 
 
 def coordinate(joint: Joint, following: Joint) -> float:
@@ -478,4 +486,5 @@ class JointsMixin:
     @cached_property
     def _nominal_centres(self) -> np.ndarray:
         """``(L, J, 3)`` joint centres at the nominal pose (U axes are chosen there)."""
-        return self._joint_arrays(*self._frames(self.nominal_pose), axes=False).centre[0]
+        c = self._joint_arrays(*self._frames(self.nominal_pose), axes=False).centre
+        return np.stack([x[0] for x in c], axis=1)

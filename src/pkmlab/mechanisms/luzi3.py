@@ -403,8 +403,8 @@ class Luzi3(Mechanism):
             ax[:, :, 2, 0] = u2
             ax[:, :, 3, 0] = np.repeat(t, 2, axis=1)
             ax[:, :, 3, 1] = np.repeat(R[:, None, :, 2], 6, axis=1)
-        return JointArrays(np.stack([A, B, B, C2], axis=2), ax,
-                           self.inverse((p, R), stroke=NO_STROKE).q)
+        return JointArrays((A, B, B, C2), ax,
+                           self.inverse((p, R), stroke=NO_STROKE).q if axes else None)
 
     def _leg_templates(self):
         out = []

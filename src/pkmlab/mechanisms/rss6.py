@@ -473,8 +473,8 @@ class RSS6(Mechanism):
         and rod/rod of different legs (read from the joints)."""
         c = self._joint_arrays(p, R, axes=False).centre
         leg = np.arange(6)
-        return np.concatenate([c[:, :, 0], c[:, :, 1]], axis=1), \
-            np.concatenate([c[:, :, 1], c[:, :, 2]], axis=1), np.concatenate([leg, leg])
+        return np.concatenate([np.broadcast_to(c[0], c[1].shape), c[1]], axis=1), \
+            np.concatenate([c[1], c[2]], axis=1), np.concatenate([leg, leg])
 
     def base_joint_axes(self, p, R, axes):
         """The crank-end ball joints ride on the cranks: their mounting axes, given at the

@@ -455,20 +455,23 @@ class SixLeg(Mechanism):
 
     def _joint_arrays(self, p, R, axes=True):
         q = self.inverse((p, R), stroke=NO_STROKE).q
-        _, _, start = self._legs(p, R, q)
-        start = np.broadcast_to(start, (len(p), 6, 3))
-        W = joints.platform_joints(self, p, R)
-        centre = np.empty((len(p), 6, 3, 3))
+        _, a, start = self._legs(p, R, q)
+        start = np.broadcast_to(start, a.shape)
+        W = start + a          # the platform joints, as leg_segments always drew them
+        if len(set(self.leg_kinds)) == 1:
+            return joints.kind_arrays(self, self.leg_kinds[0], start, W, q, R, axes,
+                                      rail=self.axes)
+        centre = np.empty((3, len(p), 6, 3))
         ax = np.empty((len(p), 6, 3, 2, 3)) if axes else None
         for kind in KINDS:
             m = self._mask(kind)
             if m.any():
                 part = joints.kind_arrays(self, kind, start[:, m], W[:, m], q, R, axes,
                                    legs=np.flatnonzero(m), rail=self.axes[m])
-                centre[:, m] = part.centre
+                centre[:, :, m] = part.centre
                 if axes:
                     ax[:, m] = part.axes
-        return joints.JointArrays(centre, ax, q)
+        return joints.JointArrays(tuple(centre), ax, q)
 
     def _leg_templates(self):
         out = []

@@ -215,7 +215,7 @@ class UPS6(Mechanism):
 
     def _joint_arrays(self, p, R, axes=True):
         W = platform_joints(self, p, R)
-        q = self.inverse((p, R), stroke=NO_STROKE).q
+        q = self.inverse((p, R), stroke=NO_STROKE).q if axes else None
         return kind_arrays(self, "prismatic", self.base_points, W, q, R, axes)
 
     def _leg_templates(self):
