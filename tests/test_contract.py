@@ -52,6 +52,14 @@ def test_bad_pose_shape_raises_named_error(mech):
     testing.check_bad_shapes(mech)
 
 
+def test_joint_chains_close(mech):
+    testing.check_joints(mech)
+
+
+def test_parameters_round_trip(mech):
+    testing.check_parameters(mech)
+
+
 def test_checks_can_fail(mech):
     """A Jacobian with one wrong entry, or a leg whose status hides a NaN, is caught."""
     import dataclasses

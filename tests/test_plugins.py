@@ -62,7 +62,7 @@ print(run_contract(m, skip=("assembly_modes",)))
                          env=_env(site), timeout=600)
     assert run.returncode == 0, run.stderr
     assert run.stdout.strip() == "['declaration', 'round_trip', 'jacobian', 'batching', " \
-                                 "'statuses', 'bad_shapes']"
+                                 "'statuses', 'bad_shapes', 'joints', 'parameters']"
 
 
 def test_without_the_plugin_its_family_is_unknown():

@@ -25,7 +25,11 @@ The checks:
   non-finite poses are flagged, forward kinematics reports failure as data (NaN and a status);
 * :func:`check_assembly_modes` — the nominal pose is the first mode and doubling the starts finds
   nothing new;
-* :func:`check_bad_shapes` — malformed pose arrays raise a named error.
+* :func:`check_bad_shapes` — malformed pose arrays raise a named error;
+* :func:`check_joints` — each leg's joint chain (``legs``) closes at random valid poses, its
+  actuated joint's coordinate is the IK's value, its axes are unit (U: orthogonal), and
+  ``leg_segments`` read the same joints;
+* :func:`check_parameters` — ``with_parameters(parameters().values)`` equals the mechanism.
 
 :func:`cell_points` draws test points inside position × orientation cells, for checking a
 family's cell bounds (``leg_cell_bounds``, ``leg_cell_margins``) against its kinematics;
@@ -44,6 +48,7 @@ from .poses import as_frames, euler_to_matrix, exp_so3, log_so3
 __all__ = ["random_valid_poses", "rotation_error", "check_declaration", "check_round_trip",
            "check_jacobian",
            "check_batching", "check_statuses", "check_assembly_modes", "check_bad_shapes",
+           "check_joints", "check_parameters",
            "CHECKS", "run_contract", "cell_points", "check_columns", "random_sixleg"]
 
 REASON = {v: k for k, v in LEG_STATUS.items()}
@@ -223,11 +228,55 @@ def check_bad_shapes(mech):
             raise AssertionError(f"a pose array of shape {shape} was accepted")
 
 
+def check_joints(mech, n: int = 12, rel: float = 1e-9):
+    """The joint chains (``legs``, :mod:`pkmlab.mechanisms.joints`) close at the nominal pose
+    and ``n`` random valid ones: consecutive joints are the declared link lengths apart, the
+    last joint is the platform point moved by the pose, the first a base point, each actuated
+    joint's coordinate (from the joint locations alone) is the IK's actuator value, R/P/U axes
+    are unit and U axes orthogonal; to ``rel``·scale mm (``rel`` rad, unitless). And
+    ``leg_segments`` are the legs' ``segment`` joint centres."""
+    from .mechanisms.joints import chain_errors
+
+    try:
+        mech.legs()
+    except NotImplementedError as exc:
+        raise AssertionError(str(exc)) from exc
+    X = np.concatenate([mech.nominal_pose[None], random_valid_poses(mech, n, seed=6)])
+    mm = rel * mech.scale
+    tol = {"link_mm": mm, "platform_mm": mm, "platform_point_mm": mm, "base_mm": mm,
+           "p_direction": mm, "coordinate": mm if mech.actuator_unit == "mm" else rel,
+           "axis_norm": rel, "u_orthogonal": rel, "r_reference": rel}
+    start, end = mech.leg_segments(*as_frames(X))
+    for k, x in enumerate(X):
+        for key, value in chain_errors(mech, x).items():
+            assert value <= tol[key], f"joints at pose {x.tolist()}: {key} off by {value:.3g}"
+        for i, leg in enumerate(mech.legs(x)):
+            a, b = leg.segment
+            d = max(np.abs(start[k, i] - leg.joints[a].location).max(),
+                    np.abs(end[k, i] - leg.joints[b].location).max())
+            assert d <= mm, f"leg_segments of {leg.name} differ from its joints by {d:.3g} mm"
+
+
+def check_parameters(mech):
+    """The parameter vector round-trips (``with_parameters(parameters().values)`` equals the
+    mechanism), names are distinct, units known, and a changed length is applied as given."""
+    P = mech.parameters()
+    assert len(set(P.names)) == len(P) == len(P.values) == len(P.units) == len(P.descriptions)
+    assert set(P.units) <= {"mm", "rad", "1"}, set(P.units)
+    assert np.all(np.isfinite(P.values))
+    assert mech.with_parameters(P.values) == mech, "with_parameters(parameters()) differs"
+    k = P.units.index("mm")
+    m2 = mech.with_parameters({P.names[k]: P.values[k] + 1e-3 * mech.scale})
+    assert type(m2) is type(mech) and m2 != mech
+    assert m2.parameters().values[k] == P.values[k] + 1e-3 * mech.scale, P.names[k]
+
+
 #: name → check, in the order :func:`run_contract` runs them
 CHECKS = {"declaration": check_declaration, "round_trip": check_round_trip,
           "jacobian": check_jacobian,
           "batching": check_batching, "statuses": check_statuses,
-          "assembly_modes": check_assembly_modes, "bad_shapes": check_bad_shapes}
+          "assembly_modes": check_assembly_modes, "bad_shapes": check_bad_shapes,
+          "joints": check_joints, "parameters": check_parameters}
 
 
 def run_contract(mech, skip: tuple[str, ...] = ()) -> list[str]:

@@ -18,6 +18,7 @@ from __future__ import annotations
 import logging
 
 from .base import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult, Mechanism
+from .joints import Joint, Leg, Link, Parameters
 from .luzi3 import Luzi3
 from .mobility import PLANAR, SPATIAL, TRANSLATIONAL, Mobility
 from .psu6 import PSU6
@@ -95,4 +96,4 @@ def load_plugins() -> dict[str, type[Mechanism]]:
 __all__ = ["REGISTRY", "BUILTIN", "PLUGIN_GROUP", "PLUGIN_ERRORS", "load_plugins",
            "register_family", "NO_STROKE", "Mobility", "SPATIAL", "TRANSLATIONAL", "PLANAR",
            "Mechanism", "IKResult", "FKResult", "AssemblyModes", "LEG_STATUS", "PSU6", "UPS6",
-           "Luzi3", "RSS6", "SixLeg"]
+           "Luzi3", "RSS6", "SixLeg", "Joint", "Leg", "Link", "Parameters"]

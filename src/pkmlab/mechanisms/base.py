@@ -19,9 +19,26 @@ method whose name starts with ``_``):
 * ``forward(q)``, ``assembly_modes(q)`` (``q`` of ``L`` values; poses returned with six
   coordinates, the fixed ones those of the nominal pose);
 * ``footprint()`` — base and platform radii measured from their centres;
-* ``leg_segments(p, R)`` — each leg's moving link, for interference and drawing;
-  ``link_segments(p, R)`` — every moving link with the leg it belongs to (default: the
-  ``leg_segments``; 6-RSS: cranks and rods), for interference; ``base_joint_axes(p, R, axes)``
+* ``legs(pose=None)`` — each leg's joint chain at a pose (default nominal), base frame, one
+  :class:`.joints.Leg` per actuator in the order of ``actuator_names``: its joints from base
+  to platform (type R, P, U or S; ``location`` mm; unit ``axes``, R/P one, U two orthogonal,
+  the parent's first; ``actuated``, exactly one a leg; ``parent`` / ``child`` bodies "base",
+  a named link, "platform"; a P joint's ``zero``, ``location - zero = coordinate·axis``; an
+  actuated R joint's ``reference`` direction at angle 0), the links between them with their
+  fixed lengths, and the actuator value. Chains close: consecutive joints are the declared
+  lengths apart, the last is the platform point moved by the pose, the actuated joint's
+  coordinate is the IK's value (:func:`pkmlab.testing.check_joints`). Exports, calibration
+  and the drawings read it;
+* ``parameters()`` — the geometry as one named vector with units (:class:`.joints.Parameters`:
+  names, values, units "mm" / "rad" / "1", descriptions): every base and platform joint, every
+  axis, fixed link lengths, the actuator window and zero, the tool offset;
+  ``with_parameters(values)`` — the same family with those values (an array, or a mapping name
+  → value), ``m.with_parameters(m.parameters().values) == m``
+  (:func:`pkmlab.testing.check_parameters`);
+* ``leg_segments(p, R)`` — each leg's moving link, for interference and drawing, read from
+  the joints (each leg's ``segment``); ``link_segments(p, R)`` — every moving link with the
+  leg it belongs to (default: the ``leg_segments``; 6-RSS: cranks and rods, from the joints),
+  for interference; ``base_joint_axes(p, R, axes)``
   — the mounting axes of the base-side passive joints at each pose (default: fixed; 6-RSS:
   turned with the crank that carries the joint), for joint cones;
 * workspace hooks: ``position_bounds(R)``, and for families with exact column intervals
@@ -52,7 +69,12 @@ contract suite in ``tests/test_contract.py`` then runs on it):
   in parallel: ``psu6``, ``ups6`` and ``rss6`` do, at tens of M poses/s;
 * ``_closure(p, R, q)`` — loop-closure residuals ``(N, L)`` in mm and their derivative with
   respect to the tool twist ``(N, L, 6)``, used by Newton's method (on the free columns);
-* ``scale`` and ``leg_segments``; optionally the column hooks above.
+* ``scale``; the joints, ``_joint_arrays(p, R, axes=True)`` (every leg's joint centres and
+  axes over N poses, vectorised) and ``_leg_templates()`` (each leg's joint types, bodies,
+  fixed link lengths, actuated joint), helped by :func:`.joints.kind_arrays` for UPS, PSU and
+  RSS legs; ``parameter_fields`` when the geometry has more than the protocol's
+  ``base_points``, ``platform_points``, ``stroke_window`` and ``tool_offset``
+  (:class:`.joints.ParamField`); optionally the column hooks above.
 
 Forward kinematics, the assembly-mode search and the nominal-pose search are generic and live
 here and in :mod:`.solvers`.
@@ -72,6 +94,7 @@ from ..poses import as_frames, log_so3
 from ..threads import threads_for
 from ..tolerances import TOL
 from . import _kernels, _tiles, column_kernels
+from .joints import JointsMixin
 from .mobility import SPATIAL, Mobility
 from .results import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult
 from .solvers import bracketed_root, forward_newton, multistart_modes
@@ -97,8 +120,9 @@ __all__ = [
 
 
 @dataclass(frozen=True, eq=False)
-class Mechanism:
-    """Base of every mechanism family (geometry lives in the subclass)."""
+class Mechanism(JointsMixin):
+    """Base of every mechanism family (geometry lives in the subclass; joints and parameters:
+    :class:`.joints.JointsMixin`)."""
 
     family: ClassVar[str] = ""
     #: the free pose coordinates (:mod:`.mobility`)
@@ -228,13 +252,6 @@ class Mechanism:
         p = self.nominal_pose[:3]
         S = 2.0 * self.scale
         return np.broadcast_to(np.stack([p - S, p + S]), (len(R), 2, 3)).copy()
-
-    def leg_segments(self, p: np.ndarray, R: np.ndarray):  # pragma: no cover - abstract
-        """End points ``(start, end)``, each ``(N, 6, 3)``, of each leg's moving link.
-
-        ``start`` carries the base-side passive joint and ``end`` the platform-side one.
-        """
-        raise NotImplementedError
 
     def link_segments(self, p: np.ndarray, R: np.ndarray):
         """``(start, end, leg)``: end points ``(N, S, 3)`` of every moving link and the leg

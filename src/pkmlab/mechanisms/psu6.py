@@ -25,6 +25,7 @@ from numba.extending import register_jitable
 from ..errors import ParameterError
 from . import _kernels
 from .base import NO_STROKE, Mechanism, as_points, as_positive, as_stroke, as_vector3
+from .joints import DEFAULT_FIELDS, ParamField, kind_arrays, kind_template, platform_joints
 from .layout import build_paired
 
 __all__ = ["PSU6"]
@@ -200,12 +201,25 @@ class PSU6(Mechanism):
                       axis=-1)
         return np.stack([lo.max(axis=1), hi.min(axis=1)], axis=1)
 
-    def leg_segments(self, p, R):
-        """Link end points ``(N, 6, 3)`` each: slider S joint → platform U joint."""
-        W = p[:, None, :] + np.einsum("nij,kj->nki", R, self.tool_points)
-        r = self.inverse((p, R), stroke=NO_STROKE)
-        start = self.base_points + r.q[..., None] * np.array([0.0, 0.0, 1.0])
-        return start, W
+    # ---- joints (:mod:`.joints`): P (vertical rail), S on the slider, link, U on the platform
+    parameter_fields = (
+        ParamField("base_points", "base", "mm",
+                   "leg {i}'s slider position at actuator value 0 (base frame; its z is the "
+                   "actuator zero)"),
+        *DEFAULT_FIELDS[1:2],
+        ParamField("link_length", "link_length", "mm", "leg {i}'s link length, S to U"),
+        *DEFAULT_FIELDS[2:])
+
+    def _joint_arrays(self, p, R, axes=True):
+        q = self.inverse((p, R), stroke=NO_STROKE).q
+        start = self.base_points + q[..., None] * np.array([0.0, 0.0, 1.0])
+        return kind_arrays(self, "slider", start, platform_joints(self, p, R), q, R, axes,
+                           rail=np.array([0.0, 0.0, 1.0]))
+
+    def _leg_templates(self):
+        return tuple(kind_template("slider", i, n, self.base_points[i], self.platform_points[i],
+                                   (0.0, self.link_length[i]), zero=self.base_points[i])
+                     for i, n in enumerate(self.actuator_names))
 
 
 def _radii(value, field: str) -> tuple[float, float]:

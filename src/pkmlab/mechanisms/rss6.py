@@ -54,8 +54,10 @@ from ._crank import crank_column_leg, crank_params
 from ._crank_cells import crank_cell_terms, crank_position_curvature
 from ._set_columns import set_column_intervals
 from .base import NO_STROKE, Mechanism, as_points, as_positive, as_vector3
+from .joints import DEFAULT_FIELDS, ParamField, kind_arrays, kind_template, platform_joints
 from .layout import build_paired
 from .psu6 import _radii
+from .validation import unit_rows, without_component
 
 __all__ = ["RSS6"]
 
@@ -185,7 +187,7 @@ def _unit_rows(value, field: str) -> np.ndarray:
     n = np.linalg.norm(arr, axis=1)
     if np.any(n < 1e-9):
         raise ParameterError(field, "non-zero directions", arr.tolist())
-    out = arr / n[:, None]
+    out = unit_rows(arr)
     out.setflags(write=False)
     return out
 
@@ -240,11 +242,11 @@ class RSS6(Mechanism):
         set_(self, "platform_points", as_points(self.platform_points, "platform_points", 6))
         n = _unit_rows(self.servo_axes, "servo_axes")
         u = _unit_rows(self.zero_directions, "zero_directions")
-        u = u - np.sum(u * n, axis=1, keepdims=True) * n          # Gram-Schmidt
+        u = without_component(u, n)                               # Gram-Schmidt
         if np.any(np.linalg.norm(u, axis=1) < 1e-6):
             raise ParameterError("zero_directions", "directions not parallel to the servo axes",
                                  self.zero_directions)
-        u = u / np.linalg.norm(u, axis=1, keepdims=True)
+        u = unit_rows(u)
         for arr in (n, u):
             arr.setflags(write=False)
         set_(self, "servo_axes", n)
@@ -442,21 +444,37 @@ class RSS6(Mechanism):
                                         self.servo_axes, self.crank_length, self.rod_length,
                                         self.branch, 1e-9 + 1e-12 * self.scale)
 
-    def leg_segments(self, p, R):
-        """Rod end points ``(N, 6, 3)`` each: crank-end ball joint → platform ball joint."""
-        W = p[:, None, :] + np.einsum("nij,kj->nki", R, self.tool_points)
+    # ---- joints (:mod:`.joints`): R (servo, actuated), S at the crank end, rod, S --------
+    parameter_fields = (
+        ParamField("base_points", "base", "mm", "leg {i}'s crank pivot on its servo axis "
+                   "(base frame)"),
+        DEFAULT_FIELDS[1],
+        ParamField("servo_axes", "servo_axis", "1", "leg {i}'s servo axis direction"),
+        ParamField("zero_directions", "zero_direction", "1",
+                   "leg {i}'s crank direction at angle 0 (the actuator zero)"),
+        ParamField("crank_length", "crank_length", "mm", "leg {i}'s crank length"),
+        ParamField("rod_length", "rod_length", "mm", "leg {i}'s rod length"),
+        *DEFAULT_FIELDS[2:])
+
+    def _joint_arrays(self, p, R, axes=True):
         q = self.inverse((p, R), stroke=NO_STROKE).q
-        return self.crank_ends(q), W
+        return kind_arrays(self, "crank", self.crank_ends(q), platform_joints(self, p, R), q,
+                           R, axes, rail=self.servo_axes)
+
+    def _leg_templates(self):
+        return tuple(kind_template("crank", i, n, self.base_points[i], self.platform_points[i],
+                                   (self.crank_length[i], self.rod_length[i]),
+                                   reference=self.zero_directions[i])
+                     for i, n in enumerate(self.actuator_names))
 
     def link_segments(self, p, R):
         """Cranks (pivot → crank end, segments 0-5) and rods (crank end → platform joint,
         6-11), with their legs ``[0..5, 0..5]``: interference covers crank/crank, crank/rod
-        and rod/rod of different legs."""
-        C, W = self.leg_segments(p, R)
-        B = np.broadcast_to(self.base_points, C.shape)
+        and rod/rod of different legs (read from the joints)."""
+        c = self._joint_arrays(p, R, axes=False).centre
         leg = np.arange(6)
-        return np.concatenate([B, C], axis=1), np.concatenate([C, W], axis=1), \
-            np.concatenate([leg, leg])
+        return np.concatenate([np.broadcast_to(c[0], c[1].shape), c[1]], axis=1), \
+            np.concatenate([c[1], c[2]], axis=1), np.concatenate([leg, leg])
 
     def base_joint_axes(self, p, R, axes):
         """The crank-end ball joints ride on the cranks: their mounting axes, given at the

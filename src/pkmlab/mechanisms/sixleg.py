@@ -64,7 +64,7 @@ from numba.extending import register_jitable
 
 from ..errors import ParameterError
 from ..poses import euler_to_matrix
-from . import _kernels
+from . import _kernels, joints
 from ._crank import crank_column_leg, crank_params
 from ._set_columns import set_column_intervals
 from ._slider import K_MIN, slider_interval
@@ -72,6 +72,7 @@ from .base import NO_STROKE, Mechanism, as_points, as_stroke, as_vector3
 from .layout import PAIRED_ALIASES
 from .rss6 import _atan2
 from .ups6 import _ups_column_leg, working_sides
+from .validation import unit_rows, without_component
 
 __all__ = ["SixLeg", "KINDS"]
 
@@ -192,8 +193,7 @@ def _directions(value, field: str, need: np.ndarray) -> np.ndarray:
     if np.any(bad):
         i = int(np.argmax(bad))
         raise ParameterError(f"legs[{i + 1}].{field}", "a non-zero direction", arr[i].tolist())
-    out = np.where(need[:, None], arr / np.where(n > 0, n, 1.0)[:, None], 0.0)
-    return out
+    return np.where(need[:, None], unit_rows(arr), 0.0)
 
 
 def _per_leg(value, field: str, need: np.ndarray, positive: bool = True) -> np.ndarray:
@@ -278,14 +278,13 @@ class SixLeg(Mechanism):
         set_(self, "kinds", codes)
         set_(self, "axes", _directions(self.axes, "axis", slider | crank))
         u = _directions(self.zero_directions, "zero_direction", crank)
-        u = u - np.sum(u * self.axes, axis=1, keepdims=True) * self.axes     # Gram-Schmidt
+        u = without_component(u, self.axes)                                  # Gram-Schmidt
         nu = np.linalg.norm(u, axis=1)
         if np.any(crank & (nu < 1e-6)):
             i = int(np.argmax(crank & (nu < 1e-6)))
             raise ParameterError(f"legs[{i + 1}].zero_direction", "a direction not parallel "
                                  "to the servo axis", self.zero_directions[i])
-        set_(self, "zero_directions", np.where(crank[:, None], u / np.where(nu > 0, nu, 1)[
-            :, None], 0.0))
+        set_(self, "zero_directions", np.where(crank[:, None], unit_rows(u), 0.0))
         set_(self, "crank_length", _per_leg(self.crank_length, "crank_length", crank))
         set_(self, "link_length", _per_leg(self.link_length, "link_length", slider | crank))
         set_(self, "branch", _per_leg(self.branch, "branch", slider | crank, positive=False))
@@ -438,12 +437,53 @@ class SixLeg(Mechanism):
         target = np.where(self._mask("prismatic"), q, self.link_length)
         return norm - target, np.concatenate([n, np.cross(r, n)], axis=-1)
 
-    def leg_segments(self, p, R):
-        """Moving-link end points ``(N, 6, 3)`` each: base U joint (prismatic), slider joint or
-        crank end → platform joint."""
+    # ---- joints (:mod:`.joints`): UPS, PSU or RSS legs by kind -------------------------------
+    _moving_rows, _crank_rows = (lambda m: ~m._mask("prismatic")), (lambda m: m._mask("crank"))
+    parameter_fields = (
+        joints.ParamField("base_points", "base", "mm", "leg {i}'s base U joint, slider position at "
+                   "actuator value 0 or crank pivot (base frame)"),
+        joints.DEFAULT_FIELDS[1],
+        joints.ParamField("axes", "axis", "1", "leg {i}'s rail or servo axis direction",
+                   rows=_moving_rows),
+        joints.ParamField("zero_directions", "zero_direction", "1", "leg {i}'s crank direction at "
+                   "angle 0 (the actuator zero)", rows=_crank_rows),
+        joints.ParamField("crank_length", "crank_length", "mm", "leg {i}'s crank length",
+                   rows=_crank_rows),
+        joints.ParamField("link_length", "link_length", "mm", "leg {i}'s slider link or crank rod "
+                   "length", rows=_moving_rows),
+        *joints.DEFAULT_FIELDS[2:])
+
+    def _joint_arrays(self, p, R, axes=True):
         q = self.inverse((p, R), stroke=NO_STROKE).q
         _, a, start = self._legs(p, R, q)
-        return np.broadcast_to(start, a.shape).copy(), start + a
+        start = np.broadcast_to(start, a.shape)
+        W = start + a          # the platform joints, as leg_segments always drew them
+        if len(set(self.leg_kinds)) == 1:
+            return joints.kind_arrays(self, self.leg_kinds[0], start, W, q, R, axes,
+                                      rail=self.axes)
+        centre = np.empty((3, len(p), 6, 3))
+        ax = np.empty((len(p), 6, 3, 2, 3)) if axes else None
+        for kind in KINDS:
+            m = self._mask(kind)
+            if m.any():
+                part = joints.kind_arrays(self, kind, start[:, m], W[:, m], q, R, axes,
+                                   legs=np.flatnonzero(m), rail=self.axes[m])
+                centre[:, :, m] = part.centre
+                if axes:
+                    ax[:, m] = part.axes
+        return joints.JointArrays(tuple(centre), ax, q)
+
+    def _leg_templates(self):
+        out = []
+        for i, (kind, name) in enumerate(zip(self.leg_kinds, self.actuator_names, strict=True)):
+            lengths = {"prismatic": (0.0, 0.0), "slider": (0.0, self.link_length[i]),
+                       "crank": (self.crank_length[i], self.link_length[i])}[kind]
+            out.append(joints.kind_template(kind, i, name, self.base_points[i],
+                                     self.platform_points[i], lengths,
+                                     zero=None if kind == "crank" else self.base_points[i],
+                                     reference=self.zero_directions[i] if kind == "crank"
+                                     else None))
+        return tuple(out)
 
     def describe(self) -> dict:
         d = super().describe()

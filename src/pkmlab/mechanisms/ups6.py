@@ -21,7 +21,8 @@ from numba.extending import register_jitable
 
 from ..poses import euler_to_matrix
 from . import _kernels
-from .base import Mechanism, as_points, as_stroke, as_vector3
+from .base import NO_STROKE, Mechanism, as_points, as_stroke, as_vector3
+from .joints import DEFAULT_FIELDS, ParamField, kind_arrays, kind_template, platform_joints
 from .layout import build_paired
 from .psu6 import _radii
 
@@ -207,7 +208,17 @@ class UPS6(Mechanism):
         hi[:, ~up, 2] = -W[:, ~up, 2]
         return np.stack([lo.max(axis=1), hi.min(axis=1)], axis=1)
 
-    def leg_segments(self, p, R):
-        """Leg end points ``(N, 6, 3)`` each: base U joint → platform S joint."""
-        W = p[:, None, :] + np.einsum("nij,kj->nki", R, self.tool_points)
-        return np.broadcast_to(self.base_points, W.shape).copy(), W
+    # ---- joints (:mod:`.joints`): U on the base, P (the leg), S on the platform -------------
+    parameter_fields = (ParamField("base_points", "base", "mm",
+                                   "leg {i}'s base U joint centre (base frame)"),
+                        *DEFAULT_FIELDS[1:])
+
+    def _joint_arrays(self, p, R, axes=True):
+        W = platform_joints(self, p, R)
+        q = self.inverse((p, R), stroke=NO_STROKE).q if axes else None
+        return kind_arrays(self, "prismatic", self.base_points, W, q, R, axes)
+
+    def _leg_templates(self):
+        return tuple(kind_template("prismatic", i, n, self.base_points[i],
+                                   self.platform_points[i], (0.0, 0.0), zero=self.base_points[i])
+                     for i, n in enumerate(self.actuator_names))

@@ -10,9 +10,13 @@ import numpy as np
 from ..errors import ParameterError
 from ..tolerances import TOL
 
-__all__ = ["as_points", "as_stroke", "as_positive", "as_vector3"]
+__all__ = ["as_points", "as_stroke", "as_positive", "as_vector3", "unit_rows",
+           "without_component"]
 
-
+#: a row whose norm is within this of 1 is already a unit vector and is kept as given, so that
+#: normalising is idempotent: a mechanism rebuilt from its own fields (``with_parameters``) is
+#: equal to it, bit for bit (x/|x| has a norm within a few ulp of 1, not exactly 1)
+_UNIT_ULP = 8.0 * np.finfo(float).eps
 
 def as_points(value: Any, field: str, count: int) -> np.ndarray:
     """Validate a ``(count, 3)`` array of finite coordinates with no two points coincident."""
@@ -66,3 +70,21 @@ def as_vector3(value: Any, field: str) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------------------------
+
+
+def unit_rows(arr: np.ndarray) -> np.ndarray:
+    """``arr (K, 3)`` with each non-zero row divided by its norm, except rows already of unit
+    norm to 8 ulp (kept bit for bit: idempotent); zero rows stay zero."""
+    arr = np.asarray(arr, dtype=float)
+    n = np.linalg.norm(arr, axis=1)
+    keep = (np.abs(n - 1.0) <= _UNIT_ULP) | (n == 0)
+    return np.where(keep[:, None], arr, arr / np.where(keep, 1.0, n)[:, None])
+
+
+def without_component(u: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Rows of ``u`` minus their component along the unit rows ``n`` (Gram-Schmidt), except
+    rows already perpendicular to 8 ulp (kept bit for bit: idempotent)."""
+    c = np.sum(u * n, axis=1, keepdims=True)
+    small = np.abs(c) <= _UNIT_ULP * np.linalg.norm(u, axis=1, keepdims=True)
+    return np.where(small, u, u - c * n)
+

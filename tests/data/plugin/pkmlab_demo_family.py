@@ -9,7 +9,7 @@ import numpy as np
 from numba.extending import register_jitable
 
 from pkmlab.config import FamilySpec, Points
-from pkmlab.mechanisms import Mechanism, _kernels
+from pkmlab.mechanisms import NO_STROKE, Mechanism, _kernels, joints
 from pkmlab.mechanisms.base import as_points, as_stroke
 
 
@@ -78,6 +78,15 @@ class Legs6(Mechanism):
         r, n, length = self._legs(p, R)
         return length - q, np.concatenate([n, np.cross(r, n)], axis=-1)
 
-    def leg_segments(self, p, R):
-        W = p[:, None, :] + np.einsum("nij,kj->nki", R, self.tool_points)
-        return np.broadcast_to(self.base_points, W.shape).copy(), W
+    # joints (pkmlab.mechanisms.joints): U on the base, the actuated P along the leg, S on
+    # the platform; the parameter vector is the protocol's default (joints, stroke, tool)
+    def _joint_arrays(self, p, R, axes=True):
+        q = self.inverse((p, R), stroke=NO_STROKE).q
+        W = joints.platform_joints(self, p, R)
+        return joints.kind_arrays(self, "prismatic", self.base_points, W, q, R, axes)
+
+    def _leg_templates(self):
+        return tuple(joints.kind_template("prismatic", i, n, self.base_points[i],
+                                          self.platform_points[i], (0.0, 0.0),
+                                          zero=self.base_points[i])
+                     for i, n in enumerate(self.actuator_names))

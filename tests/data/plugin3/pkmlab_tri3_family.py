@@ -10,7 +10,7 @@ import numpy as np
 from numba.extending import register_jitable
 
 from pkmlab.config import FamilySpec
-from pkmlab.mechanisms import TRANSLATIONAL, Mechanism, _kernels
+from pkmlab.mechanisms import NO_STROKE, TRANSLATIONAL, Mechanism, _kernels, joints
 from pkmlab.mechanisms.base import as_points, as_stroke
 
 
@@ -77,9 +77,22 @@ class Tri3(Mechanism):
         r, n, length = self._legs(p, R)
         return length - q, np.concatenate([n, np.cross(r, n)], axis=-1)
 
-    def leg_segments(self, p, R):
-        W = p[:, None, :] + np.einsum("nij,kj->nki", R, self.tool_points)
-        return np.broadcast_to(self.base_points, W.shape).copy(), W
+    # joints (pkmlab.mechanisms.joints): U on the base, the actuated P along the leg, U on
+    # the platform, arranged for translation (Tsai's 3-UPU): the platform U's axes parallel
+    # to the base U's, in reverse order
+    def _joint_arrays(self, p, R, axes=True):
+        q = self.inverse((p, R), stroke=NO_STROKE).q
+        W = joints.platform_joints(self, p, R)
+        arr = joints.kind_arrays(self, "prismatic", self.base_points, W, q, R, axes)
+        if axes:
+            arr.axes[:, :, 2] = arr.axes[:, :, 0, ::-1]
+        return arr
+
+    def _leg_templates(self):
+        return tuple(joints.kind_template("prismatic", i, n, self.base_points[i],
+                                          self.platform_points[i], (0.0, 0.0),
+                                          zero=self.base_points[i], types=("U", "P", "U"))
+                     for i, n in enumerate(self.actuator_names))
 
 
 def circle(radius, degrees=(90.0, 210.0, 330.0)):
