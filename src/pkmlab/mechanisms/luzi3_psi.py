@@ -1,21 +1,17 @@
 """The paper's reduced direct position analysis of the 3-chain platform (:mod:`.luzi3`) in
 ψ1..ψ4 (Luzi, Sancisi & Parenti Castelli, eqs. 1-13) and the ψ ↔ pose conversion; see
 ``docs/validation.md`` for the conventions and the errata found. Moved out of :mod:`.luzi3`,
-which re-exports every name."""
+which re-exports every name. Every function takes ``mech``, a :class:`~.luzi3.Luzi3`."""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..poses import as_frames, frames_to_poses
 from .results import NO_STROKE
-
-if TYPE_CHECKING:
-    from .luzi3 import Luzi3
 
 __all__ = ["four_bar_theta", "pose_to_psi", "psi_to_pose", "reduced_dpa", "ReducedDPAResult"]
 
@@ -45,7 +41,7 @@ def _rz(a):
     return R
 
 
-def four_bar_theta(mech: Luzi3, psi1, l11, l12, branch: int = -1):
+def four_bar_theta(mech, psi1, l11, l12, branch: int = -1):
     """Eqs. (1)-(3): the upper-link angle θ of chain 1 from ψ1 and the chain-1 leg lengths.
 
     ``branch=-1`` is the paper's root ``(-b - sqrt(b² - 4ac)) / 2a``; ``+1`` the other one.
@@ -68,7 +64,7 @@ def four_bar_theta(mech: Luzi3, psi1, l11, l12, branch: int = -1):
     return np.where(disc >= 0, 2 * np.arctan(t), np.nan)
 
 
-def psi_to_pose(mech: Luzi3, psi, l11, l12, branch: int = -1) -> np.ndarray:
+def psi_to_pose(mech, psi, l11, l12, branch: int = -1) -> np.ndarray:
     """ψ ``(N, 4)`` plus chain-1 lengths → tool poses ``(N, 6)`` (NaN where θ is not real)."""
     psi = np.atleast_2d(np.asarray(psi, dtype=float))
     p1, p2, p3, p4 = psi.T
@@ -84,7 +80,7 @@ def psi_to_pose(mech: Luzi3, psi, l11, l12, branch: int = -1) -> np.ndarray:
     return frames_to_poses(tool, R)
 
 
-def pose_to_psi(mech: Luzi3, poses) -> np.ndarray:
+def pose_to_psi(mech, poses) -> np.ndarray:
     """Tool poses ``(N, 6)`` / ``(N, 4, 4)`` → the paper's ψ1..ψ4 ``(N, 4)``."""
     p, R = as_frames(poses)
     F = mech.chain1_frame()
@@ -107,7 +103,7 @@ def pose_to_psi(mech: Luzi3, poses) -> np.ndarray:
     return np.stack([psi1, psi2, psi3, psi4], axis=1)
 
 
-def _reduced_residual(mech: Luzi3, psi, q, branch: int, literal: bool = False) -> np.ndarray:
+def _reduced_residual(mech, psi, q, branch: int, literal: bool = False) -> np.ndarray:
     """Eq. (13): the four closure residuals (mm) of chains 2 and 3, t_i from eq. (10).
 
     Eq. (10) fixes t_i's sign by the order of the cross products alone; unless ``literal``,
@@ -154,7 +150,7 @@ class ReducedDPAResult:
     ik_error: np.ndarray
 
 
-def reduced_dpa(mech: Luzi3, q, *, grid: int = 9, tol: float = 1e-9, max_iter: int = 60,
+def reduced_dpa(mech, q, *, grid: int = 9, tol: float = 1e-9, max_iter: int = 60,
                 literal_eq10: bool = False) -> ReducedDPAResult:
     """Solve the paper's 4-equation system (13) in ψ1..ψ4 by multi-start Newton.
 
