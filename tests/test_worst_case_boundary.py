@@ -196,3 +196,17 @@ def test_sign_changes_at_the_column_ends_are_counted_and_genuine():
     Jh = UPS.jacobian(((((1 - lo) * a + lo * b))[None], R[None]))[0]
     Jh[:, 3:] /= L
     assert np.linalg.cond(Jh) > 1e10
+
+
+def test_sampled_voxel_faces_are_not_taken_for_the_boundary():
+    """On the sampled method (luzi3) ``lo``/``hi`` are faces of voxel runs, which can lie
+    outside the workspace (a face of a dexterous run need not be feasible at every orientation):
+    no column ends are evaluated there, so the worst κ is the grid's (it took a face's before,
+    e.g. 9,078 against the grid's 6,857 on this ±5° set at 10 mm)."""
+    luzi = pkmlab.load_mechanism(MECH_DIR / "luzi-3chain.yaml")
+    box = pkmlab.OrientationSet.box(np.radians([5.0] * 3), samples=2)
+    res = workspace(luzi, "dexterous", box, resolution=20.0)
+    assert res.method == "sampled voxels" and res.lo is not None and not res.exact_columns
+    wc = dx.worst_case(luzi, res)
+    assert wc.boundary_points == 0 and wc.boundary_sign_changes == 0
+    assert wc.worst_kappa == wc.grid_max_kappa or (wc.singular and not wc.boundary_singular)

@@ -58,7 +58,7 @@ def column_ends(result, idx: np.ndarray, shared: bool) -> ColumnEnds | None:
     ``shared`` (the Jacobian does not depend on z) the ends of a column that holds a voxel have
     that column's Jacobian and are left out; the other columns' ends are kept.
     """
-    if result.lo is None:
+    if not result.exact_columns:
         return None
     lo, hi = result.lo, result.hi
     i, j, k = np.nonzero(lo <= hi)

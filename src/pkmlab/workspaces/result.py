@@ -267,6 +267,12 @@ class WorkspaceResult:
 
         return merged_mesh(*self._triangles)
 
+    @property
+    def exact_columns(self) -> bool:
+        """True when ``lo``/``hi`` are the exact z sets of the column method; the sampled
+        method's ``lo``/``hi`` are faces of voxel runs, not the workspace's boundary."""
+        return self.lo is not None and not self.method.startswith("sampled")
+
     def mesh(self):
         """Watertight boundary mesh (``trimesh.Trimesh``, mm) by marching cubes on ``field``
         (computed once; each call returns a copy the caller may colour or move)."""
