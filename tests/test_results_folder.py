@@ -104,12 +104,47 @@ def test_overwrite_replaces_a_run_folder_including_an_interrupted_export(capsys,
     p = small_study(tmp_path)
     out = tmp_path / "out"
     assert cli(capsys, "run", p)[0] == 0
-    # what a killed run leaves: an atomic write's scratch file and a staged scratch folder
-    (out / ".summary.md.x1y2.part").write_text("half")
-    (out / "designs" / ".partial-abc").mkdir()
+    # what a killed run leaves: atomic writes' scratch files (tempfile's 8 random characters)
+    (out / ".summary.md.x1y2_9zq.part").write_text("half")
+    (out / "designs" / ".index.json.abcdefgh.part").write_text("half")
     (out / "designs" / "07-0123abcd").mkdir()
     code, _, err = cli(capsys, "run", p, "--overwrite")
     assert code == 0, err
-    assert not (out / ".summary.md.x1y2.part").exists()
+    assert not (out / ".summary.md.x1y2_9zq.part").exists()
     assert not (out / "designs" / "07-0123abcd").exists()
+    assert not (out / "designs" / ".index.json.abcdefgh.part").exists()
     assert _evaluations(out) == 5 and foreign(out) is None
+
+
+@pytest.mark.parametrize("plant", [".partial-mydata/thesis.tex", ".mine.part",
+                                   ".notes.txt.abcdefgh.part", "designs/.partial-x/a.png"])
+def test_overwrite_refuses_user_files_named_like_scratch_files(capsys, tmp_path, plant):
+    """Only the scratch files pkmlab's own atomic writes leave count as pkmlab's (any
+    '.partial-*' folder or '*.part' file was taken, and deleted, before)."""
+    p = small_study(tmp_path)
+    out = tmp_path / "out"
+    assert cli(capsys, "run", p)[0] == 0
+    planted = out / plant
+    planted.parent.mkdir(parents=True, exist_ok=True)
+    planted.write_text("precious")
+    code, _, err = cli(capsys, "run", p, "--overwrite")
+    assert code == 2 and "only what pkmlab wrote" in err, err
+    assert planted.read_text() == "precious"
+
+
+def test_overwrite_accepts_meshes_of_a_registered_format(capsys, tmp_path):
+    """A study writes every registered mesh format; --overwrite must know them as pkmlab's."""
+    from test_exporters import _off
+
+    from pkmlab.export import EXPORTERS, Exporter, register_exporter
+
+    register_exporter(Exporter("off", "mesh", "Object File Format text in mm", _off,
+                               trimesh=False))
+    try:
+        p = small_study(tmp_path)
+        assert cli(capsys, "run", p)[0] == 0
+        assert list((tmp_path / "out" / "designs").glob("*/workspace.off"))
+        code, _, err = cli(capsys, "run", p, "--overwrite")
+        assert code == 0, err
+    finally:
+        EXPORTERS.pop("off")

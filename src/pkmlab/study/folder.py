@@ -8,7 +8,8 @@ folder in use is refused, naming the holder.
 :data:`MARKER` (written as a run starts) or a study store (``evaluations.sqlite``, for runs of
 earlier versions), and every entry in it has the name of a pkmlab output (:func:`foreign`): the
 store and its journals, the tables, pictures, summary, resolved study and report, the
-``designs/`` folders with their design files, and the scratch files of atomic writes. Anything
+``designs/`` folders with their design files (mesh files in any registered format), and the
+scratch files an interrupted atomic write of one of these leaves. Anything
 else, a symbolic link included (pkmlab writes none and never follows one), makes the whole
 folder refused, naming the first such entry, and nothing is deleted.
 """
@@ -37,9 +38,11 @@ _TOP_FILES = frozenset({
     "report.html"})
 _DESIGNS = "designs"
 _DESIGN_FOLDER = re.compile(r"^\d{2}-[0-9a-f]{8}$")         # as study.export names them
-_DESIGN_FILE = re.compile(r"^[a-z0-9_.-]+\.(json|yaml|png|stl|ply|glb|npz|csv)$")
-_SCRATCH_FILE = re.compile(r"^\..+\.part$")                 # atomic.write_bytes
-_SCRATCH_DIR = re.compile(r"^\.partial-")                   # atomic.staged
+_DESIGN_FILE = re.compile(r"^[a-z0-9_.-]+\.([a-z0-9]+)$")
+#: suffixes of a design's own files besides the registered mesh formats (pkmlab.export)
+_DESIGN_SUFFIXES = frozenset({"json", "yaml", "png", "npz", "csv"})
+#: ``atomic.write_bytes``'s scratch file of ``target``: ``.<target>.<8 random chars>.part``
+_SCRATCH_FILE = re.compile(r"^\.(.+)\.[a-z0-9_]{8}\.part$")
 
 
 class OutputLock:
@@ -103,9 +106,11 @@ def _marked(out: Path) -> bool:
     return (out / MARKER).is_file() or (out / _STORE).is_file()
 
 
-def _scratch(entry: os.DirEntry) -> bool:
-    return (_SCRATCH_DIR.match(entry.name) is not None if entry.is_dir(follow_symlinks=False)
-            else _SCRATCH_FILE.match(entry.name) is not None)
+def _scratch(entry: os.DirEntry, allowed_files) -> bool:
+    """A plain file an interrupted atomic write of an allowed file left behind."""
+    m = _SCRATCH_FILE.match(entry.name)
+    return (m is not None and entry.is_file(follow_symlinks=False)
+            and bool(allowed_files(m.group(1))))
 
 
 def _foreign_in(folder: Path, rel: str, allowed_files, allowed_dirs) -> str | None:
@@ -114,7 +119,7 @@ def _foreign_in(folder: Path, rel: str, allowed_files, allowed_dirs) -> str | No
             name = f"{rel}{e.name}"
             if e.is_symlink():
                 return name + " (a symbolic link)"
-            if _scratch(e):
+            if _scratch(e, allowed_files):
                 continue
             if e.is_dir(follow_symlinks=False):
                 sub = allowed_dirs(e.name)
@@ -130,7 +135,14 @@ def _foreign_in(folder: Path, rel: str, allowed_files, allowed_dirs) -> str | No
 def _design_folder(name: str):
     if _DESIGN_FOLDER.match(name) is None:
         return None
-    return (lambda f: _DESIGN_FILE.match(f) is not None), (lambda d: None)
+    return _design_file, (lambda d: None)
+
+
+def _design_file(name: str) -> bool:
+    from ..export import exporters
+
+    m = _DESIGN_FILE.match(name)
+    return m is not None and (m.group(1) in _DESIGN_SUFFIXES or m.group(1) in exporters("mesh"))
 
 
 def _designs(name: str):
