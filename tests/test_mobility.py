@@ -160,3 +160,23 @@ def test_the_fk_mode_check_moves_the_free_coordinates_only(tripod):
     fk = tripod.forward(tripod.inverse([[5.0, 5.0, 390.0]]).q, modes=True)
     assert fk.converged.all() and not fk.ambiguous.any()     # the mirror is below the base
     assert fk.mode_starts > 1 and np.isnan(fk.next_mode).all()
+
+
+def test_pkmlab_fk_takes_one_value_per_declared_actuator(tripod, tmp_path, capsys):
+    """`pkmlab fk` asked for six values whatever the family declared (and then refused six)."""
+    import json
+
+    from test_faults import cli
+
+    f = tmp_path / "tri3.yaml"
+    f.write_text("family: tri3\nbase_points: " + str(tri3.circle(300.0).tolist())
+                 + "\nplatform_points: " + str(tri3.circle(60.0).tolist())
+                 + "\nstroke: [250, 600]\n")
+    q = tripod.inverse([[0.0, 0.0, 400.0]]).q[0]
+    code, out, err = cli(capsys, "fk", f, "--actuators", ",".join(f"{v:.9f}" for v in q),
+                         "--json")
+    assert code == 0, err
+    pose = json.loads(out)["pose"]
+    assert abs(pose["z"] - 400.0) < 1e-6 and abs(pose["x"]) < 1e-6
+    code, _, err = cli(capsys, "fk", f, "--actuators", "1,2,3,4,5,6")
+    assert code == 2 and "--actuators: must be 3 comma-separated values" in err, err

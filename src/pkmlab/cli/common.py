@@ -110,9 +110,9 @@ def _act_str(mech: Mechanism, q, digits: int = 4) -> str:
 
 
 def _parse_actuators(mech: Mechanism, text: str) -> np.ndarray:
-    """``"q1,…,q6"``: mm (or with units) for prismatic families, deg (or with units) for
-    rotary ones."""
-    parts = _parse_csv(text, "--actuators", 6)
+    """``"q1,…,qL"``, one value per declared actuator: mm (or with units) for prismatic
+    families, deg (or with units) for rotary ones."""
+    parts = _parse_csv(text, "--actuators", mech.n_actuators)
     parse = parse_angle if mech.actuator_unit == "rad" else parse_length
     try:
         return np.array([parse(p, f"--actuators[{i}]") for i, p in enumerate(parts)])

@@ -112,8 +112,9 @@ def mech_status(code: int) -> str:
 
 @app.command()
 def fk(mech_file: MechArg,
-       actuators: Annotated[str, typer.Option(help='Actuator values "q1,…,q6" in mm, or in '
-                                              'deg for rotary families (rss6).')],
+       actuators: Annotated[str, typer.Option(help='Actuator values "q1,…,q6" (one per '
+                                              'actuator of the family) in mm, or in deg for '
+                                              'rotary families (rss6).')],
        all_modes: Annotated[bool, typer.Option("--all", help="List every assembly mode found "
                                                "by the multi-start search.")] = False,
        guess: Annotated[str | None, typer.Option(help='Start pose "x,y,z,θx,θy,θz" (mm, deg); '

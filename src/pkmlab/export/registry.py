@@ -2,7 +2,7 @@
 
 An :class:`Exporter` names its format (the file suffix), the kind of subject it writes
 (``"mesh"``: a triangle mesh in mm, such as a workspace hull), a one-line description with its
-units (shown in ``--help``, the report's file table and ``pkmlab formats``), the options it
+units (shown in ``--help`` and the report's file table), the options it
 understands and its writer, which returns the file's bytes. :data:`EXPORTERS` holds them in
 registration order; the built-in ones (:mod:`.meshes`) register exactly as a plugin's do,
 through :func:`register_exporter` or the entry point group :data:`PLUGIN_GROUP`.
