@@ -241,7 +241,7 @@ def _sweep_general(J, L, fmax, kup, force, det, mobility) -> None:
     (:func:`pkmlab.dexterity.condition_number`, ``L`` as there: ``None`` for a translational
     J), ``force`` :func:`pkmlab.dexterity.max_force_all_directions` (the columns that translate
     from ``mobility``) and ``det`` from ``numpy.linalg.det``; not finite: inf, NaN, NaN."""
-    from .force import max_force_all_directions     # both import this module
+    from .force import max_force_all_directions  # both import this module
     from .metrics import condition_number
 
     J = np.asarray(J, dtype=float)

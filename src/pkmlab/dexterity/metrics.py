@@ -248,7 +248,7 @@ def manipulability(J: np.ndarray, mobility=None) -> tuple[np.ndarray, np.ndarray
         singular (:func:`is_singular` with ``L = 1 mm``: the ellipsoid is unbounded — in the
         rare case that its unbounded axis is purely rotational, ``w_t`` is in truth finite).
     """
-    from .force import block_columns          # force imports this module
+    from .force import block_columns  # force imports this module
 
     J = _as_jacobian(J)
     lead = J.shape[:-2]
