@@ -127,6 +127,9 @@ def test_dexterity_report_on_the_tripod(tripod):
     assert nom["kappa"] == pytest.approx(np.linalg.cond(_unit_rows(tripod.nominal_pose[:3])),
                                          rel=1e-12)
     assert nom["moment_all_directions_Nmm"] is None and nom["manipulability_rotational"] is None
+    from pkmlab.cli.common import _kappa_text
+
+    assert _kappa_text(nom).startswith("κ = 2.067 (no characteristic length")
     agg = rep.data["aggregates"]
     assert agg["workspace_volume_cm3"] == pytest.approx(75032.0)
     assert agg["worst_case"]["status"] == "ok" and agg["kappa"]["singular_samples"] == 0
@@ -177,7 +180,6 @@ def test_a_small_study_with_workspace_and_dexterity_validates_and_runs(tripod, t
      "rotations"),
     ({"dexterity": {"characteristic_length": "100 mm"}},
      "evaluate.dexterity.characteristic_length.*: must be 'auto' for a mechanism without"),
-    ({"orientation_capability": {}}, "evaluate.orientation_capability"),
 ])
 def test_blocks_a_translational_mechanism_cannot_serve_are_refused_naming_the_field(
         tripod, tmp_path, evaluate, field):
