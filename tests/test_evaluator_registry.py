@@ -117,7 +117,9 @@ def test_validate_refuses_what_a_translational_family_cannot_serve(tri3_family, 
               r"needs rotations \(a free orientation coordinate\); family 'tri3' has "
               r"translational mobility \(x, y, z\)\); got True"),
              ({"trajectory": {}}, "paper_motion_fits", "trajectory", "needs rotations"),
-             ({"workspace": ws}, "constant_volume", "workspace",
+             ({"workspace": {"kind": "dexterous", "box": [5, 5, 5], "resolution": "10 mm"}},
+              "dexterous_volume", "workspace", "needs rotations"),
+             ({"workspace": ws, "volume_bracket": {}}, "constant_volume", "volume_bracket",
               "needs six free pose coordinates"),
              ({"motions": [{"name": "p", "paper": True}]}, "motions_feasible", "motions",
               "needs six free pose coordinates")]
@@ -131,18 +133,30 @@ def test_validate_refuses_what_a_translational_family_cannot_serve(tri3_family, 
         assert r.exit_code == 2 and f"evaluate.{block} (study.yaml" in r.stderr, r.output
 
 
-def test_what_validates_for_a_translational_family_runs(tri3_family, tmp_path):
-    path = write(tmp_path, tri3_study(tmp_path, {}, "base_outer_radius"))
+@pytest.mark.parametrize("evaluate, objective", [
+    ({}, "base_outer_radius"),
+    # a constant workspace and dexterity (refused before: "needs six free pose coordinates")
+    ({"workspace": {"kind": "constant", "resolution": "20 mm"},
+      "dexterity": {"gci_samples": 200}}, "worst_kappa")])
+def test_what_validates_for_a_translational_family_runs(tri3_family, tmp_path, evaluate,
+                                                        objective):
+    data = tri3_study(tmp_path, evaluate, objective)
+    if evaluate:
+        data["optimizer"]["samples"] = 2
+    path = write(tmp_path, data)
     runner = CliRunner()
     r = runner.invoke(app, ["validate", str(path), "--check-space", "0"])
     assert r.exit_code == 0, r.output
     r = runner.invoke(app, ["run", str(path)])
     assert r.exit_code == 0, r.output
     rows = Store(tmp_path / "out" / "evaluations.sqlite", read_only=True).all()
-    assert len(rows) == 5 and {row["status"] for row in rows} == {"ok"}
+    assert len(rows) == (3 if evaluate else 5) and {row["status"] for row in rows} == {"ok"}
     for row in rows:      # the base joints lie on a 300 mm circle in the base plane
         assert row["metrics"]["base_outer_radius"] == pytest.approx(300.0, abs=1e-9)
         assert row["metrics"]["servo_range"] is None
+        if evaluate:      # κ of the unit leg directions, no characteristic length
+            assert row["metrics"]["worst_kappa"] > row["metrics"]["nominal_kappa"] >= 1.0
+            assert row["metrics"]["characteristic_length"] is None
 
 
 def test_an_actuator_of_the_wrong_kind_is_refused_at_load(tmp_path):

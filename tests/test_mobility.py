@@ -128,32 +128,7 @@ def test_mobility_declarations():
         TRANSLATIONAL.full(np.zeros((2, 4)), np.zeros(6))
 
 
-def test_analyses_that_assume_six_coordinates_refuse_a_lower_mobility_clearly(tripod, tmp_path):
-    """Until workspaces, dexterity and studies size themselves from the mobility, they refuse
-    it with one named error (a shape error or garbage before)."""
-    import pkmlab
-    from pkmlab.dexterity.report import dexterity_report
-    from pkmlab.errors import ParameterError
-    from pkmlab.study import study_from_mapping
-
-    with pytest.raises(ParameterError, match="mechanism: must be a mechanism with six free "
-                       r"pose coordinates for workspaces .*translational mobility \(x, y, z\)"):
-        pkmlab.workspace(tripod, "constant", resolution=10.0)
-    with pytest.raises(ParameterError, match="for dexterity"):
-        dexterity_report(tripod, {"kind": "constant", "resolution": 10.0})
-    study = {"study": "tri3", "seed": 1, "output": str(tmp_path / "out"),
-             "mechanism": {"inline": {"family": "tri3",
-                                      "base_points": tri3.circle(300.0).tolist(),
-                                      "platform_points": tri3.circle(60.0).tolist(),
-                                      "stroke": [250, 600]}},
-             "design": {"stroke_max": {"low": "500 mm", "high": "650 mm",
-                                       "path": "stroke[1]", "quantity": "length"}},
-             "evaluate": {"workspace": {"kind": "constant", "resolution": "10 mm"}},
-             "objectives": [{"maximize": "constant_volume"}],
-             "optimizer": {"method": "sobol", "samples": 4}}
-    with pytest.raises(ParameterError, match=r"evaluate.workspace: must be a block this "
-                       r"mechanism can serve \(workspace needs six free pose coordinates"):
-        study_from_mapping(study, tmp_path)
+# the workspace, dexterity and study layers on this family: tests/test_low_mobility.py
 
 
 def test_the_fk_mode_check_moves_the_free_coordinates_only(tripod):

@@ -139,6 +139,8 @@ def _kappa_text(rep: dict) -> str:
     """One line: κ with its characteristic length and status (from a pose report)."""
     cl = rep["characteristic_length"]
     k = "inf (singular)" if rep["kappa"] is None else f"{rep['kappa']:.4g}"
+    if cl["length_mm"] is None:             # no rotational column: κ of J itself
+        return f"κ = {k} (no characteristic length: {cl['source']})"
     return (f"κ = {k} (Jacobian homogenised with L = {cl['length_mm']:.2f} mm, "
             f"{cl['status']})")
 

@@ -46,16 +46,36 @@ __all__ = ["ForceAlong", "max_force_all_directions", "max_moment_all_directions"
            "force_along", "force_along_closed_form", "transpose_inverse"]
 
 
-def _jac(J, square: bool = True) -> np.ndarray:
+def _jac(J, square: bool = True, any_width: bool = False) -> np.ndarray:
     J = np.asarray(J, dtype=float)
     if J.ndim == 2:
         J = J[None]
-    ok = J.ndim == 3 and J.shape[-1] == 6 and (J.shape[-2] == 6 if square else
-                                                 J.shape[-2] >= 6)
+    w = J.shape[-1] if any_width and J.ndim == 3 and 1 <= J.shape[-1] <= 6 else 6
+    ok = J.ndim == 3 and J.shape[-1] == w and (J.shape[-2] == w if square else
+                                                 J.shape[-2] >= w)
     if not ok:
         what = "(6, 6) or (N, 6, 6)" if square else "(m, 6) or (N, m, 6) with m >= 6"
         raise ParameterError("J", f"an array of shape {what}", J.shape)
     return J
+
+
+def block_columns(J: np.ndarray, mobility=None, rotational: bool = False):
+    """The columns of ``J`` that act on the platform's translation (or rotation): 0:3 (3:6) of
+    a six-column J; for a lower mobility (``mobility``, :mod:`pkmlab.mechanisms.mobility`) the
+    positions of its free twist columns below (at and above) 3. A J of another width without
+    its mobility is refused."""
+    if mobility is None:
+        if J.shape[-1] != 6:
+            raise ParameterError("mobility", f"the mechanism's mobility for a {J.shape[-1]}-"
+                                 "column Jacobian (which columns translate)", None)
+        return slice(3, 6) if rotational else slice(0, 3)
+    tc = np.asarray(mobility.twist_columns)
+    if len(tc) != J.shape[-1]:
+        raise ParameterError("mobility", f"a mobility with {J.shape[-1]} free coordinates",
+                             f"{mobility.name} ({len(tc)})")
+    if len(tc) == 6:
+        return slice(3, 6) if rotational else slice(0, 3)
+    return np.nonzero(tc >= 3 if rotational else tc < 3)[0]
 
 
 def _fmax(f_max, m: int) -> np.ndarray:
@@ -94,7 +114,7 @@ def transpose_inverse(J: np.ndarray, L: float | None = None
     """``G = J⁻ᵀ`` for a stack of square Jacobians, with masks.
 
     Args:
-        J: ``(N, 6, 6)`` twist-to-joint Jacobians.
+        J: ``(N, 6, 6)`` twist-to-joint Jacobians (or ``(N, w, w)``, a lower mobility's).
         L: characteristic length (mm) of the singular rule; ``None``: ``J`` as given.
 
     Returns:
@@ -102,7 +122,7 @@ def transpose_inverse(J: np.ndarray, L: float | None = None
         every entry of ``J`` finite, ``singular (N,)`` finite but singular by
         :func:`pkmlab.dexterity.is_singular`.
     """
-    J = _jac(J)
+    J = _jac(J, any_width=True)
     finite = np.all(np.isfinite(J), axis=(1, 2))
     singular = finite & is_singular(J, L)
     G = np.full(J.shape, np.nan)
@@ -112,9 +132,14 @@ def transpose_inverse(J: np.ndarray, L: float | None = None
     return G, finite, singular
 
 
-def _isotropic(J, f_max, cols: slice, L) -> np.ndarray:
+def _isotropic(J, f_max, rotational: bool, L, mobility=None) -> np.ndarray:
     G, finite, singular = transpose_inverse(J, L)
-    f = _fmax(f_max, 6)
+    cols = block_columns(G, mobility, rotational)
+    if not isinstance(cols, slice) and len(cols) == 0:
+        raise ParameterError("mobility", "a mechanism with a free "
+                             f"{'rotation' if rotational else 'translation'}",
+                             getattr(mobility, "name", None))
+    f = _fmax(f_max, G.shape[-2])
     norm = np.linalg.norm(G[:, :, cols], axis=-1)                      # (N, 6)
     with np.errstate(divide="ignore", invalid="ignore"):
         cap = np.min(np.where(norm > 0, f / norm, np.inf), axis=1)
@@ -122,32 +147,38 @@ def _isotropic(J, f_max, cols: slice, L) -> np.ndarray:
     return np.where(finite, cap, np.nan)
 
 
-def max_force_all_directions(J: np.ndarray, f_max, L: float | None = None) -> np.ndarray:
+def max_force_all_directions(J: np.ndarray, f_max, L: float | None = None,
+                             mobility=None) -> np.ndarray:
     """Largest force magnitude (N) that can be held in *every* direction with zero moment.
 
     ``F_iso = min_i f_max_i / ‖(J⁻ᵀ)_{i,0:3}‖`` (exact for a square invertible J; see the
     module docstring).
 
     Args:
-        J: ``(6, 6)`` or ``(N, 6, 6)`` twist-to-joint Jacobian.
-        f_max: actuator force limit(s) in N, scalar or ``(6,)``.
+        J: ``(6, 6)`` or ``(N, 6, 6)`` twist-to-joint Jacobian, or ``(N, w, w)`` over a lower
+            mobility's free twist columns (then ``mobility`` says which translate: a
+            translational mechanism's wrench is a force only, ``G`` is 3 × 3).
+        f_max: actuator force limit(s) in N, scalar or one per actuator.
         L: characteristic length (mm) of the singular rule; ``None``: ``J`` as given.
+        mobility: the mechanism's :class:`~pkmlab.mechanisms.Mobility` (needed unless J has
+            six columns).
 
     Returns:
         ``(N,)`` force in N; 0 where J is singular (a parallel singularity leaves some wrench
         unbalanced — reported conservatively as no capability); NaN exactly where J has a
         non-finite entry.
     """
-    return _isotropic(J, f_max, slice(0, 3), L)
+    return _isotropic(J, f_max, False, L, mobility)
 
 
-def max_moment_all_directions(J: np.ndarray, f_max, L: float | None = None) -> np.ndarray:
+def max_moment_all_directions(J: np.ndarray, f_max, L: float | None = None,
+                              mobility=None) -> np.ndarray:
     """Largest moment magnitude (N·mm) that can be held about every axis with zero force.
 
     ``M_iso = min_i f_max_i / ‖(J⁻ᵀ)_{i,3:6}‖``; conventions as
     :func:`max_force_all_directions`.
     """
-    return _isotropic(J, f_max, slice(3, 6), L)
+    return _isotropic(J, f_max, True, L, mobility)
 
 
 @dataclass(frozen=True)

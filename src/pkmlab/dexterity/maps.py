@@ -118,7 +118,7 @@ def metric_map(mech, result, metric: str = "kappa",
             val = np.broadcast_to(kmax if metric == "kappa" else 1.0 / kmax, (n, U))
         else:
             J = mech.jacobian((np.tile(unit_pos, (n, 1)), np.repeat(R[m0:m0 + n], U, axis=0)))
-            val = _unit_metric(metric, J, L, f_max, k)
+            val = _unit_metric(metric, J, L, f_max, k, mech.mobility)
         val = np.where(_ik_valid(mech, p, Rr).reshape(n, V),
                        np.reshape(val, (n, U))[:, voxel_unit], bad)
         worst = np.maximum(worst, val.max(axis=0)) if worse_is_larger else \
@@ -130,14 +130,14 @@ def metric_map(mech, result, metric: str = "kappa",
     return MetricMap(metric, worst, idx, pos, grid, length)
 
 
-def _unit_metric(metric: str, J, L, f_max, k) -> np.ndarray:
+def _unit_metric(metric: str, J, L, f_max, k, mobility=None) -> np.ndarray:
     """The force or stiffness metric of every Jacobian (0 where J is not finite)."""
     if metric == "force":
-        return np.nan_to_num(max_force_all_directions(J, f_max, L))
+        return np.nan_to_num(max_force_all_directions(J, f_max, L, mobility))
     ok = np.all(np.isfinite(J), axis=(1, 2))
     val = np.zeros(len(J))
     if ok.any():
-        val[ok] = stiffness(J[ok], k).translational_min
+        val[ok] = stiffness(J[ok], k, mobility).translational_min
     return val
 
 
@@ -152,7 +152,7 @@ def _unit_kappa_max(mech, unit_pos, R, L) -> np.ndarray:
     if U == 0 or M == 0:
         return np.full(U, -np.inf)
     up = np.empty((M, U))
-    ones = np.ones(6)
+    ones = np.ones(mech.n_actuators)
     step = max(1, _CHUNK // max(U, 1))
     for m0 in range(0, M, step):
         Rm = R[m0:m0 + step]
@@ -160,7 +160,7 @@ def _unit_kappa_max(mech, unit_pos, R, L) -> np.ndarray:
         J = np.ascontiguousarray(mech.jacobian((np.tile(unit_pos, (n, 1)),
                                                 np.repeat(Rm, U, axis=0))))
         kup, force, det = (np.empty(n * U) for _ in range(3))
-        sweep_bounds(J, L, ones, kup, force, det)
+        sweep_bounds(J, L, ones, kup, force, det, mech.mobility)
         up[m0:m0 + n] = kup.reshape(n, U)
     up = kappa_upper(up)
     kmax = condition_number(mech.jacobian((unit_pos, R[np.argmax(up, axis=0)])), L)

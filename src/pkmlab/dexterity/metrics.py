@@ -37,6 +37,7 @@ Definitions used everywhere in pkmlab (there is no second copy anywhere else):
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 from dataclasses import dataclass
@@ -65,6 +66,7 @@ __all__ = [
     "characteristic_length",
     "resolve_length",
     "joint_radius",
+    "rotational_columns",
     "LENGTH_STATUS",
 ]
 
@@ -77,9 +79,36 @@ KAPPA_SINGULAR = 1.0 / SINGULAR_RTOL
 
 def _as_jacobian(J) -> np.ndarray:
     J = np.asarray(J, dtype=float)
-    if J.ndim < 2 or J.shape[-2:] != (6, 6):
-        raise ParameterError("J", "an array of shape (6, 6) or (..., 6, 6)", J.shape)
+    if J.ndim < 2 or not (1 <= J.shape[-1] <= 6 and J.shape[-2] >= J.shape[-1]):
+        raise ParameterError("J", "an array of shape (6, 6) or (..., 6, 6), or (..., n, w) "
+                             "with 1 <= w <= 6 and w <= n (a lower mobility's free twist "
+                             "columns)", J.shape)
     return J
+
+
+def rotational_columns(mobility) -> tuple[int, ...]:
+    """Positions, among a mechanism's Jacobian columns (its free twist components,
+    :attr:`pkmlab.mechanisms.Mobility.twist_columns`), of the rotational ones (ω): ``(3, 4, 5)``
+    for a spatial mechanism, ``()`` for a translational one, ``(2,)`` for a planar one."""
+    return tuple(int(i) for i, c in enumerate(mobility.twist_columns) if c >= 3)
+
+
+def _rotational(J: np.ndarray, L, rotational=None) -> tuple[tuple[int, ...], float | None]:
+    """The columns to homogenise and the length: ``L`` a length in mm, ``None`` (J as given)
+    or a :class:`CharacteristicLength` (its own ``rotational`` columns). A bare length needs
+    ``rotational`` unless J is six columns wide (columns 3:6)."""
+    if isinstance(L, CharacteristicLength):
+        rotational = L.rotational if rotational is None else rotational
+        L = L.length
+    if L is None:
+        return (), None
+    if rotational is None:
+        if J.shape[-1] != 6:
+            raise ParameterError("L", "None or a CharacteristicLength (whose rotational columns "
+                                 f"say what to homogenise) for a {J.shape[-1]}-column Jacobian",
+                                 L)
+        rotational = (3, 4, 5)
+    return tuple(rotational), (_as_length(L) if rotational else None)
 
 
 def _as_length(L) -> float:
@@ -110,23 +139,33 @@ def joint_radius(mech) -> float:
     return float(np.linalg.norm(mech.tool_points, axis=1).mean())
 
 
-def homogenised_jacobian(J: np.ndarray, L: float) -> np.ndarray:
+def homogenised_jacobian(J: np.ndarray, L, rotational=None) -> np.ndarray:
     """Dimensionally homogeneous Jacobian ``J_h = J · diag(1, 1, 1, 1/L, 1/L, 1/L)``.
 
     Args:
-        J: ``(..., 6, 6)`` twist-to-joint Jacobian (columns 3:6 in mm/rad).
-        L: characteristic length in mm (> 0).
+        J: ``(..., 6, 6)`` twist-to-joint Jacobian (columns 3:6 in mm/rad), or ``(..., n, w)``
+            over a lower mobility's free twist columns.
+        L: characteristic length in mm (> 0), or a :class:`CharacteristicLength` (which names
+            its rotational columns), or ``None`` (no homogenisation: a purely translational
+            Jacobian needs none).
+        rotational: the rotational columns of ``J`` (:func:`rotational_columns`); default
+            3:6 of a six-column J, else those of the ``CharacteristicLength``.
 
     Returns:
-        ``(..., 6, 6)`` new array, all entries dimensionless (q̇ in mm/s per mm/s of
+        ``(..., n, w)`` new array, all entries dimensionless (q̇ in mm/s per mm/s of
         ``[v; L·ω]``). Non-finite entries stay non-finite.
     """
-    Jh = _as_jacobian(J).copy()
-    Jh[..., 3:] /= _as_length(L)
+    J = _as_jacobian(J)
+    cols, val = _rotational(J, L, rotational)
+    Jh = J.copy()
+    if cols == (3, 4, 5) and J.shape[-1] == 6:
+        Jh[..., 3:] /= val
+    elif cols:
+        Jh[..., list(cols)] /= val
     return Jh
 
 
-def _sv(J: np.ndarray, L: float | None) -> np.ndarray:
+def _sv(J: np.ndarray, L) -> np.ndarray:
     J = _as_jacobian(J)
     return singular_values(J if L is None else homogenised_jacobian(J, L))
 
@@ -139,12 +178,14 @@ def _kappa_from_sv(s: np.ndarray) -> np.ndarray:
     return np.where(np.isfinite(smax) & (smin > SINGULAR_RTOL * smax), k, np.inf)
 
 
-def condition_number(J: np.ndarray, L: float) -> np.ndarray:
+def condition_number(J: np.ndarray, L) -> np.ndarray:
     """2-norm condition number κ = σmax / σmin of the homogenised Jacobian.
 
     Args:
-        J: ``(..., 6, 6)`` twist-to-joint Jacobian.
-        L: characteristic length in mm.
+        J: ``(..., 6, 6)`` twist-to-joint Jacobian, or ``(..., n, w)`` over a lower mobility's
+            free twist columns.
+        L: characteristic length in mm, a :class:`CharacteristicLength`, or ``None``: κ of
+            ``J`` as given (a purely translational J: σmax/σmin of J itself).
 
     Returns:
         ``(...,)`` κ ≥ 1; ``inf`` exactly where the pose is singular (:func:`is_singular`: a
@@ -164,7 +205,8 @@ def is_singular(J: np.ndarray, L: float | None = None) -> np.ndarray:
         L: characteristic length in mm; ``None`` applies the rule to ``J`` as given
             (``L = 1 mm``).
     """
-    return ~np.isfinite(condition_number(J, 1.0 if L is None else L))
+    J = _as_jacobian(J)
+    return ~np.isfinite(condition_number(J, 1.0 if L is None and J.shape[-1] == 6 else L))
 
 
 def lci(J: np.ndarray, L: float) -> np.ndarray:
@@ -182,7 +224,7 @@ def smallest_singular_value(J: np.ndarray, L: float) -> np.ndarray:
     return _sv(J, L)[..., -1]
 
 
-def manipulability(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def manipulability(J: np.ndarray, mobility=None) -> tuple[np.ndarray, np.ndarray]:
     """Yoshikawa manipulability of the translational and rotational velocity ellipsoids.
 
     With the twist-to-joint map ``q̇ = J t``, the twists reachable with ``‖q̇‖ ≤ 1`` form the
@@ -196,7 +238,9 @@ def manipulability(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     ``J = U S Vᵀ`` as ``A A ᵀ = V_b S⁻² V_bᵀ`` (``V_b`` the rows of V for the block).
 
     Args:
-        J: ``(..., 6, 6)`` twist-to-joint Jacobian.
+        J: ``(..., 6, 6)`` twist-to-joint Jacobian, or a square ``(..., w, w)`` one over a
+            lower mobility's free twist columns (then pass ``mobility``; ``w_r`` is NaN
+            without a free rotation).
 
     Returns:
         ``(w_t, w_r)``, each ``(...,)``. ``w_t`` is dimensionless ((mm/s)³ per (mm/s)³), ``w_r``
@@ -204,19 +248,25 @@ def manipulability(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         singular (:func:`is_singular` with ``L = 1 mm``: the ellipsoid is unbounded — in the
         rare case that its unbounded axis is purely rotational, ``w_t`` is in truth finite).
     """
+    from .force import block_columns  # force imports this module
+
     J = _as_jacobian(J)
     lead = J.shape[:-2]
-    flat = J.reshape(-1, 6, 6)
+    flat = J.reshape((-1,) + J.shape[-2:])
+    blocks = (block_columns(J, mobility), block_columns(J, mobility, rotational=True))
     ok = np.all(np.isfinite(flat), axis=(1, 2))
     wt = np.full(flat.shape[0], np.nan)
     wr = np.full(flat.shape[0], np.nan)
     if np.any(ok):
         _, s, Vh = np.linalg.svd(flat[ok])
         sing = ~np.isfinite(_kappa_from_sv(s))                    # the rule at L = 1 mm
-        inv2 = 1.0 / np.where(sing[:, None], 1.0, s) ** 2        # (n, 6)
+        inv2 = 1.0 / np.where(sing[:, None], 1.0, s) ** 2        # (n, w)
         V = np.swapaxes(Vh, -1, -2)                               # columns = right sing. vectors
         out = []
-        for rows in (slice(0, 3), slice(3, 6)):
+        for rows in blocks:
+            if not isinstance(rows, slice) and len(rows) == 0:
+                out.append(np.full(len(s), np.nan))
+                continue
             Vb = V[:, rows, :]                                    # (n, 3, 6)
             M = np.einsum("nik,nk,njk->nij", Vb, inv2, Vb)
             w = np.sqrt(np.clip(np.linalg.det(M), 0.0, None))
@@ -232,6 +282,7 @@ LENGTH_STATUS = {
     "given": "given by the caller",
     "fallback": "Angeles' length undefined: mean platform joint radius used instead",
     "failed": "Angeles' length undefined",
+    "not-applicable": "no rotational Jacobian column: κ of J itself, no characteristic length",
 }
 
 
@@ -240,7 +291,9 @@ class CharacteristicLength:
     """A characteristic length and why it is what it is; unpacks as ``L, kappa = ...``.
 
     Attributes:
-        length: L in mm; NaN only when ``status == "failed"``.
+        length: L in mm; NaN only when ``status == "failed"``; ``None`` when
+            ``status == "not-applicable"`` (a purely translational mechanism: its Jacobian has
+            no rotational column, κ is that of J itself).
         kappa: κ of ``J_h`` at that L at the pose it was determined for (the nominal pose by
             default); ``inf`` where the Jacobian is singular there.
         ok: Angeles' optimisation succeeded (``status`` is ``"angeles"`` or
@@ -251,14 +304,17 @@ class CharacteristicLength:
             ``"given"``, ``"fallback"`` (:func:`resolve_length` only) or ``"failed"``
             (:func:`characteristic_length` only).
         reason: one sentence on how L was obtained, or why Angeles' length failed.
+        rotational: the Jacobian columns L divides (:func:`rotational_columns` of the
+            mechanism's mobility); ``None``: columns 3:6 of a six-column Jacobian.
     """
 
-    length: float
+    length: float | None
     kappa: float
     ok: bool
     at_bound: bool
     status: str = "angeles"
     reason: str = ""
+    rotational: tuple[int, ...] | None = None
 
     def __iter__(self):
         return iter((self.length, self.kappa))
@@ -272,7 +328,7 @@ class CharacteristicLength:
         """JSON-ready record: ``length_mm``, ``status``, ``source``, ``reason``,
         ``kappa_at_pose`` (``None`` where not finite)."""
         def fin(v):
-            return float(v) if math.isfinite(v) else None
+            return float(v) if v is not None and math.isfinite(v) else None
 
         return {"length_mm": fin(self.length), "status": self.status, "source": self.source,
                 "reason": self.reason, "kappa_at_pose": fin(self.kappa)}
@@ -301,6 +357,10 @@ def characteristic_length(mech, pose=None) -> CharacteristicLength:
         raise ParameterError("pose", "a single pose, shape (6,) or (4, 4)", np.shape(X))
     where = "the nominal pose" if pose is None else f"pose {np.round(np.asarray(X), 6)}"
     J = mech.jacobian((p, R))[0]
+    rot = rotational_columns(mech.mobility)
+    if not rot:
+        return _not_applicable(mech, J, where)
+    spatial = rot == (3, 4, 5) and J.shape[-1] == 6
     r = joint_radius(mech)
     if not np.all(np.isfinite(J)):
         reason = (f"the Jacobian is undefined at {where} (a leg has no real solution or is at "
@@ -309,8 +369,11 @@ def characteristic_length(mech, pose=None) -> CharacteristicLength:
         return CharacteristicLength(float("nan"), float("inf"), False, False, "failed", reason)
     lo, hi = math.log(1e-3 * r), math.log(1e3 * r)
     grid = np.linspace(lo, hi, 121)
-    Js = np.broadcast_to(J, (len(grid), 6, 6)).copy()
-    Js[..., 3:] /= np.exp(grid)[:, None, None]
+    Js = np.broadcast_to(J, (len(grid),) + J.shape).copy()
+    if spatial:
+        Js[..., 3:] /= np.exp(grid)[:, None, None]
+    else:
+        Js[..., list(rot)] /= np.exp(grid)[:, None, None]
     kap = _kappa_from_sv(singular_values(Js))
     if not np.any(np.isfinite(kap)):
         reason = (f"the Jacobian is singular at {where} for every L in [1e-3, 1e3] × "
@@ -321,7 +384,10 @@ def characteristic_length(mech, pose=None) -> CharacteristicLength:
 
     def f(logL: float) -> float:
         Jh = J.copy()
-        Jh[:, 3:] /= math.exp(logL)
+        if spatial:
+            Jh[:, 3:] /= math.exp(logL)
+        else:
+            Jh[:, list(rot)] /= math.exp(logL)
         return float(_kappa_from_sv(singular_values(Jh)))
 
     a, b = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
@@ -337,10 +403,22 @@ def characteristic_length(mech, pose=None) -> CharacteristicLength:
         reason = (f"κ at {where} is smallest on the edge of the search bracket [1e-3, 1e3] × "
                   f"{r:.4g} mm (L = {L:.6g} mm, κ = {val:.6g}); the optimum may lie outside")
         log.warning("characteristic_length: %s", reason)
-        return CharacteristicLength(L, val, True, True, "angeles-at-bound", reason)
+        return CharacteristicLength(L, val, True, True, "angeles-at-bound", reason,
+                                    None if spatial else rot)
     return CharacteristicLength(L, val, True, False, "angeles",
                                 f"Angeles: L = {L:.6g} mm minimises κ at {where} "
-                                f"(κ = {val:.6g})")
+                                f"(κ = {val:.6g})", None if spatial else rot)
+
+
+def _not_applicable(mech, J, where) -> CharacteristicLength:
+    """The record of a mechanism whose Jacobian has no rotational column."""
+    mob = mech.mobility
+    kappa = float(condition_number(J, None)) if J.ndim == 2 else float("inf")
+    return CharacteristicLength(
+        None, kappa, False, False, "not-applicable",
+        f"{mob.name} mobility ({', '.join(mob.coordinates)}): the Jacobian has no rotational "
+        f"column, so κ = σmax/σmin of J itself needs no characteristic length (κ = "
+        f"{kappa:.6g} at {where})", ())
 
 
 def resolve_length(mech, L=None) -> CharacteristicLength:
@@ -355,16 +433,28 @@ def resolve_length(mech, L=None) -> CharacteristicLength:
         :class:`CharacteristicLength`: status ``"given"`` for a given length; ``"angeles"``
         or ``"angeles-at-bound"`` for the default; ``"fallback"`` when Angeles' length fails:
         L is then :func:`joint_radius` and ``reason`` says why Angeles' failed. Never NaN.
+        ``"not-applicable"`` (length ``None``) for a mechanism without a free rotation: κ is
+        that of J itself, whatever ``L`` is given.
     """
     if isinstance(L, CharacteristicLength):
-        if math.isfinite(L.length) and L.length > 0:
+        if L.status == "not-applicable" or math.isfinite(L.length) and L.length > 0:
             return L
         L = None
+    rot = rotational_columns(mech.mobility)
+    if not rot:
+        cl = _not_applicable(mech, mech.jacobian(mech.nominal_pose)[0], "the nominal pose")
+        if L is None:
+            return cl
+        return dataclasses.replace(cl, reason=f"{cl.reason}; the given L = {_as_length(L):.6g} "
+                                   "mm is not used")
+    spatial = rot == (3, 4, 5)
     if L is not None:
         val = _as_length(L)
         J = mech.jacobian(mech.nominal_pose)
-        return CharacteristicLength(val, float(condition_number(J, val)[0]), False, False,
-                                    "given", f"L = {val:.6g} mm given by the caller")
+        cols = None if spatial else rot
+        k = condition_number(J, CharacteristicLength(val, 0.0, False, False, rotational=cols))
+        return CharacteristicLength(val, float(k[0]), False, False, "given",
+                                    f"L = {val:.6g} mm given by the caller", cols)
     cl = characteristic_length(mech)
     if cl.ok:
         return cl
@@ -373,6 +463,7 @@ def resolve_length(mech, L=None) -> CharacteristicLength:
     reason = (f"Angeles' length failed ({cl.reason}); using the mean platform joint radius "
               f"about the tool point, {r:.6g} mm")
     log.warning("resolve_length: %s", reason)
-    return CharacteristicLength(r, float(condition_number(J, r)[0]), False, False, "fallback",
-                                reason)
+    cols = None if spatial else rot
+    k = condition_number(J, CharacteristicLength(r, 0.0, False, False, rotational=cols))
+    return CharacteristicLength(r, float(k[0]), False, False, "fallback", reason, cols)
 

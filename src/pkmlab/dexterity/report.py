@@ -19,7 +19,6 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..mechanisms import LEG_STATUS
-from ..mechanisms.mobility import require_spatial
 from ..workspaces import workspace
 from .aggregate import (
     gci_grid,
@@ -87,18 +86,20 @@ def pose_report(mech, pose, *, L: float | CharacteristicLength | None = None,
         "characteristic_length": length.as_dict(),
         "kappa": _fin(condition_number(J, length)[0]),
         "lci": float(1.0 / condition_number(J, length)[0]),
-        "sigma_min": _fin(smallest_singular_value(J, length.length)[0]),
+        "sigma_min": _fin(smallest_singular_value(J, length)[0]),
         "singular": bool(is_singular(J, length)[0]),
         "singularity": str(singularity_flags(mech, X, L=length).kind[0]),
     }
+    mob = mech.mobility
     if force_limit is not None:
-        out["force_all_directions_N"] = _fin(max_force_all_directions(J, force_limit,
-                                                                      length.length)[0])
-        out["moment_all_directions_Nmm"] = _fin(max_moment_all_directions(J, force_limit,
-                                                                          length.length)[0])
+        out["force_all_directions_N"] = _fin(max_force_all_directions(
+            J, force_limit, length.length, mob)[0])
+        # no free rotation: the platform carries no moment through the actuators (None)
+        out["moment_all_directions_Nmm"] = _fin(max_moment_all_directions(
+            J, force_limit, length.length, mob)[0]) if mob.rotations else None
     if actuator_stiffness is not None:
-        wt, wr = manipulability(J)
-        st = stiffness(J, actuator_stiffness)
+        wt, wr = manipulability(J, mob)
+        st = stiffness(J, actuator_stiffness, mob)
         out.update({
             "manipulability_translational": _fin(wt[0]),
             "manipulability_rotational": _fin(wr[0]),
@@ -165,7 +166,6 @@ def dexterity_report(mech, request: dict, *, L: float | CharacteristicLength | N
         standard error), :func:`pkmlab.dexterity.worst_case` (worst κ, smallest force,
         singular pose inside), the well-conditioned and force-capable volumes.
     """
-    require_spatial(mech, "dexterity")
     if metric not in METRICS:
         raise ParameterError("metric", f"one of {list(METRICS)}", metric)
     if not (math.isfinite(well_conditioned) and well_conditioned >= 1):

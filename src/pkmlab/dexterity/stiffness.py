@@ -19,6 +19,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import ParameterError
+from .force import block_columns
 from .metrics import _as_jacobian
 
 __all__ = ["Stiffness", "stiffness"]
@@ -43,29 +44,36 @@ class Stiffness(NamedTuple):
     rotational_min: np.ndarray
 
 
-def stiffness(J: np.ndarray, k) -> Stiffness:
+def stiffness(J: np.ndarray, k, mobility=None) -> Stiffness:
     """Cartesian stiffness ``K = Jᵀ diag(k) J`` and its weakest block eigenvalues.
 
     Args:
         J: ``(..., 6, 6)`` twist-to-joint Jacobian.
-        k: actuator stiffness in N/mm, a scalar or ``(6,)``, all > 0.
+        k: actuator stiffness in N/mm, a scalar or one per actuator, all > 0.
+        mobility: the mechanism's mobility for a J that is not six columns wide (``(..., L,
+            w)``: K is w × w over its free twist columns; ``rotational_min`` NaN without a
+            free rotation).
 
     Returns:
         :class:`Stiffness`. ``K`` is positive definite wherever ``J`` is invertible.
     """
     J = _as_jacobian(J)
+    n = J.shape[-2]
     kk = np.asarray(k, dtype=float)
     if kk.ndim == 0:
-        kk = np.full(6, float(kk))
-    if kk.shape != (6,) or not np.all(np.isfinite(kk)) or np.any(kk <= 0):
-        raise ParameterError("k", "actuator stiffness > 0 N/mm, a scalar or 6 values", k)
+        kk = np.full(n, float(kk))
+    if kk.shape != (n,) or not np.all(np.isfinite(kk)) or np.any(kk <= 0):
+        raise ParameterError("k", f"actuator stiffness > 0 N/mm, a scalar or {n} values", k)
+    tr, rot = block_columns(J, mobility), block_columns(J, mobility, rotational=True)
     K = np.einsum("...ki,k,...kj->...ij", J, kk, J)
     K = 0.5 * (K + np.swapaxes(K, -1, -2))              # exact symmetry despite rounding
     ok = np.all(np.isfinite(J), axis=(-2, -1))
     kt = np.full(ok.shape, np.nan)
     kr = np.full(ok.shape, np.nan)
     if np.any(ok):
-        kt[ok] = np.linalg.eigvalsh(K[ok][:, :3, :3])[:, 0]
-        kr[ok] = np.linalg.eigvalsh(K[ok][:, 3:, 3:])[:, 0]
+        Kok = K[ok]
+        kt[ok] = np.linalg.eigvalsh(Kok[:, tr][:, :, tr])[:, 0]
+        if isinstance(rot, slice) or len(rot):
+            kr[ok] = np.linalg.eigvalsh(Kok[:, rot][:, :, rot])[:, 0]
     K = np.where(ok[..., None, None], K, np.nan)
     return Stiffness(K=K, translational_min=kt, rotational_min=kr)

@@ -125,7 +125,7 @@ class WorstCase:
             kinematics is valid at one of the unit's voxels.
         exact: poses whose κ was computed exactly (the others were bounded below the maximum).
         L: characteristic length used (mm); ``length``: with its status and reason.
-        force_limit: ``(6,)`` actuator force limits (N).
+        force_limit: ``(n_actuators,)`` actuator force limits (N).
         method: one line: what was maximised over, and the singularity tests.
         status: ``"ok"``, ``"empty"`` (nothing to evaluate) or ``"too large"`` (more poses
             than ``max_poses``; nothing evaluated).
@@ -309,7 +309,7 @@ def worst_case(mech, result, L: float | CharacteristicLength | None = None,
         result: a :class:`pkmlab.workspaces.WorkspaceResult`.
         L: characteristic length (mm) for κ; default :func:`pkmlab.dexterity.resolve_length`
             (Angeles'), recorded with its status in ``length``.
-        force_limit: actuator force limit(s) in N, scalar or ``(6,)``.
+        force_limit: actuator force limit(s) in N, scalar or one per actuator.
         max_poses: refuse (``status="too large"``, nothing evaluated) above this many
             Jacobian evaluations.
 
@@ -319,7 +319,7 @@ def worst_case(mech, result, L: float | CharacteristicLength | None = None,
     t0 = time.perf_counter()
     length = resolve_length(mech, L)
     L = length.length
-    fmax = _fmax(force_limit, 6)
+    fmax = _fmax(force_limit, mech.n_actuators)
     idx, pos = _voxels(result)
     Rs = result.orientations.rotations()
     V, M = len(pos), len(Rs)
@@ -458,7 +458,7 @@ def _force_at(mech, unit_pos, Rs, arg, fmax, L):
         return 0.0, np.full(6, np.nan)
     u, m = arg
     f = float(max_force_all_directions(mech.jacobian((unit_pos[u][None], Rs[m][None])), fmax,
-                                       L)[0])
+                                       L, mech.mobility)[0])
     return (f if math.isfinite(f) else 0.0), _pose(unit_pos[u], Rs[m])
 
 
@@ -488,7 +488,7 @@ def _sweep(mech, unit_pos, Rs, feas, L, fmax) -> _Sweep:
         kup = np.empty(k * U)
         force = np.empty(k * U)
         det = np.empty(k * U)
-        sweep_bounds(np.ascontiguousarray(J), L, fmax, kup, force, det)
+        sweep_bounds(np.ascontiguousarray(J), L, fmax, kup, force, det, mech.mobility)
         kup, force, det = (a.reshape(k, U).T for a in (kup, force, det))
         fe = feas[:, m0:m0 + k]
         kup = np.where(fe, kup, -np.inf)

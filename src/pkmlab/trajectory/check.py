@@ -25,6 +25,7 @@ import numpy as np
 from ..dexterity.metrics import CharacteristicLength, condition_number, resolve_length
 from ..errors import ParameterError
 from ..mechanisms.base import LEG_STATUS, Mechanism
+from ..mechanisms.mobility import require_spatial
 from ..poses import as_frames
 from ..tolerances import TOL
 from ._args import limit6 as _limit6
@@ -246,6 +247,7 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
     Raises:
         ParameterError: for malformed inputs (shapes, non-monotonic time, negative mass, ...).
     """
+    require_spatial(mech, "trajectory checks")
     t = np.array(t, dtype=float)
     if t.ndim != 1 or len(t) < 2:
         raise ParameterError("t", "an array of shape (T,) with T >= 2 (s)", t.shape)

@@ -90,6 +90,7 @@ import time
 import numpy as np
 
 from ..errors import ParameterError
+from ..mechanisms.mobility import require_spatial
 from ..poses import as_frames, matrix_to_euler
 from . import cells as oc
 from .bracket_cells import cell_volume_bracket
@@ -197,6 +198,7 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
         max_cells: largest number of (column × orientation cell) items of one step (an
             orientation split that would pass it halves the x-y cells instead).
     """
+    require_spatial(mech, "volume brackets")
     t_call = time.perf_counter()
     mech, oset, cons = _request(mech, kind, orientations, resolution, constraints)
     if mech.cell_bounds:

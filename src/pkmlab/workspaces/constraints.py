@@ -255,7 +255,7 @@ def check(mech, p: np.ndarray, R: np.ndarray, cons: Constraints) -> np.ndarray:
         d = segment_distances(start, end, leg)
         ok &= np.all(d >= cons.link_diameter, axis=1)
     if cons.kappa_max is not None:
-        L = resolve_length(mech, cons.characteristic_length).length
+        L = resolve_length(mech, cons.characteristic_length)      # with its columns
         idx = np.nonzero(ok)[0]
         k = condition_number(mech.jacobian((p[idx], R[idx])), L)
         ok[idx] &= k <= cons.kappa_max

@@ -28,7 +28,6 @@ from ..dexterity.metrics import resolve_length
 from ..errors import ParameterError
 from ..limits import RESOLUTION_MM
 from ..mechanisms import NO_STROKE
-from ..mechanisms.mobility import require_spatial
 from ..memory import coarser_resolution, require
 from ..poses import as_frames, matrix_to_euler
 from ..time_budget import coarser_for_time, require_time, workspace_seconds
@@ -99,8 +98,8 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
         :class:`WorkspaceResult`; an empty workspace is a valid result (``result.empty``).
     """
     t0 = time.perf_counter()
-    require_spatial(mech, "workspaces")
     check_request(kind, resolution)
+    _check_mobility(mech, kind, orientations)
     if method not in ("auto", "columns", "sampled"):
         raise ParameterError("method", "one of ['auto', 'columns', 'sampled']", method)
     cons = (constraints or Constraints()).resolved(mech)
@@ -111,8 +110,8 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
     if cons.kappa_max is not None:
         length = resolve_length(mech, cons.characteristic_length)
         cons = dataclasses.replace(cons, characteristic_length=length.length)
-        notes.append(f"kappa_max: L = {length.length:.6g} mm ({length.status}): "
-                     f"{length.reason}")
+        shown = "none" if length.length is None else f"{length.length:.6g} mm"
+        notes.append(f"kappa_max: L = {shown} ({length.status}): {length.reason}")
     sing = _nominal_singularity(mech)
     if sing:
         notes.append(sing)
@@ -328,15 +327,35 @@ def _voxel_extras(mech, xs, ys, zs, R, mode, cons, field, h):
     return out
 
 
+def _check_mobility(mech, kind, orientations) -> None:
+    """A mechanism without a free rotation has constant-orientation workspaces only: refuse
+    the other kinds and any orientation set, naming the field."""
+    mob = mech.mobility
+    if mob.rotations:
+        return
+    what = f"family {mech.family!r} with {mob.name} mobility ({', '.join(mob.coordinates)})"
+    if kind != "constant":
+        raise ParameterError("kind", "'constant' for a mechanism without a free rotation "
+                             "(its orientation is fixed)", f"{kind!r} ({what})")
+    if orientations is not None and orientations.kind != "fixed":
+        raise ParameterError("orientations", "the nominal orientation for a mechanism without "
+                             "a free rotation", f"{orientations.kind!r} ({what})")
+
+
 def _nominal_singularity(mech) -> str | None:
     """A note when the Jacobian is rank-deficient at the nominal pose (architecturally
     singular designs: platform equal to the base, collinear joints), where the stroke-feasible
-    volume says nothing about what the mechanism can hold or control."""
-    from ..dexterity.metrics import is_singular
+    volume says nothing about what the mechanism can hold or control. The rotational columns
+    (the mobility's) are scaled by ``mech.scale``; a translational J is taken as it is."""
+    from ..dexterity.metrics import CharacteristicLength, is_singular, rotational_columns
 
     X = mech.nominal_pose
     J = mech.jacobian(X)
-    if not bool(is_singular(J, mech.scale)[0]):
+    L = mech.scale
+    if not mech.mobility.is_spatial:
+        L = CharacteristicLength(L, math.nan, False, False, "given",
+                                 rotational=rotational_columns(mech.mobility))
+    if not bool(is_singular(J, L)[0]):
         return None
     return (f"{SINGULAR_NOTE} (the Jacobian is rank-deficient there): the mechanism cannot "
             "resist or control every load and motion; the volume counts stroke only")

@@ -95,6 +95,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..limits import CAPABILITY_MAX_DEG
 from ..mechanisms import _kernels, _search
+from ..mechanisms.mobility import require_spatial
 from ..poses import as_frames, euler_to_matrix, matrix_to_euler
 from .binding import binding_orientations, column_ends
 from .legbounds import EPS, Legs
@@ -198,6 +199,7 @@ def orientation_capability(mech, samples: int = 7, tol_deg: float = CAPABILITY_T
                            max_deg: float = CAPABILITY_MAX_DEG) -> OptimumBracket:
     """The orientation capability over continuous positions, bracketed (module notes), in one
     compiled search."""
+    require_spatial(mech, "orientation capability")
     _require(mech)
     if not (isinstance(samples, int) and samples >= 2):
         raise ParameterError("samples", "an integer >= 2 (angles per axis)", samples)
@@ -333,6 +335,7 @@ def stroke_needed(mech, orientations: OrientationSet, tol_mm: float = STROKE_TOL
     (module notes). ``q_max_limit`` caps the search (default: lower limit + 4 × scale);
     ``rounds`` caps the exchange rounds that add binding orientations to the sample,
     ``cell_budget`` the orientation cells of one certification."""
+    require_spatial(mech, "the needed stroke")
     _require(mech)
     if orientations.kind != "box" or orientations.semantics != "simultaneous" or \
             len(set(orientations.angles)) != 1:

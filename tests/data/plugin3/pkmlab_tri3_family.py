@@ -23,7 +23,10 @@ def _tri3_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, 
         sz = pz + r20 * ux + r21 * uy + r22 * uz - g[3 * i + 2]
         v = math.sqrt(sx * sx + sy * sy + sz * sz)
         q[i * _kernels.ROW + j] = v
-        st[i * _kernels.ROW + j] = _kernels.stroke_status(v, qmin, qmax)
+        # the working mode: every leg rises from its base joint (the mirror below is the
+        # other assembly mode, as on the 6-UPS)
+        st[i * _kernels.ROW + j] = (_kernels.OTHER_MODE if sz <= 0.0
+                                    else _kernels.stroke_status(v, qmin, qmax))
 
 
 class Tri3Spec(FamilySpec):

@@ -11,7 +11,7 @@ from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSche
 
 from ... import dexterity as dx
 from ... import limits
-from ...errors import NumericalError
+from ...errors import NumericalError, ParameterError
 from ...units import parse_length
 from .registry import Evaluator, finite, metric, register_evaluator
 
@@ -49,14 +49,15 @@ class Dexterity(Evaluator):
     name = "dexterity"
     block = DexteritySpec
     description = DexteritySpec.__doc__
-    requires = frozenset({"spatial", "workspace"})   # dexterity.report: six coordinates
+    requires = frozenset({"workspace"})   # sized from the mobility (pkmlab.dexterity)
     after = ("workspace",)
     absent = None
     metrics = (
         metric("nominal_kappa", "", "exact",
                "κ of the homogenised Jacobian at the nominal pose"),
         metric("characteristic_length", "mm", "exact",
-               "length L homogenising the Jacobian (Angeles' or the one given)"),
+               "length L homogenising the Jacobian (Angeles' or the one given; null with a "
+               "note for a mechanism without a free rotation, whose κ needs none)"),
         metric("worst_kappa", "", "worst-case",
                "largest κ over every voxel of the workspace and every end of its exact "
                "columns × every orientation sample (inf when a singular pose is found inside "
@@ -84,6 +85,14 @@ class Dexterity(Evaluator):
         return {"characteristic_length": "auto" if L is None else f"{L:.12g} mm",
                 "gci_samples": plan.gci_samples, "force_limit": plan.force_limit}
 
+    def check(self, plan, evaluation, mech) -> None:
+        if plan.characteristic_length is not None and not mech.mobility.rotations:
+            mob = mech.mobility
+            raise ParameterError("evaluate.dexterity.characteristic_length",
+                                 "'auto' for a mechanism without a free rotation (its κ needs "
+                                 "no characteristic length)",
+                                 f"{plan.characteristic_length:g} mm ({mob.name} mobility)")
+
     def compute(self, mech, ctx) -> dict:
         plan, res = ctx.evaluation.dexterity, ctx.result
         length = dx.resolve_length(mech, plan.characteristic_length)
@@ -92,8 +101,10 @@ class Dexterity(Evaluator):
         L = length.length
         ctx.L = L
         J0 = mech.jacobian(mech.nominal_pose)
-        out = {"characteristic_length": float(L),
-               "nominal_kappa": finite(dx.condition_number(J0, L)[0])}
+        out = {"characteristic_length": None if L is None else float(L),
+               "nominal_kappa": finite(dx.condition_number(J0, length)[0])}
+        if L is None:
+            ctx.notes["characteristic_length"] = f"not applicable: {length.reason}"
         if out["nominal_kappa"] is None:
             ctx.notes["nominal_kappa"] = "singular at the nominal pose"
         if res.empty:
@@ -119,7 +130,7 @@ class Dexterity(Evaluator):
         out["sampled_max_kappa"] = finite(g.sampled_max_kappa) if g.ok else None
         valid = mech.inverse((p, R)).valid
         F = dx.max_force_all_directions(mech.jacobian((p[valid], R[valid])),
-                                        plan.force_limit, L=L)
+                                        plan.force_limit, L=L, mobility=mech.mobility)
         out["sampled_min_force"] = float(np.min(F)) if len(F) else None
         for n in ("gci", "gci_std_error", "sampled_max_kappa", "sampled_min_force"):
             if out[n] is None:

@@ -9,7 +9,7 @@ class Inscribed(Evaluator):
     name = "inscribed"
     block = bool
     description = "largest inscribed box and cylinder of the workspace"
-    requires = frozenset({"workspace"})
+    requires = frozenset({"spatial", "workspace"})   # not yet sized from the mobility
     after = ("workspace",)
     absent = False
     metrics = (

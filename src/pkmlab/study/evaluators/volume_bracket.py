@@ -27,7 +27,7 @@ class VolumeBracket(Evaluator):
     name = "volume_bracket"
     block = VolumeBracketSpec
     description = VolumeBracketSpec.__doc__
-    requires = frozenset({"workspace"})
+    requires = frozenset({"spatial", "workspace"})   # the bracket: six coordinates
     after = ("workspace",)
     metrics = (
         metric("workspace_volume_lower", "cm³", "guaranteed",

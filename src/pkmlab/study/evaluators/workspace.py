@@ -14,7 +14,9 @@ class Workspace(Evaluator):
     name = "workspace"
     block = WorkspaceSpec
     description = "a workspace request (see 'pkmlab workspace'): kind, box or tilt, ..."
-    requires = frozenset({"spatial"})   # workspaces.engine: six free pose coordinates
+    #: a constant workspace at the nominal orientation serves any mobility; other kinds and
+    #: orientations need a free rotation (:meth:`requirements`)
+    requires = frozenset()
     absent = None
     metrics = (
         metric("workspace_volume", "cm³", "grid",
@@ -37,6 +39,12 @@ class Workspace(Evaluator):
 
     def written(self, plan):
         return to_display(plan)
+
+    def requirements(self, plan) -> frozenset[str]:
+        """An orientation set, or a constant orientation off the nominal one, needs a free
+        rotation (a translational mechanism has constant-orientation workspaces only)."""
+        turned = plan.orientation is not None and any(a != 0 for a in plan.orientation)
+        return frozenset({"rotations"}) if plan.kind != "constant" or turned else frozenset()
 
     def compute(self, mech, ctx) -> dict:
         res = workspace(mech, **ctx.evaluation.request)
