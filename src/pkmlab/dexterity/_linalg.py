@@ -204,7 +204,7 @@ def _gram_lambda_max(A, G, T):
 _SWEEP_TASK = 512
 
 
-def sweep_bounds(J, L, fmax, kup, force, det, mobility=None) -> None:
+def sweep_bounds(J, L, fmax, kup, force, det) -> None:
     """For each ``J[m] (6, 6)``: det J, the all-direction force capability and an upper bound
     on κ(J_h), from one LU factorisation (partial pivoting) and the inverse, written into
     ``kup``, ``force`` and ``det`` (C-contiguous float64 ``(M,)``); on numba's threads in
@@ -219,12 +219,11 @@ def sweep_bounds(J, L, fmax, kup, force, det, mobility=None) -> None:
     * a matrix with a non-finite entry: ``kup = inf``, ``force = NaN``, ``det = NaN``;
       an exactly zero pivot: ``kup = inf``, ``force = 0``, ``det = 0``.
 
-    A stack of other (square) shapes, a lower mobility's ``(M, w, w)`` (``mobility`` says which
-    columns translate), takes :func:`_sweep_general` instead: ``kup`` is then the exact κ.
+    Other (square) shapes, a lower mobility's ``(M, w, w)``, go through
+    :func:`pkmlab.dexterity.sweep.sweep_bounds`, which calls this for a 6 × 6 stack.
     """
     if np.shape(J)[1:] != (6, 6):
-        _sweep_general(J, L, fmax, kup, force, det, mobility)
-        return
+        raise ValueError(f"sweep_bounds: a stack of 6 × 6 matrices, got {np.shape(J)}")
     J = np.require(J, np.float64, ("C", "A", "W"))     # the kernel's one signature: writeable
     fmax = np.require(np.broadcast_to(fmax, (6,)), np.float64, ("C", "A", "W"))
     for name, a in (("kup", kup), ("force", force), ("det", det)):
@@ -234,28 +233,6 @@ def sweep_bounds(J, L, fmax, kup, force, det, mobility=None) -> None:
                              f"array of shape ({len(J)},), got {a.dtype} {a.shape}")
     with threads_for(len(J)):
         _sweep()(J, float(L), fmax, kup, force, det)
-
-
-def _sweep_general(J, L, fmax, kup, force, det, mobility) -> None:
-    """:func:`sweep_bounds` for a stack that is not 6 × 6, in NumPy: ``kup`` the exact κ
-    (:func:`pkmlab.dexterity.condition_number`, ``L`` as there: ``None`` for a translational
-    J), ``force`` :func:`pkmlab.dexterity.max_force_all_directions` (the columns that translate
-    from ``mobility``) and ``det`` from ``numpy.linalg.det``; not finite: inf, NaN, NaN."""
-    from .force import max_force_all_directions  # both import this module
-    from .metrics import condition_number
-
-    J = np.asarray(J, dtype=float)
-    for name, a in (("kup", kup), ("force", force), ("det", det)):
-        if a.shape != (len(J),):
-            raise ValueError(f"sweep_bounds: {name} must have shape ({len(J)},), got {a.shape}")
-    if len(J) == 0:
-        return
-    finite = np.all(np.isfinite(J), axis=(1, 2))
-    kup[:] = condition_number(J, L)
-    force[:] = max_force_all_directions(J, fmax, L, mobility)
-    d = np.full(len(J), np.nan)
-    d[finite] = np.linalg.det(J[finite])
-    det[:] = d
 
 
 def _sweep_loop(J, L, fmax, kup, force, det):

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from .metrics import is_singular
+from .metrics import block_columns, is_singular
 
 log = logging.getLogger(__name__)
 
@@ -57,25 +57,6 @@ def _jac(J, square: bool = True, any_width: bool = False) -> np.ndarray:
         what = "(6, 6) or (N, 6, 6)" if square else "(m, 6) or (N, m, 6) with m >= 6"
         raise ParameterError("J", f"an array of shape {what}", J.shape)
     return J
-
-
-def block_columns(J: np.ndarray, mobility=None, rotational: bool = False):
-    """The columns of ``J`` that act on the platform's translation (or rotation): 0:3 (3:6) of
-    a six-column J; for a lower mobility (``mobility``, :mod:`pkmlab.mechanisms.mobility`) the
-    positions of its free twist columns below (at and above) 3. A J of another width without
-    its mobility is refused."""
-    if mobility is None:
-        if J.shape[-1] != 6:
-            raise ParameterError("mobility", f"the mechanism's mobility for a {J.shape[-1]}-"
-                                 "column Jacobian (which columns translate)", None)
-        return slice(3, 6) if rotational else slice(0, 3)
-    tc = np.asarray(mobility.twist_columns)
-    if len(tc) != J.shape[-1]:
-        raise ParameterError("mobility", f"a mobility with {J.shape[-1]} free coordinates",
-                             f"{mobility.name} ({len(tc)})")
-    if len(tc) == 6:
-        return slice(3, 6) if rotational else slice(0, 3)
-    return np.nonzero(tc >= 3 if rotational else tc < 3)[0]
 
 
 def _fmax(f_max, m: int) -> np.ndarray:

@@ -16,11 +16,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ._linalg import kappa_upper, sweep_bounds
+from ._linalg import kappa_upper
 from .aggregate import _CHUNK, _ik_valid, _units, _voxels, orientation_batches
 from .force import max_force_all_directions
 from .metrics import CharacteristicLength, condition_number, resolve_length
 from .stiffness import stiffness
+from .sweep import sweep_bounds
 
 __all__ = ["METRICS", "MetricMap", "metric_map", "drawn_voxels", "mesh_colours",
            "vertex_values"]

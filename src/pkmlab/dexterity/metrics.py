@@ -52,6 +52,7 @@ from ._linalg import singular_values
 log = logging.getLogger(__name__)
 
 __all__ = [
+    "block_columns",
     "SINGULAR_RTOL",
     "KAPPA_SINGULAR",
     "jacobian_ok",
@@ -248,8 +249,6 @@ def manipulability(J: np.ndarray, mobility=None) -> tuple[np.ndarray, np.ndarray
         singular (:func:`is_singular` with ``L = 1 mm``: the ellipsoid is unbounded — in the
         rare case that its unbounded axis is purely rotational, ``w_t`` is in truth finite).
     """
-    from .force import block_columns  # force imports this module
-
     J = _as_jacobian(J)
     lead = J.shape[:-2]
     flat = J.reshape((-1,) + J.shape[-2:])
@@ -467,3 +466,21 @@ def resolve_length(mech, L=None) -> CharacteristicLength:
     k = condition_number(J, CharacteristicLength(r, 0.0, False, False, rotational=cols))
     return CharacteristicLength(r, float(k[0]), False, False, "fallback", reason, cols)
 
+
+def block_columns(J: np.ndarray, mobility=None, rotational: bool = False):
+    """The columns of ``J`` that act on the platform's translation (or rotation): 0:3 (3:6) of
+    a six-column J; for a lower mobility (``mobility``, :mod:`pkmlab.mechanisms.mobility`) the
+    positions of its free twist columns below (at and above) 3. A J of another width without
+    its mobility is refused."""
+    if mobility is None:
+        if J.shape[-1] != 6:
+            raise ParameterError("mobility", f"the mechanism's mobility for a {J.shape[-1]}-"
+                                 "column Jacobian (which columns translate)", None)
+        return slice(3, 6) if rotational else slice(0, 3)
+    tc = np.asarray(mobility.twist_columns)
+    if len(tc) != J.shape[-1]:
+        raise ParameterError("mobility", f"a mobility with {J.shape[-1]} free coordinates",
+                             f"{mobility.name} ({len(tc)})")
+    if len(tc) == 6:
+        return slice(3, 6) if rotational else slice(0, 3)
+    return np.nonzero(tc >= 3 if rotational else tc < 3)[0]

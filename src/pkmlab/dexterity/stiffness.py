@@ -19,8 +19,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import ParameterError
-from .force import block_columns
-from .metrics import _as_jacobian
+from .metrics import _as_jacobian, block_columns
 
 __all__ = ["Stiffness", "stiffness"]
 

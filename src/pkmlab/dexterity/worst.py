@@ -71,10 +71,11 @@ import numpy as np
 
 from ..poses import matrix_to_euler
 from ._boundary import column_ends
-from ._linalg import KAPPA_BRACKET, KAPPA_ROUND, kappa_upper, sweep_bounds
+from ._linalg import KAPPA_BRACKET, KAPPA_ROUND, kappa_upper
 from .aggregate import _CHUNK, _ik_valid, _units, _voxels, orientation_batches
 from .force import _fmax, max_force_all_directions
 from .metrics import KAPPA_SINGULAR, CharacteristicLength, condition_number, resolve_length
+from .sweep import sweep_bounds
 
 log = logging.getLogger(__name__)
 

@@ -1,0 +1,36 @@
+"""The worst case's per-pose pass, for any Jacobian shape: the numba 6 × 6 kernel of
+:mod:`._linalg` for spatial mechanisms, NumPy for a lower mobility's square Jacobians."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _linalg
+from .force import max_force_all_directions
+from .metrics import condition_number
+
+__all__ = ["sweep_bounds"]
+
+
+def sweep_bounds(J, L, fmax, kup, force, det, mobility=None) -> None:
+    """:func:`._linalg.sweep_bounds` (the numba kernel) for a stack of 6 × 6 Jacobians; for
+    another (square) shape, a lower mobility's ``(M, w, w)``, the same outputs in NumPy:
+    ``kup`` the exact κ (:func:`pkmlab.dexterity.condition_number`, ``L`` as there: ``None``
+    for a translational J), ``force`` :func:`pkmlab.dexterity.max_force_all_directions`
+    (the columns that translate from ``mobility``) and ``det`` from ``numpy.linalg.det``; not
+    finite: inf, NaN, NaN."""
+    if np.shape(J)[1:] == (6, 6):
+        _linalg.sweep_bounds(J, L, fmax, kup, force, det)
+        return
+    J = np.asarray(J, dtype=float)
+    for name, a in (("kup", kup), ("force", force), ("det", det)):
+        if a.shape != (len(J),):
+            raise ValueError(f"sweep_bounds: {name} must have shape ({len(J)},), got {a.shape}")
+    if len(J) == 0:
+        return
+    finite = np.all(np.isfinite(J), axis=(1, 2))
+    kup[:] = condition_number(J, L)
+    force[:] = max_force_all_directions(J, fmax, L, mobility)
+    d = np.full(len(J), np.nan)
+    d[finite] = np.linalg.det(J[finite])
+    det[:] = d
