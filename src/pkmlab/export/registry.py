@@ -15,15 +15,12 @@ flag is set, the report describes the files from the descriptions, and
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from ..errors import ParameterError
-
-log = logging.getLogger(__name__)
 
 __all__ = ["Exporter", "EXPORTERS", "PLUGIN_GROUP", "PLUGIN_ERRORS", "register_exporter",
            "exporters", "exporter_for", "write", "load_exporter_plugins"]
@@ -118,17 +115,8 @@ def write(obj: Any, path: str | Path, subject: str = "mesh", **options) -> Path:
 
 def load_exporter_plugins() -> dict[str, Exporter]:
     """Register the exporters of the :data:`PLUGIN_GROUP` entry points (a broken one is
-    logged and listed in :data:`PLUGIN_ERRORS`); returns those loaded."""
-    from importlib.metadata import entry_points
+    logged and listed in :data:`PLUGIN_ERRORS`); returns those loaded, by format."""
+    from ..plugins import load_entry_points
 
-    loaded = {}
-    for ep in entry_points(group=PLUGIN_GROUP):
-        try:
-            ex = register_exporter(ep.load())
-        except Exception as exc:  # a broken plugin must not break pkmlab
-            PLUGIN_ERRORS[ep.name] = f"{type(exc).__name__}: {exc}"
-            log.warning("pkmlab exporter plugin %r (%s) not loaded: %s", ep.name, ep.value,
-                        PLUGIN_ERRORS[ep.name])
-            continue
-        loaded[ex.format] = ex
-    return loaded
+    loaded = load_entry_points(PLUGIN_GROUP, register_exporter, PLUGIN_ERRORS, "exporter")
+    return {ex.format: ex for ex in loaded.values()}

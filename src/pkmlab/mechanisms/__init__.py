@@ -15,8 +15,6 @@ listed in :data:`PLUGIN_ERRORS`, never fatal.
 
 from __future__ import annotations
 
-import logging
-
 from .base import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult, Mechanism
 from .joints import Joint, Leg, Link, Parameters
 from .luzi3 import Luzi3
@@ -25,8 +23,6 @@ from .psu6 import PSU6
 from .rss6 import RSS6
 from .sixleg import SixLeg
 from .ups6 import UPS6
-
-log = logging.getLogger(__name__)
 
 #: family name → mechanism class (built-in families, then plugins once loaded)
 REGISTRY: dict[str, type[Mechanism]] = {cls.family: cls for cls in (PSU6, UPS6, Luzi3, RSS6,
@@ -76,20 +72,10 @@ def register_family(cls) -> type[Mechanism]:
 def load_plugins() -> dict[str, type[Mechanism]]:
     """Register the families of the ``pkmlab.families`` entry points (idempotent); returns
     the plugin families loaded so far."""
-    from importlib.metadata import entry_points
+    from ..plugins import load_entry_points
 
-    for ep in entry_points(group=PLUGIN_GROUP):
-        if ep.name in _LOADED:
-            continue
-        try:
-            register_family(ep.load())
-        except Exception as exc:  # a broken plugin must not break pkmlab
-            PLUGIN_ERRORS[ep.name] = f"{type(exc).__name__}: {exc}"
-            log.warning("pkmlab family plugin %r (%s) not loaded: %s", ep.name, ep.value,
-                        PLUGIN_ERRORS[ep.name])
-            continue
-        PLUGIN_ERRORS.pop(ep.name, None)
-        _LOADED.add(ep.name)
+    _LOADED.update(load_entry_points(PLUGIN_GROUP, register_family, PLUGIN_ERRORS, "family",
+                                     skip=_LOADED))
     return {k: v for k, v in REGISTRY.items() if k not in BUILTIN}
 
 

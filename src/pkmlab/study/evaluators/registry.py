@@ -29,7 +29,6 @@ built-in evaluators (one module each in this package) register exactly as a plug
 from __future__ import annotations
 
 import dataclasses
-import logging
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -40,8 +39,6 @@ from pydantic import BaseModel
 from ...config import validate_model
 from ...errors import ParameterError
 from ..metrics import METRICS, Metric
-
-log = logging.getLogger(__name__)
 
 __all__ = ["Evaluator", "Context", "EVALUATORS", "PLUGIN_GROUP", "PLUGIN_ERRORS",
            "metrics_markdown", "MECHANISM_NEEDS", "register_evaluator", "unregister_evaluator",
@@ -213,20 +210,11 @@ def _drop_metrics(name: str) -> None:
 
 def load_evaluator_plugins() -> dict[str, Evaluator]:
     """Register the evaluators of the :data:`PLUGIN_GROUP` entry points (a broken one is
-    logged and listed in :data:`PLUGIN_ERRORS`); returns those loaded."""
-    from importlib.metadata import entry_points
+    logged and listed in :data:`PLUGIN_ERRORS`); returns those loaded, by name."""
+    from ...plugins import load_entry_points
 
-    loaded = {}
-    for ep in entry_points(group=PLUGIN_GROUP):
-        try:
-            ev = register_evaluator(ep.load())
-        except Exception as exc:  # a broken plugin must not break pkmlab
-            PLUGIN_ERRORS[ep.name] = f"{type(exc).__name__}: {exc}"
-            log.warning("pkmlab evaluator plugin %r (%s) not loaded: %s", ep.name, ep.value,
-                        PLUGIN_ERRORS[ep.name])
-            continue
-        loaded[ev.name] = ev
-    return loaded
+    loaded = load_entry_points(PLUGIN_GROUP, register_evaluator, PLUGIN_ERRORS, "evaluator")
+    return {ev.name: ev for ev in loaded.values()}
 
 
 # ---- what the mechanism must offer -------------------------------------------------------------
