@@ -220,3 +220,59 @@ def test_random_sixleg_columns_and_bracket_against_the_ik(family, lower, seed):
         Rr = box.centred(tuple(matrix_to_euler(Rn[0]))).rotations_at(
             rng.uniform(-1, 1, (len(P), 3)) * math.radians(deg))
         assert m.inverse((P, Rr)).valid.all()
+
+
+def _end_certificates(m, res, L):
+    """Independently: for each exact column slot, its two ends (1e-6 mm inside) and the voxel
+    centres nearest them in the slot; ``(singular end, sign change end <-> centre, κ of every
+    feasible end and centre)`` with κ = numpy.linalg.cond of the homogenised Jacobian and the
+    sign from numpy.linalg.det."""
+    _, Rn = as_frames(m.nominal_pose)
+    scale = np.array([1.0, 1.0, 1.0, 1 / L, 1 / L, 1 / L])
+    i, j, k = np.nonzero(res.lo <= res.hi)
+    lo, hi = res.lo[i, j, k], res.hi[i, j, k]
+    d = np.minimum(1e-6, 0.5 * (hi - lo))
+    zs, h = res.zs, res.resolution
+    first = zs[0] + np.ceil((lo - zs[0]) / h - 1e-9) * h      # voxel centres inside the slot
+    last = zs[0] + np.floor((hi - zs[0]) / h + 1e-9) * h
+    xy = np.stack([res.xs[i], res.ys[j]], axis=1)
+    P = np.concatenate([np.column_stack([xy, lo + d]), np.column_stack([xy, hi - d]),
+                        np.column_stack([xy, first]), np.column_stack([xy, last])])
+    R = np.broadcast_to(Rn[0], (len(P), 3, 3))
+    ok = m.inverse((P, R)).valid
+    J = m.jacobian((P, R)) * scale
+    fin = ok & np.all(np.isfinite(J), axis=(1, 2))
+    with np.errstate(all="ignore"):
+        det = np.where(fin, np.linalg.det(np.where(fin[:, None, None], J, np.eye(6))), np.nan)
+        cond = np.array([np.linalg.cond(Jm) if f else np.inf for Jm, f in zip(J, fin)])
+    n = len(lo)
+    end_ok, cen_ok = ok[:2 * n], ok[2 * n:] & (np.concatenate([first, last])
+                                               <= np.concatenate([hi, hi])) & (
+        np.concatenate([first, last]) >= np.concatenate([lo, lo]))
+    singular_end = bool(np.any(end_ok & ~(cond[:2 * n] < 1e12)))
+    flips = end_ok & cen_ok & (np.sign(det[:2 * n]) * np.sign(det[2 * n:]) < 0)
+    kappas = np.concatenate([cond[:2 * n][end_ok], cond[2 * n:][cen_ok]])
+    return singular_end, bool(np.any(flips)), kappas
+
+
+@pytest.mark.parametrize("family,lower,seed", CASES)
+def test_random_sixleg_worst_case_covers_the_column_ends(family, lower, seed):
+    """On every random machine (every leg kind and window sign; all of them reach a singular
+    set on their constant workspace's boundary), the worst case covers the exact column ends:
+    where an independent computation (IK 1e-6 mm inside each end, numpy's det and cond of the
+    homogenised Jacobian at the end and at the nearest voxel centre of its slot) finds a
+    singular end or a sign change of det J, the worst case is singular with a boundary
+    certificate; otherwise its worst κ is at least every feasible end's and centre's κ."""
+    from pkmlab import dexterity as dx
+
+    m = _draw(family, lower, seed)
+    res = workspace(m, "constant", resolution=12.0)
+    if res.empty:
+        pytest.skip("empty constant workspace")
+    assert res.exact_columns
+    wc = dx.worst_case(m, res)
+    singular_end, flip, kappas = _end_certificates(m, res, wc.length.length)
+    if singular_end or flip:                       # a certificate exists on the boundary
+        assert wc.singular and (wc.boundary_singular or wc.boundary_sign_changes), wc.reason
+    if not wc.singular:
+        assert wc.worst_kappa >= np.max(kappas) * (1 - 1e-9), (wc.worst_kappa, np.max(kappas))
