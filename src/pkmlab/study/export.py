@@ -24,7 +24,6 @@ from __future__ import annotations
 import io
 import json
 import logging
-import re
 import shutil
 import time
 from pathlib import Path
@@ -37,6 +36,7 @@ from ..config import to_display
 from ..errors import NumericalError, ParameterError
 from ..export import exporters
 from .definition import Study
+from .folder import DESIGN_FOLDER
 from .run import BASELINE, objective_matrix
 from .selection import select_designs
 
@@ -45,7 +45,6 @@ log = logging.getLogger(__name__)
 __all__ = ["export_designs", "chosen_designs", "read_index", "DESIGN_FOLDER"]
 
 #: Exported design folders: ``NN-<first 8 characters of the candidate key>``.
-DESIGN_FOLDER = re.compile(r"^\d{2}-[0-9a-f]{8}$")
 
 
 def _plain(obj):

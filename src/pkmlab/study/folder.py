@@ -25,8 +25,8 @@ from pathlib import Path
 
 from ..errors import ParameterError
 
-__all__ = ["MARKER", "OutputLock", "check_output", "foreign", "clear_for_overwrite",
-           "claim"]
+__all__ = ["MARKER", "DESIGN_FOLDER", "OutputLock", "check_output", "foreign",
+           "clear_for_overwrite", "claim"]
 
 #: written into a results folder as a run starts: the folder is pkmlab's
 MARKER = ".pkmlab-results"
@@ -37,7 +37,8 @@ _TOP_FILES = frozenset({
     "evaluations.csv", "pareto.csv", "pareto.png", "summary.md", "study.resolved.yaml",
     "report.html"})
 _DESIGNS = "designs"
-_DESIGN_FOLDER = re.compile(r"^\d{2}-[0-9a-f]{8}$")         # as study.export names them
+#: an exported design's folder, ``NN-<8 hex digits of its key>`` (:mod:`.export` names them)
+DESIGN_FOLDER = re.compile(r"^\d{2}-[0-9a-f]{8}$")
 _DESIGN_FILE = re.compile(r"^[a-z0-9_.-]+\.([a-z0-9]+)$")
 #: suffixes of a design's own files besides the registered mesh formats (pkmlab.export)
 _DESIGN_SUFFIXES = frozenset({"json", "yaml", "png", "npz", "csv"})
@@ -133,7 +134,7 @@ def _foreign_in(folder: Path, rel: str, allowed_files, allowed_dirs) -> str | No
 
 
 def _design_folder(name: str):
-    if _DESIGN_FOLDER.match(name) is None:
+    if DESIGN_FOLDER.match(name) is None:
         return None
     return _design_file, (lambda d: None)
 
