@@ -28,7 +28,7 @@ _WORKER = """
 import numpy as np
 from pathlib import Path
 from pkmlab.study import evaluate_design, load_study
-from pkmlab.threads import single_thread_worker
+from pkmlab.runtime.threads import single_thread_worker
 single_thread_worker()
 study = load_study(Path({study!r}))
 space = study.space

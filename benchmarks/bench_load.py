@@ -13,9 +13,9 @@ Each is measured quiet and beside a competing load: another process running a pa
 loop on both cores under libgomp's default (spinning) wait policy, as another OpenMP program
 would. "before" is libgomp's default wait policy (``OMP_WAIT_POLICY`` set to an empty value,
 which libgomp ignores with a warning, so pkmlab's default does not apply); "after" is pkmlab's
-default (:mod:`pkmlab.threads`). Targets (issue 14): the per-candidate time loaded within 1.5×
-of quiet, and Dask at least as fast as joblib. "Quiet" means no load of ours; the load average
-printed first says how quiet the machine was.
+default (:mod:`pkmlab.runtime.threads`). Targets (issue 14): the per-candidate time loaded
+within 1.5× of quiet, and Dask at least as fast as joblib. "Quiet" means no load of ours; the
+load average printed first says how quiet the machine was.
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ Prints, in one run:
   as wall-clock rate and as rate per CPU-second (process time over all threads: what one
   core delivers, nearly independent of how loaded the machine is), against a plain NumPy
   baseline measured in the same run (the Jacobian by the family's NumPy formula, the wrench
-  by :func:`~pkmlab.requirements.dynamics.platform_wrench`, ``numpy.linalg.solve`` of
+  by :func:`~pkmlab.motion.dynamics.platform_wrench`, ``numpy.linalg.solve`` of
   ``Jᵀ f = w``) on the first 2·10⁵ samples.
 
 Run: ``.venv/bin/python benchmarks/bench_requirements.py``.
@@ -28,10 +28,10 @@ import numpy as np
 from _timing import timed  # noqa: E402 - the benchmarks folder is on sys.path
 
 from pkmlab import load_mechanism
+from pkmlab.motion.dynamics import inverse_dynamics, platform_wrench
+from pkmlab.motion.motions import sinusoid_motion
+from pkmlab.motion.payload import MassProperties
 from pkmlab.poses import as_frames
-from pkmlab.requirements.dynamics import inverse_dynamics, platform_wrench
-from pkmlab.requirements.motions import sinusoid_motion
-from pkmlab.requirements.payload import MassProperties
 from pkmlab.requirements.task import TaskRegion, task_contained, task_margins
 from pkmlab.workspaces import OrientationSet, workspace
 

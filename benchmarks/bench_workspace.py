@@ -184,10 +184,11 @@ def load() -> str:
 
 def ups_pruning(columns: int = 300, seed: int = 0) -> None:
     """The shipped 6-UPS (legs 390-950 mm), ±10° simultaneous dexterous, 7³ orientations,
-    2.5 mm: the public call (tile pruning, :mod:`pkmlab.mechanisms._tiles`), the plain column
+    2.5 mm: the public call (tile pruning, :mod:`pkmlab.mechanisms.kernels.tiles`), the plain column
     kernel without pruning, and a plain NumPy brute force (every voxel × orientation × leg)
     run on ``columns`` random columns of the same grid and extrapolated to all of them."""
-    from pkmlab.mechanisms import _kernels, column_kernels
+    from pkmlab.mechanisms.kernels import columns as column_kernels
+    from pkmlab.mechanisms.kernels import ik as _kernels
 
     big = load_mechanism(ROOT / "studies/mechanisms/gough-stewart-6ups.yaml")
     box = OrientationSet.box(np.radians([10.0] * 3), "simultaneous", samples=7)
@@ -244,7 +245,7 @@ def capability_cost(repeats: int = 3) -> None:
     before (bisection over full 2.5 mm workspaces, ``study.evaluators.capability``) and after
     (one compiled search over continuous positions, ``workspaces.optima``)."""
     from pkmlab.study.evaluators import capability
-    from pkmlab.workspaces.optima import orientation_capability
+    from pkmlab.workspaces.optima.search import orientation_capability
 
     psu = load_mechanism(ROOT / "studies/mechanisms/hopkins-williams-6psu.yaml")
     req = {"orientations": OrientationSet.box(np.radians([5.0] * 3), samples=5),
@@ -285,12 +286,12 @@ def main() -> None:
 
 
 def bracket_report(budget_s: float = 120.0) -> None:
-    """Time to a guaranteed 1 % volume bracket (pkmlab.workspaces.bracket), per family and
+    """Time to a guaranteed 1 % volume bracket (pkmlab.workspaces.bracket.columns), per family and
     kind (``bracket [budget_s]``), against the plain sampled engine call of the same request
     (no guarantee) timed in the same run. The machine's load is printed with it."""
     import os
 
-    from pkmlab.workspaces.bracket import volume_bracket
+    from pkmlab.workspaces.bracket.columns import volume_bracket
 
     print(f"volume bracket, time to 1 % (load {os.getloadavg()[0]:.1f} on "
           f"{os.cpu_count()} cores):")

@@ -102,7 +102,7 @@ def psi_pose(geo, psi, l11, l12):
 
 def compare_with_pkmlab() -> None:
     from pkmlab.mechanisms import NO_STROKE, Luzi3
-    from pkmlab.mechanisms.luzi3 import pose_to_psi
+    from pkmlab.mechanisms.families.luzi3 import pose_to_psi
     from pkmlab.poses import as_frames, frames_to_poses
 
     F = Rotation.from_euler("z", 30, degrees=True).as_matrix()

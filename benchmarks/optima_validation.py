@@ -23,7 +23,7 @@ from pkmlab.mechanisms import NO_STROKE
 from pkmlab.poses import euler_to_matrix
 from pkmlab.study.evaluators import capability
 from pkmlab.workspaces import Constraints, OrientationSet, workspace
-from pkmlab.workspaces.optima import orientation_capability, stroke_needed
+from pkmlab.workspaces.optima.search import orientation_capability, stroke_needed
 
 ROOT = Path(__file__).resolve().parents[1]
 

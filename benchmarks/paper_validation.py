@@ -14,8 +14,8 @@ from scipy.optimize import least_squares, linprog, minimize, minimize_scalar
 
 import pkmlab
 from pkmlab.mechanisms import NO_STROKE, Luzi3
-from pkmlab.mechanisms.layout import equal_leg_base_angle, paired_layout
-from pkmlab.mechanisms.luzi3 import four_bar_theta, pose_to_psi, reduced_dpa
+from pkmlab.mechanisms.families.luzi3 import four_bar_theta, pose_to_psi, reduced_dpa
+from pkmlab.mechanisms.legs.layout import equal_leg_base_angle, paired_layout
 from pkmlab.poses import euler_to_matrix
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -1,4 +1,4 @@
-"""Calibrate and check the time model of :mod:`pkmlab.time_budget`.
+"""Calibrate and check the time model of :mod:`pkmlab.runtime.time_budget`.
 
     python benchmarks/time_model.py
 
@@ -21,7 +21,12 @@ from _timing import timed  # noqa: E402 - the benchmarks folder is on sys.path
 
 import pkmlab
 from pkmlab.poses import as_frames, matrix_to_euler
-from pkmlab.time_budget import NS_PER_COLUMN_LEG, NS_PER_VOXEL_LEG, OVERHEAD_S, workspace_seconds
+from pkmlab.runtime.time_budget import (
+    NS_PER_COLUMN_LEG,
+    NS_PER_VOXEL_LEG,
+    OVERHEAD_S,
+    workspace_seconds,
+)
 from pkmlab.workspaces import OrientationSet, workspace
 from pkmlab.workspaces.engine import _grid_xy
 

@@ -1,4 +1,4 @@
-"""Validation of the guaranteed volume bracket (``pkmlab.workspaces.bracket``) against dense
+"""Validation of the guaranteed volume bracket (``pkmlab.workspaces.bracket.columns``) against dense
 brute-force estimates, for each kind, on the Hopkins & Williams 6-PSU and the shipped 6-UPS.
 
 For every case, the bracket is computed once with a budget of leg-bound evaluations; every
@@ -27,7 +27,7 @@ from pathlib import Path
 
 from pkmlab import load_mechanism
 from pkmlab.workspaces import OrientationSet, workspace
-from pkmlab.workspaces.bracket import volume_bracket
+from pkmlab.workspaces.bracket.columns import volume_bracket
 
 ROOT = Path(__file__).resolve().parents[1]
 

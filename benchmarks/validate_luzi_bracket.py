@@ -1,4 +1,4 @@
-"""Validation of the luzi3 cell bracket (``pkmlab.workspaces.bracket_cells``): the leg bound
+"""Validation of the luzi3 cell bracket (``pkmlab.workspaces.bracket.cells``): the leg bound
 really bounds, and the bracket contains dense estimates.
 
 1. ``Luzi3.leg_cell_bounds``: random cells (positions within ±500 mm of the nominal in x, y
@@ -29,10 +29,10 @@ from scipy.spatial.transform import Rotation
 
 from pkmlab import load_mechanism
 from pkmlab.mechanisms import NO_STROKE
-from pkmlab.mechanisms.luzi3 import Luzi3
+from pkmlab.mechanisms.families.luzi3 import Luzi3
 from pkmlab.testing import cell_points
 from pkmlab.workspaces import OrientationSet, workspace
-from pkmlab.workspaces.bracket import volume_bracket
+from pkmlab.workspaces.bracket.columns import volume_bracket
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -1,5 +1,5 @@
-"""Validation of the rss6 cell bracket (``pkmlab.mechanisms._crank_cells`` through
-``pkmlab.workspaces.bracket_cells``): the bounds really bound, and the bracket contains the
+"""Validation of the rss6 cell bracket (``pkmlab.mechanisms.legs.crank_cells`` through
+``pkmlab.workspaces.bracket.cells``): the bounds really bound, and the bracket contains the
 engine's estimates.
 
 1. ``RSS6.leg_cell_bounds`` / ``leg_cell_margins`` on random cells (positions within
@@ -34,10 +34,10 @@ from scipy.spatial.transform import Rotation
 
 from pkmlab import load_mechanism
 from pkmlab.mechanisms import NO_STROKE
-from pkmlab.mechanisms.rss6 import RSS6
+from pkmlab.mechanisms.families.rss6 import RSS6
 from pkmlab.testing import cell_points
 from pkmlab.workspaces import OrientationSet, workspace
-from pkmlab.workspaces.bracket import volume_bracket
+from pkmlab.workspaces.bracket.columns import volume_bracket
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -1,4 +1,4 @@
-"""The guaranteed volume bracket (pkmlab.workspaces.bracket): its cell bounds, its soundness
+"""The guaranteed volume bracket (pkmlab.workspaces.bracket.columns): its cell bounds, its soundness
 against independent evaluations of the kinematics, its narrowing with the budget, and the study
 metrics and CLI fields that carry it."""
 
@@ -17,17 +17,17 @@ from typer.testing import CliRunner
 from pkmlab import load_mechanism
 from pkmlab.cli import app
 from pkmlab.errors import ParameterError
-from pkmlab.mechanisms.column_kernels import make_leg_eval
-from pkmlab.mechanisms.sixleg import SixLeg
-from pkmlab.mechanisms.ups6 import working_sides
+from pkmlab.mechanisms.families.sixleg import SixLeg
+from pkmlab.mechanisms.families.ups6 import working_sides
+from pkmlab.mechanisms.kernels.columns import make_leg_eval
 from pkmlab.study import evaluators as ev_mod
 from pkmlab.study import load_study
 from pkmlab.workspaces import OrientationSet, workspace
 from pkmlab.workspaces import cells as oc
-from pkmlab.workspaces.bracket import volume_bracket
-from pkmlab.workspaces.bracket_level import Level
+from pkmlab.workspaces.bracket.columns import volume_bracket
+from pkmlab.workspaces.bracket.legbounds import Legs
+from pkmlab.workspaces.bracket.level import Level
 from pkmlab.workspaces.constraints import Constraints
-from pkmlab.workspaces.legbounds import Legs
 
 HOPKINS = MECH_DIR / "hopkins-williams-6psu.yaml"
 UPS = MECH_DIR / "gough-stewart-6ups.yaml"
@@ -366,7 +366,7 @@ def test_cli_prints_and_writes_the_bracket(tmp_path):
 
 def test_positive_part_of_an_affine_function_integrates_exactly():
     """The closed form behind the x-y second-order volumes, against a fine midpoint rule."""
-    from pkmlab.workspaces.bracket_sets import tri_positive
+    from pkmlab.workspaces.bracket.sets import tri_positive
 
     rng = np.random.default_rng(4)
     f = rng.normal(size=(200, 3))

@@ -1,4 +1,4 @@
-"""The luzi3 cell bracket (pkmlab.workspaces.bracket_cells): the leg bound over a cell holds on
+"""The luzi3 cell bracket (pkmlab.workspaces.bracket.cells): the leg bound over a cell holds on
 random samples, the inner and outer cube sets agree with the kinematics evaluated
 independently (IK at random points and rotations), the bracket contains the engine's volume,
 and the CLI brackets luzi3."""
@@ -19,8 +19,8 @@ from pkmlab.cli import app
 from pkmlab.mechanisms import NO_STROKE
 from pkmlab.testing import cell_points
 from pkmlab.workspaces import OrientationSet, workspace
-from pkmlab.workspaces.bracket import volume_bracket
-from pkmlab.workspaces.bracket_cells import touching_components
+from pkmlab.workspaces.bracket.cells import touching_components
+from pkmlab.workspaces.bracket.columns import volume_bracket
 
 LUZI = MECH_DIR / "luzi-3chain.yaml"
 
@@ -152,7 +152,7 @@ def test_position_curvature_bounds_the_linearisation(luzi):
 
 
 def test_cube_fraction_matches_monte_carlo():
-    from pkmlab.workspaces.bracket_partial import cube_fraction
+    from pkmlab.workspaces.bracket.partial import cube_fraction
 
     rng = np.random.default_rng(9)
     g = rng.normal(size=(60, 3))

@@ -1,4 +1,4 @@
-"""The rss6 cell bracket (pkmlab.mechanisms._crank_cells through bracket_cells): the crank
+"""The rss6 cell bracket (pkmlab.mechanisms.legs.crank_cells through bracket_cells): the crank
 angle's and the rod's closing margins' bounds over a cell hold on random cells (the angle
 against the IK, the closing margins against the distances to the crank ends of the crank
 circle, the decisions against the IK's status), the bracket contains the engine's exact-column
@@ -17,10 +17,10 @@ from scipy.spatial.transform import Rotation
 
 from pkmlab import load_mechanism
 from pkmlab.mechanisms import NO_STROKE
-from pkmlab.mechanisms.rss6 import RSS6
+from pkmlab.mechanisms.families.rss6 import RSS6
 from pkmlab.testing import cell_points
 from pkmlab.workspaces import OrientationSet, workspace
-from pkmlab.workspaces.bracket import volume_bracket
+from pkmlab.workspaces.bracket.columns import volume_bracket
 
 SERVO = MECH_DIR / "instructables-servo-6rss.yaml"
 

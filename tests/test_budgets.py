@@ -14,9 +14,9 @@ from test_faults import HW, LUZI, cli, one_line, small_study
 
 import pkmlab
 from pkmlab.errors import ParameterError
+from pkmlab.runtime.time_budget import ENV, time_limit, workspace_seconds
 from pkmlab.study import SerialRunner, load_study, run_study
 from pkmlab.study.optimisers import lhs_chunks
-from pkmlab.time_budget import ENV, time_limit, workspace_seconds
 
 
 @pytest.mark.parametrize("text,seconds", [("90", 90.0), ("90s", 90.0), ("20min", 1200.0),
@@ -52,7 +52,7 @@ def test_workspace_over_the_time_budget_is_refused_with_a_coarser_resolution_tha
 
 
 def test_long_workspace_estimate_is_shown_before_the_work(capsys, tmp_path, monkeypatch):
-    monkeypatch.setattr("pkmlab.time_budget.LOG_FROM_S", 0.0)
+    monkeypatch.setattr("pkmlab.runtime.time_budget.LOG_FROM_S", 0.0)
     code, out, err = cli(capsys, "workspace", HW, "--resolution", "10", "--out", tmp_path)
     assert code == 0, err
     assert "pkmlab: resolution: 10 mm" in err and "estimated at" in err
@@ -93,7 +93,7 @@ def test_a_study_over_the_time_budget_stops_after_the_baseline(tmp_path, monkeyp
     con.close()
     # within budget: the estimate is logged before the candidates, and the run completes
     monkeypatch.setenv(ENV, "1h")
-    monkeypatch.setattr("pkmlab.time_budget.LOG_FROM_S", 0.0)
+    monkeypatch.setattr("pkmlab.runtime.time_budget.LOG_FROM_S", 0.0)
     ok = tmp_path / "ok"
     ok.mkdir()
     q = small_study(ok)
@@ -165,7 +165,7 @@ def test_the_suggested_resolution_fits_both_budgets(monkeypatch):
     """A grid over the memory budget suggests a spacing whose estimate fits the time budget
     too (Luzi at 0.05 mm: 705 GiB; with a 1 h budget, 0.5 mm would fit memory but not time)."""
     import pkmlab.workspaces.engine as engine
-    from pkmlab.memory import memory_limit
+    from pkmlab.runtime.memory import memory_limit
 
     monkeypatch.setenv(ENV, "1h")
     mech = pkmlab.load_mechanism(LUZI)

@@ -18,8 +18,8 @@ from typer.testing import CliRunner
 
 from pkmlab import PSU6, UPS6
 from pkmlab.cli import app
-from pkmlab.workspaces import optima
-from pkmlab.workspaces.optima import orientation_capability
+from pkmlab.workspaces.optima import search as optima
+from pkmlab.workspaces.optima.search import orientation_capability
 
 BASE = [[-304.0559, 304.0559, 0.0], [304.0559, 304.0559, 0.0], [415.3481, 111.2922, 0.0],
         [111.2922, -415.3481, 0.0], [-111.2922, -415.3481, 0.0], [-415.3481, 111.2922, 0.0]]

@@ -78,7 +78,7 @@ def test_maps_computed_only_where_drawn_give_the_same_picture_and_mesh_colours()
     """Issue 14 (cheap exports): the export evaluates κ only on the slice layers and the
     surface voxels; the drawn values and the mesh vertex values equal the full map's."""
     from pkmlab.dexterity.maps import drawn_voxels, vertex_values
-    from pkmlab.workspaces.slicing import slice_layout
+    from pkmlab.workspaces.output.slicing import slice_layout
 
     mech = load_mechanism(HOPKINS)
     res = workspace(mech, "dexterous", OrientationSet.box(np.radians([10] * 3), samples=3), 4.0)

@@ -548,7 +548,7 @@ def test_characteristic_length_failure_is_a_status_and_every_user_says_so():
     assert w.length.status == "fallback" and w.singular and w.worst_kappa == math.inf
     g = dx.gci_monte_carlo(mech, plain, samples=50)
     assert g.length.status == "fallback" and g.gci == 0.0 and g.singular == g.samples
-    from pkmlab.trajectory import check_trajectory
+    from pkmlab.motion import check_trajectory
 
     X = np.tile(mech.nominal_pose, (3, 1))
     rep = check_trajectory(mech, [0.0, 1.0, 2.0], X)

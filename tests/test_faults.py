@@ -608,7 +608,7 @@ def test_two_concurrent_runs_one_is_refused(tmp_path):
 
 def test_mesh_in_slabs_is_the_same_watertight_mesh(monkeypatch):
     import pkmlab
-    import pkmlab.workspaces.mesh as mesh_mod
+    import pkmlab.workspaces.output.mesh as mesh_mod
     from pkmlab.workspaces import workspace
 
     res = workspace(pkmlab.load_mechanism(HW), "constant", resolution=4.0)

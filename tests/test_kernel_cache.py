@@ -1,7 +1,7 @@
 """numba's disk cache of the family kernels: no aliasing across processes, and invalidation.
 
 Kernels compiled by different processes into one ``NUMBA_CACHE_DIR`` and then loaded together
-by a third process must each run their own code (see ``pkmlab._jit``), and editing a family's
+by a third process must each run their own code (see ``pkmlab.runtime.jit``), and editing a family's
 source must recompile its kernels. The references are plain NumPy formulas, computed here.
 """
 
@@ -24,7 +24,7 @@ from pkmlab.poses import euler_to_matrix  # plain NumPy
 SRC = Path(pkmlab.__file__).resolve().parents[1]
 MECH_DIR = Path(__file__).resolve().parents[1] / "studies" / "mechanisms"
 # psu6 and ups6 pass geometry tuples of the same length, so their kernels have the same argument
-# types and, before pkmlab._jit, could get the same symbols (luzi3's could not: 28 floats).
+# types and, before pkmlab.runtime.jit, could get the same symbols (luzi3's could not: 28 floats).
 FILES = {"psu6": "hopkins-williams-6psu.yaml", "ups6": "gough-stewart-6ups.yaml"}
 # Poses (mm, rad) around each family's nominal pose, a few of them outside the workspace.
 _rng = np.random.default_rng(7)
@@ -40,7 +40,7 @@ SCRIPT = '''
 import json, sys
 import numpy as np
 import pkmlab
-from pkmlab.mechanisms import column_kernels, _kernels
+from pkmlab.mechanisms.kernels import columns as column_kernels, ik as _kernels
 from pkmlab.poses import euler_to_matrix
 
 from numba.extending import register_jitable
@@ -236,7 +236,7 @@ def check_columns(family, r):
 
 def test_parallel_and_family_kernels_are_built_safely():
     """Every ``parallel=True`` kernel and every closure compiled by numba goes through
-    ``pkmlab._jit`` (whose naming makes cached kernels unique), none is declared directly."""
+    ``pkmlab.runtime.jit`` (whose naming makes cached kernels unique), none is declared directly."""
     bad = []
     for path in SRC.joinpath("pkmlab").rglob("*.py"):
         text = path.read_text()
@@ -253,7 +253,7 @@ def test_uid_namespace_of_a_kernel():
     far above the ordinary ones, which carry on afterwards as if nothing happened."""
     from numba.core.bytecode import FunctionIdentity
 
-    from pkmlab import _jit
+    from pkmlab.runtime import jit as _jit
 
     assert _jit.CACHE_SAFE            # else this numba's internals changed: kernels uncached
 
@@ -275,8 +275,8 @@ def test_uid_namespace_of_a_kernel():
 def test_identity_tells_functions_apart():
     """Two per-pose functions of one module, or one reached through another function, give
     different identities; the same function gives the same one every time."""
-    from pkmlab import _jit
-    from pkmlab.mechanisms import luzi3, psu6, ups6
+    from pkmlab.mechanisms.families import luzi3, psu6, ups6
+    from pkmlab.runtime import jit as _jit
 
     ids = [_jit.identity(f) for f in (psu6._psu_one, psu6._psu_column_leg, ups6._ups_one,
                                       luzi3._luzi_one, luzi3._luzi_chain)]
@@ -324,7 +324,7 @@ from numba import njit
 from numba.extending import register_jitable
 
 from famx_helpers import offset
-from pkmlab.mechanisms import _kernels
+from pkmlab.mechanisms.kernels import ik as _kernels
 
 SCALE = 1.0
 
@@ -354,7 +354,7 @@ FAMILY_SCRIPT = '''
 import json
 import numpy as np
 import famx
-from pkmlab.mechanisms import column_kernels, _kernels
+from pkmlab.mechanisms.kernels import columns as column_kernels, ik as _kernels
 
 X = np.array([[0.0, 0.0, 10.0, 0.0, 0.0, 0.0]])
 q, st, reason = np.empty((1, 6)), np.empty((1, 6), np.int8), np.empty(1, np.int8)
@@ -408,7 +408,7 @@ def test_compiling_a_kernel_shows_no_numba_ir_warning(monkeypatch):
     from numba import types as nt
     from numba.core.errors import NumbaIRAssumptionWarning
 
-    from pkmlab import _jit
+    from pkmlab.runtime import jit as _jit
 
     real = _jit.njit
 
@@ -430,7 +430,9 @@ def test_compiling_a_kernel_shows_no_numba_ir_warning(monkeypatch):
 
 
 _RELOAD = """
-from pkmlab.mechanisms import column_kernels, _kernels, _search, _tiles, psu6, ups6
+from pkmlab.mechanisms.families import psu6, ups6
+from pkmlab.mechanisms.kernels import columns as column_kernels, ik as _kernels
+from pkmlab.mechanisms.kernels import search as _search, tiles as _tiles
 
 missed = []
 for fam in (psu6.PSU6, ups6.UPS6):

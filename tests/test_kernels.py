@@ -1,4 +1,4 @@
-"""The blocked inverse-kinematics drivers of ``pkmlab.mechanisms._kernels``."""
+"""The blocked inverse-kinematics drivers of ``pkmlab.mechanisms.kernels.ik``."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 from conftest import random_valid_poses
 from numba import njit
 
-from pkmlab.mechanisms import _kernels
+from pkmlab.mechanisms.kernels import ik as _kernels
 from pkmlab.poses import as_frames
 
 

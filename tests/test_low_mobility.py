@@ -194,8 +194,8 @@ def test_blocks_a_translational_mechanism_cannot_serve_are_refused_naming_the_fi
 def test_analyses_still_on_six_coordinates_refuse_the_tripod_naming_the_mechanism(tripod):
     """Brackets, optima and trajectory checks are not yet sized from the mobility: they refuse
     (now that workspace() accepts the tripod, a bracket would otherwise run on it)."""
-    from pkmlab.workspaces.bracket import volume_bracket
-    from pkmlab.workspaces.optima import orientation_capability
+    from pkmlab.workspaces.bracket.columns import volume_bracket
+    from pkmlab.workspaces.optima.search import orientation_capability
 
     for call, what in ((lambda: volume_bracket(tripod, "constant", resolution=H),
                         "volume brackets"),

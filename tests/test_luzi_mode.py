@@ -1,5 +1,5 @@
 """The luzi3 working mode (each upper link keeps the branch, sign of n·r, that it has at the
-nominal pose; module notes of pkmlab.mechanisms.luzi3): the inverse kinematics reports the
+nominal pose; module notes of pkmlab.mechanisms.families.luzi3): the inverse kinematics reports the
 mirror image below the base as outside it, and every workspace kind keeps to it
 (docs/validation.md, "The luzi3 working mode"). The branch is recomputed here from its
 geometric meaning, the sign of k · d_i with d_i the part of C_i - A_i1 normal to the base
@@ -17,7 +17,7 @@ from pkmlab.mechanisms import LEG_STATUS, NO_STROKE, Luzi3
 from pkmlab.poses import as_frames, matrix_to_euler
 from pkmlab.testing import cell_points
 from pkmlab.workspaces import OrientationSet, workspace
-from pkmlab.workspaces.bracket import volume_bracket
+from pkmlab.workspaces.bracket.columns import volume_bracket
 
 OTHER = {v: k for k, v in LEG_STATUS.items()}["leg outside the working mode"]
 BOX = OrientationSet.box((math.radians(5),) * 3, samples=3)

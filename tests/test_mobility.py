@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 from numba.extending import register_jitable
 
-from pkmlab.mechanisms import PLANAR, REGISTRY, SPATIAL, TRANSLATIONAL, _kernels, register_family
+from pkmlab.mechanisms import PLANAR, REGISTRY, SPATIAL, TRANSLATIONAL, register_family
+from pkmlab.mechanisms.kernels import ik as _kernels
 from pkmlab.mechanisms.mobility import Mobility
 from pkmlab.testing import run_contract
 

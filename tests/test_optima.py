@@ -17,11 +17,14 @@ from conftest import assert_point_holds
 from scipy.optimize import minimize
 
 from pkmlab import UPS6, load_mechanism
-from pkmlab.mechanisms import NO_STROKE, _kernels, _tiles, column_kernels
+from pkmlab.mechanisms import NO_STROKE
+from pkmlab.mechanisms.kernels import columns as column_kernels
+from pkmlab.mechanisms.kernels import ik as _kernels
+from pkmlab.mechanisms.kernels import tiles as _tiles
 from pkmlab.poses import euler_to_matrix
 from pkmlab.workspaces import OrientationSet
 from pkmlab.workspaces.engine import _grid_xy
-from pkmlab.workspaces.optima import orientation_capability, stroke_needed
+from pkmlab.workspaces.optima.search import orientation_capability, stroke_needed
 
 
 @pytest.fixture(scope="module")

@@ -13,7 +13,7 @@ from scipy.optimize import minimize_scalar
 
 import pkmlab
 from pkmlab.mechanisms import Luzi3
-from pkmlab.mechanisms.luzi3 import four_bar_theta, pose_to_psi, psi_to_pose, reduced_dpa
+from pkmlab.mechanisms.families.luzi3 import four_bar_theta, pose_to_psi, psi_to_pose, reduced_dpa
 from pkmlab.poses import as_frames, euler_to_matrix, log_so3
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))

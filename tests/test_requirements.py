@@ -23,10 +23,10 @@ from pkmlab import load_mechanism
 from pkmlab.cli import app
 from pkmlab.errors import ParameterError
 from pkmlab.mechanisms import PSU6, UPS6
+from pkmlab.motion.dynamics import inverse_dynamics
+from pkmlab.motion.motions import load_motion_csv, sinusoid_motion
+from pkmlab.motion.payload import GRAVITY, MassProperties
 from pkmlab.requirements.actuators import ActuatorSpec, fit
-from pkmlab.requirements.dynamics import inverse_dynamics
-from pkmlab.requirements.motions import load_motion_csv, sinusoid_motion
-from pkmlab.requirements.payload import GRAVITY, MassProperties
 from pkmlab.requirements.task import TaskRegion, task_contained, task_margins
 from pkmlab.study import load_study, study_from_mapping
 from pkmlab.study.evaluators import evaluate_design
@@ -548,8 +548,8 @@ def test_slender_rod_legs_in_the_power_balance():
     """6-UPS with uniform slender-rod legs (8 kg each): Σ f·q̇ (q̇ from the IK by finite
     differences) = d/dt of the platform's energy plus each rod's (m/6)|Ḃ|² + m·g·(A_z + B_z)/2,
     the rods' end points taken from ``leg_segments``; to 1e-6 relative."""
+    from pkmlab.motion.payload import combine, leg_end_masses, leg_rod_masses
     from pkmlab.poses import as_frames
-    from pkmlab.requirements.payload import combine, leg_end_masses, leg_rod_masses
 
     mech = _ups()
     mleg = 8.0
@@ -588,7 +588,7 @@ def test_slender_rod_legs_in_the_power_balance():
 
 def test_rod_legs_need_fixed_base_joints():
     mech = load_mechanism(MECH_DIR / "hopkins-williams-6psu.yaml")
-    from pkmlab.requirements.payload import leg_rod_masses
+    from pkmlab.motion.payload import leg_rod_masses
 
     with pytest.raises(ParameterError, match=r"legs\.model"):
         leg_rod_masses(mech, 1.0)

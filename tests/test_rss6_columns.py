@@ -1,4 +1,4 @@
-"""6-RSS exact column method (``mechanisms/_crank.py``) against dense brute force.
+"""6-RSS exact column method (``mechanisms/legs/crank.py``) against dense brute force.
 
 The crank leg's feasible z set on a column comes from quartic and quadratic roots; here it is
 checked against the IK kernel itself evaluated on a fine z grid (lengths within the grid

@@ -14,8 +14,8 @@ from typer.testing import CliRunner
 import pkmlab
 from pkmlab.config import workspace_spec
 from pkmlab.mechanisms import NO_STROKE, RSS6
+from pkmlab.motion.payload import GRAVITY, MassProperties
 from pkmlab.poses import as_frames
-from pkmlab.requirements.payload import GRAVITY, MassProperties
 from pkmlab.requirements.static import static_loads
 from pkmlab.study.evaluators import EVALUATORS, Context
 from pkmlab.workspaces import Constraints, JointLimits, OrientationSet, workspace

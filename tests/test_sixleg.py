@@ -14,7 +14,7 @@ from conftest import ROOT, SHIPPED
 import pkmlab
 from pkmlab.errors import ParameterError
 from pkmlab.mechanisms import NO_STROKE, SixLeg
-from pkmlab.mechanisms.sixleg_layout import paired_sixleg, rail_axes
+from pkmlab.mechanisms.families.sixleg_layout import paired_sixleg, rail_axes
 from pkmlab.poses import euler_to_matrix
 from pkmlab.testing import random_valid_poses
 from pkmlab.workspaces import OrientationSet, workspace

@@ -5,7 +5,7 @@ the same column sets and workspace volumes as ``rss6``'s own exact crank method 
 against dense IK in ``test_rss6_columns.py``), and its interval ends must be where the
 *sixleg's own* IK kernel flips validity. Paths that need single-interval radial legs (refine,
 exact task check, continuous optima) must decline it as they decline ``rss6``. Inclined and
-horizontal rails (``mechanisms/_slider.py``) are checked against the IK on a dense z grid and
+horizontal rails (``mechanisms/legs/slider.py``) are checked against the IK on a dense z grid and
 at 1e-9 mm either side of every interval end.
 """
 
@@ -21,7 +21,7 @@ from pkmlab.mechanisms import RSS6, SixLeg
 from pkmlab.requirements.task import TaskRegion, task_contained
 from pkmlab.testing import check_columns
 from pkmlab.workspaces import Constraints, OrientationSet, workspace
-from pkmlab.workspaces.optima import supports_continuous
+from pkmlab.workspaces.optima.search import supports_continuous
 
 EPS = 1e-9                                         # boundary probe (mm)
 FILE = ROOT / "studies/mechanisms/instructables-servo-6rss.yaml"
@@ -170,7 +170,7 @@ def test_slider_interval_against_a_numpy_scan():
     """:func:`._slider.slider_interval` on 300 random legs (inclination ±80°, any heading,
     branch, side, window) against the leg conditions evaluated in NumPy (h² ≥ 0, side, stroke)
     on a 0.05 mm z grid: the sets differ only at grid points next to the interval ends."""
-    from pkmlab.mechanisms._slider import slider_interval
+    from pkmlab.mechanisms.legs.slider import slider_interval
 
     rng = np.random.default_rng(7)
     zs = np.arange(-1200.0, 1200.0, 0.05)

@@ -28,12 +28,12 @@ from scipy import ndimage
 import pkmlab
 from pkmlab.errors import ParameterError
 from pkmlab.mechanisms import LEG_STATUS
-from pkmlab.mechanisms.sixleg import SixLeg
+from pkmlab.mechanisms.families.sixleg import SixLeg
 from pkmlab.poses import as_frames, matrix_to_euler
 from pkmlab.requirements.task import TaskRegion, task_contained
 from pkmlab.testing import check_columns, random_sixleg
 from pkmlab.workspaces import Constraints, OrientationSet, workspace
-from pkmlab.workspaces.bracket import volume_bracket
+from pkmlab.workspaces.bracket.columns import volume_bracket
 
 
 def _mixed(lo: float, hi: float) -> SixLeg:

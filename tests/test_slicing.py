@@ -13,15 +13,15 @@ import pkmlab
 from pkmlab.cli import app
 from pkmlab.config import workspace_spec
 from pkmlab.errors import ParameterError
-from pkmlab.workspaces.mesh import STL_HEADER
-from pkmlab.workspaces.plots import (
+from pkmlab.workspaces.output.mesh import STL_HEADER
+from pkmlab.workspaces.output.plots import (
     SlicePicture,
     overlay_figure,
     png_bytes,
     slice_figure,
     write_slice_pictures,
 )
-from pkmlab.workspaces.slicing import MAX_PANELS, nice_ceil, slice_layout
+from pkmlab.workspaces.output.slicing import MAX_PANELS, nice_ceil, slice_layout
 
 HOPKINS = MECH_DIR / "hopkins-williams-6psu.yaml"
 
@@ -138,7 +138,7 @@ def test_ply_carries_metric_values_as_vertex_properties(small, tmp_path):
 
 
 def test_metric_slices_are_not_washed_out_by_a_few_near_singular_voxels(small):
-    from pkmlab.workspaces.plots import _colour_range
+    from pkmlab.workspaces.output.plots import _colour_range
 
     values = np.full(small.occupancy.shape, np.nan)
     values[small.occupancy] = np.linspace(5.0, 9.0, int(small.occupancy.sum()))
@@ -183,7 +183,7 @@ def test_auto_window_also_shows_the_task_overlay(small):
     101.6 mm task box fell outside its 90 mm window and the title promised red outlines that
     no panel showed. The sections' heights stay the workspace's; the paper layout and an
     explicit window keep theirs."""
-    from pkmlab.workspaces.plots import sections_layout
+    from pkmlab.workspaces.output.plots import sections_layout
 
     task = np.array([[-150.0, -120.0], [150.0, -120.0], [150.0, 120.0], [-150.0, 120.0],
                      [-150.0, -120.0]])

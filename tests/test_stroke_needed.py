@@ -22,7 +22,7 @@ from pkmlab.poses import euler_to_matrix
 from pkmlab.study import SerialRunner, run_study, study_from_mapping
 from pkmlab.study.evaluators import evaluate_mechanism
 from pkmlab.workspaces import OrientationSet
-from pkmlab.workspaces.optima import stroke_needed
+from pkmlab.workspaces.optima.search import stroke_needed
 
 HOPKINS = MECH_DIR / "hopkins-williams-6psu.yaml"
 UPS = MECH_DIR / "gough-stewart-6ups.yaml"
@@ -227,7 +227,7 @@ def test_second_order_certification_holds_where_links_are_near_horizontal():
     bounds lift the certified lower end from 43.52° (first order) to ≥ 44.0°; the certified
     point keeps every leg in stroke at 20,000 random orientations, the corners and local
     minima of its margin (inverse kinematics)."""
-    from pkmlab.workspaces.optima import orientation_capability
+    from pkmlab.workspaces.optima.search import orientation_capability
 
     mech = load_mechanism({
         "name": "pareto-1", "family": "psu6", "link_length": "295.6 mm",

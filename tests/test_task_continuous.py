@@ -18,7 +18,7 @@ from pkmlab.poses import euler_to_matrix
 from pkmlab.requirements import task as task_mod
 from pkmlab.requirements.task import TaskRegion, task_contained, task_margins
 from pkmlab.workspaces import OrientationSet
-from pkmlab.workspaces.binding import column_ends
+from pkmlab.workspaces.optima.binding import column_ends
 
 HALF = np.radians(15.0)
 

@@ -1,4 +1,4 @@
-"""Threading policy (pkmlab.threads): OpenMP threads sleep, small calls and workers use one
+"""Threading policy (pkmlab.runtime.threads): OpenMP threads sleep, small calls and workers use one
 numba thread. The busy-machine timings themselves are in benchmarks/bench_load.py."""
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ import pytest
 from conftest import MECH_DIR
 
 import pkmlab
+from pkmlab.runtime.threads import SMALL_WORK, threads_for
 from pkmlab.study import runners
-from pkmlab.threads import SMALL_WORK, threads_for
 
 _PROBE = ("import os, pkmlab, numpy as np; "
           "m = pkmlab.load_mechanism({f!r}); m.inverse(np.tile(m.nominal_pose, (50000, 1))); "

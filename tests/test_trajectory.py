@@ -1,4 +1,4 @@
-"""Trajectory generation, CSV input and the stroke / speed / force check (pkmlab.trajectory)."""
+"""Trajectory generation, CSV input and the stroke / speed / force check (pkmlab.motion)."""
 
 from __future__ import annotations
 
@@ -13,8 +13,7 @@ from conftest import MECH_DIR
 import pkmlab
 from pkmlab import PSU6, ParameterError
 from pkmlab import dexterity as dx
-from pkmlab.poses import as_frames, exp_so3
-from pkmlab.trajectory import (
+from pkmlab.motion import (
     PAPER_AXES,
     check_trajectory,
     load_csv,
@@ -23,6 +22,7 @@ from pkmlab.trajectory import (
     paper_motion_phases,
     plot_actuators,
 )
+from pkmlab.poses import as_frames, exp_so3
 
 HOPKINS = pkmlab.load_mechanism(MECH_DIR / "hopkins-williams-6psu.yaml")
 A_MM, A_RAD = 50.8, math.radians(30.0)

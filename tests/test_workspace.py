@@ -132,7 +132,7 @@ def test_stl_written_without_trimesh_equals_trimesh_export(hopkins, tmp_path):
     the same triangles, normals and orientation as trimesh's export of the merged mesh."""
     import trimesh
 
-    from pkmlab.workspaces.mesh import STL_HEADER
+    from pkmlab.workspaces.output.mesh import STL_HEADER
 
     res = workspace(hopkins, "dexterous", BOX15, 2.5)
     ours = res.save_mesh(tmp_path / "w.stl").read_bytes()

@@ -20,8 +20,8 @@ from conftest import MECH_DIR
 
 import pkmlab
 from pkmlab import dexterity as dx
-from pkmlab.mechanisms.sixleg import SixLeg
-from pkmlab.mechanisms.sixleg_layout import paired_sixleg
+from pkmlab.mechanisms.families.sixleg import SixLeg
+from pkmlab.mechanisms.families.sixleg_layout import paired_sixleg
 from pkmlab.workspaces import Constraints, workspace
 
 HEXAGLIDE = pkmlab.load_mechanism(MECH_DIR / "hexaglide-6pus.yaml")

@@ -302,7 +302,7 @@ class WorkspaceSpec(_Model):
                                       "layout's)")
 
     def slice_options(self) -> dict:
-        """Keyword arguments of :func:`pkmlab.workspaces.plots.slice_figure`."""
+        """Keyword arguments of :func:`pkmlab.workspaces.output.plots.slice_figure`."""
         return {"layout": self.slice_layout, "window": self.slice_window,
                 "spacing": self.slice_spacing}
 

@@ -1,7 +1,7 @@
 """YAML model of the generic six-leg family (``family: sixleg``).
 
 Either six explicit ``legs``, each ``{base, platform, actuator}``, or a ``generator`` (three
-pairs on two circles, :func:`pkmlab.mechanisms.sixleg_layout.paired_sixleg`) with one
+pairs on two circles, :func:`pkmlab.mechanisms.families.sixleg_layout.paired_sixleg`) with one
 ``actuator`` template. Quantities carry units and are converted once, here: lengths in mm,
 angles in deg when bare. The shared actuator window is ``stroke`` (lengths) when the legs are
 prismatic or sliders and ``servo_range`` (angles) when they are cranks; both are typed
@@ -24,8 +24,8 @@ from pydantic import Field
 
 from .errors import ParameterError
 from .mechanisms import Mechanism
-from .mechanisms.sixleg import SixLeg
-from .mechanisms.sixleg_layout import paired_sixleg
+from .mechanisms.families.sixleg import SixLeg
+from .mechanisms.families.sixleg_layout import paired_sixleg
 from .quantities import Angle, AngleWindow, PositiveLength, Stroke, Vector3
 from .specbase import PairedCircles, _Common, _Model
 

@@ -12,10 +12,10 @@ __all__ = ["SEGMENT_TIME_S", "MEMORY_FRACTION", "TIME_LIMIT_S", "LENGTH_MAX_MM",
 #: Duration of one leg of the paper's lobe motion (s): 1 ms .. 1 day.
 SEGMENT_TIME_S = (1e-3, 86400.0)
 #: Default memory budget of one command: this share of the machine's physical memory
-#: (``PKMLAB_MEMORY_LIMIT`` overrides it; see :mod:`pkmlab.memory`).
+#: (``PKMLAB_MEMORY_LIMIT`` overrides it; see :mod:`pkmlab.runtime.memory`).
 MEMORY_FRACTION = 0.5
 #: Default time budget of one command (s): one day (``PKMLAB_TIME_LIMIT`` overrides it; see
-#: :mod:`pkmlab.time_budget`).
+#: :mod:`pkmlab.runtime.time_budget`).
 TIME_LIMIT_S = 86400.0
 #: Largest length magnitude anywhere (mm): 1 km; beyond it products of lengths overflow and
 #: printed values become unreadable.

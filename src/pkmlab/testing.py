@@ -372,7 +372,7 @@ def random_sixleg(rng, kinds, lower: str, rails: str = "any", tries: int = 50):
     ``rails``: ``"vertical"`` (±z exactly), ``"inclined"`` (10°-80° above the horizontal),
     ``"horizontal"`` or ``"any"`` (one of the three per slider). Prismatic legs hang below
     their base joint (working side -1) with probability 1/4."""
-    from .mechanisms.sixleg import SixLeg
+    from .mechanisms.families.sixleg import SixLeg
 
     kinds = list(kinds)
     crank = kinds[0] == "crank"

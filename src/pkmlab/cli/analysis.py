@@ -13,7 +13,7 @@ from rich.markup import escape
 
 from ..errors import ParameterError
 from ..export import exporters
-from ..progress import log_lines
+from ..runtime.progress import log_lines
 from ..units import parse_length
 from .common import (
     AllComponentsOpt,
@@ -89,7 +89,7 @@ def dexterity(
 
     from ..dexterity.maps import METRICS, mesh_colours, vertex_values
     from ..dexterity.report import dexterity_report
-    from ..workspaces.plots import plot_slices
+    from ..workspaces.output.plots import plot_slices
 
     mech = _load(mech_file)
     spec, req = _request(kind, orientation, box, semantics, tilt, torsion, samples, resolution,
@@ -227,7 +227,7 @@ def trajectory(
     import shutil
     import tempfile
 
-    from .. import trajectory as tr
+    from .. import motion as tr
 
     mech = _load(mech_file)
     if (csv is None) == (not paper_motion):

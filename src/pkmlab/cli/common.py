@@ -174,7 +174,7 @@ def _request(kind, orientation, box, semantics, tilt, torsion, samples, resoluti
              slice_layout="auto"):
     """CLI workspace options → validated request (the config module does the validation)."""
     from ..config import workspace_spec
-    from ..workspaces.slicing import LAYOUTS
+    from ..workspaces.output.slicing import LAYOUTS
 
     if slice_layout not in LAYOUTS:
         _fail(ParameterError("--slice-layout", f"one of {list(LAYOUTS)}", slice_layout))

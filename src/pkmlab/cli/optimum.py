@@ -1,5 +1,5 @@
 """Continuous optima with their brackets: ``pkmlab optimum stroke`` and ``pkmlab optimum
-capability`` (the analysis is :mod:`pkmlab.workspaces.optima`)."""
+capability`` (the analysis is :mod:`pkmlab.workspaces.optima.search`)."""
 
 from __future__ import annotations
 
@@ -53,7 +53,7 @@ def stroke(
     simultaneous Euler box has a dexterous position, bracketed: lower end proved (branch and
     bound over continuous positions for a sample of the box), upper end a certified point."""
     from ..workspaces import OrientationSet
-    from ..workspaces.optima import stroke_needed
+    from ..workspaces.optima.search import stroke_needed
 
     mech = _load(mech_file)
     try:
@@ -92,7 +92,7 @@ def capability(
     """The largest ±a simultaneous Euler box with a dexterous position, bracketed: lower end a
     point certified for the continuous box, upper end a box whose sample admits no position
     (branch and bound over continuous positions)."""
-    from ..workspaces.optima import orientation_capability
+    from ..workspaces.optima.search import orientation_capability
 
     mech = _load(mech_file)
     try:

@@ -111,7 +111,7 @@ def _progress_bar(total: int):
             return Text(f"{task.speed:.1f} candidates/s" if task.speed else "… candidates/s")
 
     if not err.is_terminal:
-        from ..progress import ProgressLines
+        from ..runtime.progress import ProgressLines
 
         return None, ProgressLines(total, sys.stderr)
     prog = Progress(TextColumn("evaluating"), BarColumn(), MofNCompleteColumn(), Rate(),
@@ -170,7 +170,7 @@ def run(
     """Run a design study: evaluate candidates, keep every result, report the Pareto set."""
     import time
 
-    from ..progress import log_lines
+    from ..runtime.progress import log_lines
     from ..study.folder import OutputLock, check_output
     from ..study.optimisers import expected_evaluations
     from ..study.report import export_designs, pareto_records, write_report
@@ -259,7 +259,7 @@ def report(results_dir: Annotated[Path, typer.Argument(help="a study's results f
            as_json: JsonOpt = False) -> None:
     """Rebuild the tables, Pareto plot, summary and report.html from the store and the
     exported designs (no re-evaluation)."""
-    from ..progress import log_lines
+    from ..runtime.progress import log_lines
     from ..study.folder import OutputLock
     from ..study.report import write_report
     from ..webreport import write_study_page

@@ -12,7 +12,7 @@ from rich.table import Table
 
 from ..errors import ParameterError
 from ..export import exporters
-from ..progress import log_lines
+from ..runtime.progress import log_lines
 from .common import (
     AllComponentsOpt,
     BoxOpt,
@@ -41,7 +41,7 @@ from .common import (
 def _write_workspace(res, out_dir: Path, mesh_formats: list[str], slices: dict) -> list[Path]:
     """Write every output into a scratch folder first, then move it into ``out_dir``;
     ``slices``: the slice layout (``WorkspaceSpec.slice_options()``)."""
-    from ..atomic import staged
+    from ..runtime.atomic import staged
 
     for fmt in exporters("mesh"):
         (out_dir / f"workspace.{fmt}").unlink(missing_ok=True)
@@ -185,7 +185,7 @@ def workspace(
 
             extra["orientation_convergence"] = orientation_convergence(mech, **req)
         if bracket:
-            from ..workspaces.bracket import volume_bracket
+            from ..workspaces.bracket.columns import volume_bracket
 
             if not (bracket_budget > 0):
                 raise ParameterError("--bracket-budget", "a time > 0 s", bracket_budget)

@@ -20,8 +20,8 @@ import numpy as np
 from numba import njit, prange
 from numba import types as nt
 
-from .._jit import cached_kernel
-from ..threads import threads_for
+from ..runtime.jit import cached_kernel
+from ..runtime.threads import threads_for
 
 __all__ = ["singular_values", "sweep_bounds", "KAPPA_BRACKET"]
 
@@ -114,7 +114,7 @@ def _parallel_loop(J, out):
 @cache
 def _parallel():
     """:func:`_parallel_loop` compiled on numba's thread pool; a parallel kernel is cached only
-    through :func:`pkmlab._jit.cached_kernel` (see there why)."""
+    through :func:`pkmlab.runtime.jit.cached_kernel` (see there why)."""
     return cached_kernel(_parallel_loop, nt.void(nt.float64[:, :, ::1], nt.float64[:, ::1]),
                          parallel=True, error_model="numpy")
 
@@ -209,7 +209,7 @@ def sweep_bounds(J, L, fmax, kup, force, det) -> None:
     on κ(J_h), from one LU factorisation (partial pivoting) and the inverse, written into
     ``kup``, ``force`` and ``det`` (C-contiguous float64 ``(M,)``); on numba's threads in
     tasks of :data:`_SWEEP_TASK` poses (one thread for a small stack,
-    :func:`pkmlab.threads.threads_for`).
+    :func:`pkmlab.runtime.threads.threads_for`).
 
     * ``force[m] = min_i fmax_i / ‖(J⁻ᵀ)_{i,0:3}‖`` (N; :func:`max_force_all_directions`);
     * ``kup[m] >= κ(J_h) = σmax(J_h)·σmax(J_h⁻¹)``, from ``λmax(G) <= tr(G^(2^k))^(2^-k)`` for
@@ -250,7 +250,7 @@ def _sweep_loop(J, L, fmax, kup, force, det):
 @cache
 def _sweep():
     """:func:`_sweep_loop` compiled on numba's thread pool (cached through
-    :func:`pkmlab._jit.cached_kernel`, like every parallel kernel)."""
+    :func:`pkmlab.runtime.jit.cached_kernel`, like every parallel kernel)."""
     f1 = nt.float64[::1]
     return cached_kernel(_sweep_loop, nt.void(nt.float64[:, :, ::1], nt.float64, f1, f1, f1, f1),
                          parallel=True, error_model="numpy")

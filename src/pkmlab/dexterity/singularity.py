@@ -33,7 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..mechanisms import NO_STROKE, _kernels
+from ..mechanisms import NO_STROKE
+from ..mechanisms.kernels import ik as _kernels
 from ..poses import as_frames
 from .metrics import CharacteristicLength, lci, resolve_length
 

@@ -106,7 +106,7 @@ def exporter_for(path: str | Path, subject: str = "mesh", what: str = "mesh file
 def write(obj: Any, path: str | Path, subject: str = "mesh", **options) -> Path:
     """Write ``obj`` to ``path`` in the format of its suffix, atomically; options the format
     does not understand are dropped (a colour for an STL)."""
-    from ..atomic import write_bytes
+    from ..runtime.atomic import write_bytes
 
     ex = exporter_for(path, subject)
     kw = {k: v for k, v in options.items() if k in ex.options and v is not None}

@@ -16,13 +16,13 @@ listed in :data:`PLUGIN_ERRORS`, never fatal.
 from __future__ import annotations
 
 from .base import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult, Mechanism
+from .families.luzi3 import Luzi3
+from .families.psu6 import PSU6
+from .families.rss6 import RSS6
+from .families.sixleg import SixLeg
+from .families.ups6 import UPS6
 from .joints import Joint, Leg, Link, Parameters
-from .luzi3 import Luzi3
 from .mobility import PLANAR, SPATIAL, TRANSLATIONAL, Mobility
-from .psu6 import PSU6
-from .rss6 import RSS6
-from .sixleg import SixLeg
-from .ups6 import UPS6
 
 #: family name → mechanism class (built-in families, then plugins once loaded)
 REGISTRY: dict[str, type[Mechanism]] = {cls.family: cls for cls in (PSU6, UPS6, Luzi3, RSS6,

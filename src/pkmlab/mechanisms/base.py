@@ -45,11 +45,12 @@ method whose name starts with ``_``):
   ``column_method``, ``column_leg``, ``column_params()``, ``leg_offsets(R)`` and
   ``column_intervals(xs, ys, R, mode)`` (and ``column_radial`` when the leg intervals are
   monotone functions of the distance from the leg's column axis, with ``column_profile()``
-  giving their closed form for the guaranteed volume bracket, :mod:`pkmlab.workspaces.bracket`);
+  giving their closed form for the guaranteed volume bracket,
+  :mod:`pkmlab.workspaces.bracket.columns`);
   families without column kernels may set ``cell_bounds`` and give ``leg_cell_bounds(p, R,
   delta, alpha)`` (each leg's length and a bound on its change over a position ball × rotation
   cell; ``leg_cell_margins`` when feasibility needs more than the window, rss6) for the cell
-  bracket, :mod:`pkmlab.workspaces.bracket_cells`;
+  bracket, :mod:`pkmlab.workspaces.bracket.cells`;
 * equality and hashing by geometry (two mechanisms with the same family, joints, stroke, tool
   offset and nominal pose are equal, whatever their names).
 
@@ -91,10 +92,12 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..poses import as_frames, log_so3
-from ..threads import threads_for
+from ..runtime.threads import threads_for
 from ..tolerances import TOL
-from . import _kernels, _tiles, column_kernels
 from .joints import JointsMixin
+from .kernels import columns as column_kernels
+from .kernels import ik as _kernels
+from .kernels import tiles as _tiles
 from .mobility import SPATIAL, Mobility
 from .results import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult
 from .solvers import bracketed_root, forward_newton, multistart_modes
@@ -164,7 +167,7 @@ class Mechanism(JointsMixin):
     column_leg: ClassVar[Any] = None
 
     #: True when the family gives :meth:`leg_cell_bounds` (luzi3): the volume bracket then
-    #: works on position cells × orientation cells (:mod:`pkmlab.workspaces.bracket_cells`).
+    #: works on position cells × orientation cells (:mod:`pkmlab.workspaces.bracket.cells`).
     cell_bounds: ClassVar[bool] = False
     #: True when the family also gives ``leg_position_curvature(p, R, delta)`` (each leg's
     #: gradient in the position and a bound on its second derivative over a ball): the cell

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..poses import exp_so3
-from . import _kernels
+from .kernels import ik as _kernels
 
 #: Stroke override of :meth:`Mechanism.inverse` that checks geometry only.
 NO_STROKE = (-math.inf, math.inf)

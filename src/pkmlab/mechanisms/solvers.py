@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..poses import as_frames, frames_to_poses, log_so3
 from ..tolerances import TOL
-from . import _kernels
+from .kernels import ik as _kernels
 from .results import NO_STROKE, AssemblyModes, FKResult, step_frames
 
 

@@ -13,8 +13,8 @@ import math
 
 import numpy as np
 
+from ..motion.dynamics import DynamicsResult
 from .actuators import ActuatorSpec, motor_demand
-from .dynamics import DynamicsResult
 
 __all__ = ["actuator_figure", "actuator_plot_data"]
 

@@ -22,6 +22,8 @@ from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSche
 
 from ..config import read_yaml, validate_model
 from ..errors import ParameterError, format_value
+from ..motion import motions as mo
+from ..motion.payload import MassProperties, combine, leg_end_masses, leg_rod_masses
 from ..quantities import Angle, Length
 from ..units import (
     ANGULAR_SPEED_UNITS,
@@ -37,9 +39,7 @@ from ..units import (
     parse_physical,
 )
 from ..workspaces.orientations import OrientationSet
-from . import motions as mo
 from .actuators import ActuatorSpec
-from .payload import MassProperties, combine, leg_end_masses, leg_rod_masses
 from .task import TaskRegion
 
 __all__ = ["TaskSpec", "MotionSpec", "PayloadSpec", "ActuatorsSpec", "TaskPlan",

@@ -21,9 +21,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..dexterity.metrics import is_singular
+from ..motion.dynamics import platform_wrench
+from ..motion.payload import GRAVITY, MassProperties
 from ..poses import matrix_to_euler
-from .dynamics import platform_wrench
-from .payload import GRAVITY, MassProperties
 
 __all__ = ["StaticLoads", "static_loads"]
 

@@ -61,11 +61,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..mechanisms.column_kernels import make_leg_eval
+from ..mechanisms.kernels.columns import make_leg_eval
 from ..poses import as_frames, matrix_to_euler
 from ..workspaces import cells as oc
+from ..workspaces.bracket.legbounds import EPS
 from ..workspaces.constraints import Constraints, check
-from ..workspaces.legbounds import EPS
 from ..workspaces.orientations import OrientationSet
 
 __all__ = ["TaskRegion", "TaskCheck", "task_contained", "task_margins", "task_mesh",

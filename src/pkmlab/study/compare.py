@@ -14,7 +14,7 @@ request, so a compare row can be reproduced with the other commands:
   counting 0); κ range: the grid's smallest κ … :func:`pkmlab.dexterity.worst_case`'s worst κ
   (inf with a singular pose found inside or on the boundary); force: ``worst_case``'s
   smallest all-direction force;
-* the paper's ±2 in / ±30° motion: :func:`pkmlab.trajectory.check_trajectory`.
+* the paper's ±2 in / ±30° motion: :func:`pkmlab.motion.check_trajectory`.
 
 The inscribed shapes, GCI, κ and force are over the dexterous workspace, or over the level one
 when the dexterous one is empty (the row's ``reference`` says which).
@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import dexterity as dx
-from ..trajectory import check_trajectory, paper_motion
+from ..motion import check_trajectory, paper_motion
 from ..workspaces import OrientationSet, workspace
 
 log = logging.getLogger(__name__)
@@ -160,7 +160,7 @@ def plot_overlaid_slices(rows: list[dict], path: Path, which: int = 1,
     """Outlines of every design's workspace (``which``: 0 level, 1 dexterous; the level ones
     when every dexterous workspace is empty) per section, on one layout scaled to all of them
     (``layout="paper"``: Hopkins & Williams' 152.4 mm every 12.7 mm), as a PNG at ``path``."""
-    from ..workspaces.plots import overlay_figure
+    from ..workspaces.output.plots import overlay_figure
 
     res = [r["results"][which] for r in rows]
     if all(x.empty for x in res):

@@ -31,10 +31,10 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from .. import atomic
 from ..config import to_display
 from ..errors import NumericalError, ParameterError
 from ..export import exporters
+from ..runtime import atomic
 from .definition import Study
 from .folder import DESIGN_FOLDER
 from .run import BASELINE, objective_matrix
@@ -139,7 +139,7 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
     from ..dexterity.maps import METRICS as MAPS
     from ..dexterity.maps import drawn_voxels, mesh_colours, metric_map, vertex_values
     from ..workspaces import workspace
-    from ..workspaces.plots import SlicePicture, sections_layout, write_slice_pictures
+    from ..workspaces.output.plots import SlicePicture, sections_layout, write_slice_pictures
 
     d.mkdir(parents=True, exist_ok=True)
     params = study.space.baseline_values() if r["params"] == BASELINE else r["params"]
@@ -256,7 +256,7 @@ def _task_meshes(d: Path, mech, task, res, files: list, info: dict) -> None:
     import trimesh
 
     from ..requirements.task import task_mesh
-    from ..workspaces.mesh import write_mesh, write_scene
+    from ..workspaces.output.mesh import write_mesh, write_scene
 
     V, F = task_mesh(mech, task.region)
     tm = trimesh.Trimesh(V, F, process=False)
@@ -273,7 +273,7 @@ def _actuator_plots(d: Path, study: Study, mech, r: dict, info: dict, files: lis
     """``actuators-<motion>.png`` per required motion (forces or torques, speeds, the
     torque–speed curve, the chosen actuator's limits) and ``actuators.json`` (the numbers
     drawn)."""
-    from ..requirements.dynamics import inverse_dynamics
+    from ..motion.dynamics import inverse_dynamics
     from ..requirements.plots import actuator_figure, actuator_plot_data
 
     ev = study.evaluation

@@ -190,7 +190,7 @@ def _check_overwrite(out: Path) -> None:
 
 def claim(out: Path, study_name: str) -> None:
     """Mark ``out`` as a pkmlab results folder (:data:`MARKER`)."""
-    from .. import atomic
+    from ..runtime import atomic
 
     atomic.write_text(Path(out) / MARKER, json.dumps(
         {"written_by": "pkmlab", "study": study_name,

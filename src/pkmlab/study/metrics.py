@@ -22,7 +22,7 @@ Kinds of number (``statistic``):
   standard error);
 * ``flag`` — 1 or 0;
 * ``guaranteed`` — a proven bound over the *continuous* orientation set and x-y plane
-  (:mod:`pkmlab.workspaces.bracket`): ``*_volume_lower`` never exceeds the true volume,
+  (:mod:`pkmlab.workspaces.bracket.columns`): ``*_volume_lower`` never exceeds the true volume,
   ``*_volume_upper`` never falls below it. An objective that maximises a volume should use
   ``*_volume_lower`` (a design is credited only with volume it certainly has); a constraint
   "volume ≤ limit" should use ``*_volume_upper``.

@@ -15,8 +15,8 @@ import warnings
 
 import numpy as np
 
-from ..memory import memory_limit, require
-from ..time_budget import require_time, study_seconds, time_limit
+from ..runtime.memory import memory_limit, require
+from ..runtime.time_budget import require_time, study_seconds, time_limit
 from .definition import PENALTY
 
 __all__ = ["OPTIMISERS", "expected_evaluations", "check_memory", "check_time", "lhs_chunks"]
@@ -182,7 +182,7 @@ def check_time(space, opt, done: int, seconds_per_evaluation: float, workers: in
                logger=None) -> None:
     """Refuse a study whose remaining evaluations (``expected_evaluations`` less the ``done``
     already stored) are estimated, at ``seconds_per_evaluation`` on ``workers`` parallel
-    workers, to exceed the time budget (:mod:`pkmlab.time_budget`); log a long estimate."""
+    workers, to exceed the time budget (:mod:`pkmlab.runtime.time_budget`); log a long estimate."""
     remaining = max(expected_evaluations(space, opt) - done, 0)
     need = study_seconds(remaining, seconds_per_evaluation, workers)
     fit = int(time_limit() * max(workers, 1) / max(seconds_per_evaluation, 1e-9))

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from .. import atomic
+from ..runtime import atomic
 from .definition import Study
 from .export import export_designs
 from .metrics import METRICS

@@ -10,7 +10,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable, Iterable, Iterator
 
-from ..threads import single_thread_worker
+from ..runtime.threads import single_thread_worker
 
 __all__ = ["SerialRunner", "JoblibRunner", "DaskRunner", "make_runner"]
 

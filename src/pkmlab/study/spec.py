@@ -17,7 +17,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from ..config import mechanism_spec, read_yaml, validate_model
 from ..errors import ParameterError, Shown
 from ..mechanisms import REGISTRY
-from ..mechanisms.layout import PAIRED_ALIASES as _PAIRED
+from ..mechanisms.legs.layout import PAIRED_ALIASES as _PAIRED
 from ..units import parse_angle, parse_length
 from .definition import Constraint, Evaluation, Objective, Study
 from .evaluators import EVALUATORS, check_requirements

@@ -58,7 +58,7 @@ def compare_html(rows: list[dict], path: str | Path, *, box_deg: float | None = 
         slices: also embed the overlaid slices (level and dexterous) as images.
         progress: optional ``progress(message)`` per step (also logged at INFO).
     """
-    from ..workspaces.plots import overlay_figure
+    from ..workspaces.output.plots import overlay_figure
 
     t0 = time.perf_counter()
 

@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__, atomic
+from .. import __version__
+from ..runtime import atomic
 
 __all__ = ["render_page", "figure_json", "data_json", "png_uri", "hull_of_ply",
            "colour_option"]

@@ -10,7 +10,7 @@ of inside voxels), so memory grows with the footprint (nx·ny), not with the vol
 The signed field (positive inside, zero on the boundary) is built on first use for display
 (slices, meshes) over the kept workspace's bounding box only. The memory a request needs is
 estimated before anything is allocated (:func:`estimate_bytes`) and a request over the budget
-(:mod:`pkmlab.memory`) is refused.
+(:mod:`pkmlab.runtime.memory`) is refused.
 """
 
 from __future__ import annotations
@@ -23,14 +23,14 @@ import time
 import numpy as np
 from scipy import ndimage
 
-from .._intervals import label_pieces
 from ..dexterity.metrics import resolve_length
 from ..errors import ParameterError
 from ..limits import RESOLUTION_MM
 from ..mechanisms import NO_STROKE
-from ..memory import coarser_resolution, require
+from ..mechanisms.kernels.intervals import label_pieces
 from ..poses import as_frames, matrix_to_euler
-from ..time_budget import coarser_for_time, require_time, workspace_seconds
+from ..runtime.memory import coarser_resolution, require
+from ..runtime.time_budget import coarser_for_time, require_time, workspace_seconds
 from .constraints import Constraints, check
 from .field import interval_field
 from .orientations import OrientationSet

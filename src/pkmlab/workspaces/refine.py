@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..mechanisms.column_kernels import make_leg_eval
+from ..mechanisms.kernels.columns import make_leg_eval
 from .orientations import rotations_from_parameters
 
 __all__ = ["refine_columns"]

@@ -65,7 +65,7 @@ class WorkspaceResult:
         """
         if self.voxel_field is not None:
             return self.voxel_field
-        from ..memory import coarser_resolution, require
+        from ..runtime.memory import coarser_resolution, require
 
         need = 16.0 * len(self.xs) * len(self.ys) * len(self.zs)   # field, padding, meshing
         require("resolution", need, "a display grid (slices, mesh) whose field would",
@@ -257,13 +257,13 @@ class WorkspaceResult:
 
     @cached_property
     def _triangles(self):
-        from .mesh import boundary_triangles
+        from .output.mesh import boundary_triangles
 
         return boundary_triangles(self)
 
     @cached_property
     def _boundary(self):
-        from .mesh import merged_mesh
+        from .output.mesh import merged_mesh
 
         return merged_mesh(*self._triangles)
 
@@ -301,7 +301,7 @@ class WorkspaceResult:
         """Slice grid PNG: scaled to the workspace (``layout="auto"``) or the paper's 152.4 mm
         every 12.7 mm (``"paper"``); ``window`` / ``spacing`` override (see
         :func:`.slicing.slice_layout`)."""
-        from .plots import plot_slices
+        from .output.plots import plot_slices
 
         return plot_slices(self, path, window=window, spacing=spacing, centre=centre,
                            columns=columns, layout=layout, **kw)

@@ -9,8 +9,9 @@ import numpy as np
 from numba.extending import register_jitable
 
 from pkmlab.config import FamilySpec, Points
-from pkmlab.mechanisms import NO_STROKE, Mechanism, _kernels, joints
+from pkmlab.mechanisms import NO_STROKE, Mechanism, joints
 from pkmlab.mechanisms.base import as_points, as_stroke
+from pkmlab.mechanisms.kernels import ik
 
 
 @register_jitable(inline="always")
@@ -21,8 +22,8 @@ def _legs_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, 
         sy = py + r10 * ux + r11 * uy + r12 * uz - g[3 * i + 1]
         sz = pz + r20 * ux + r21 * uy + r22 * uz - g[3 * i + 2]
         v = math.sqrt(sx * sx + sy * sy + sz * sz)
-        q[i * _kernels.ROW + j] = v
-        st[i * _kernels.ROW + j] = _kernels.stroke_status(v, qmin, qmax)
+        q[i * ik.ROW + j] = v
+        st[i * ik.ROW + j] = ik.stroke_status(v, qmin, qmax)
 
 
 class Legs6Spec(FamilySpec):

@@ -10,8 +10,9 @@ import numpy as np
 from numba.extending import register_jitable
 
 from pkmlab.config import FamilySpec
-from pkmlab.mechanisms import NO_STROKE, TRANSLATIONAL, Mechanism, _kernels, joints
+from pkmlab.mechanisms import NO_STROKE, TRANSLATIONAL, Mechanism, joints
 from pkmlab.mechanisms.base import as_points, as_stroke
+from pkmlab.mechanisms.kernels import ik
 
 
 @register_jitable(inline="always")
@@ -22,11 +23,11 @@ def _tri3_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, 
         sy = py + r10 * ux + r11 * uy + r12 * uz - g[3 * i + 1]
         sz = pz + r20 * ux + r21 * uy + r22 * uz - g[3 * i + 2]
         v = math.sqrt(sx * sx + sy * sy + sz * sz)
-        q[i * _kernels.ROW + j] = v
+        q[i * ik.ROW + j] = v
         # the working mode: every leg rises from its base joint (the mirror below is the
         # other assembly mode, as on the 6-UPS)
-        st[i * _kernels.ROW + j] = (_kernels.OTHER_MODE if sz <= 0.0
-                                    else _kernels.stroke_status(v, qmin, qmax))
+        st[i * ik.ROW + j] = (ik.OTHER_MODE if sz <= 0.0
+                                    else ik.stroke_status(v, qmin, qmax))
 
 
 class Tri3Spec(FamilySpec):

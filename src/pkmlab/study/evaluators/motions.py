@@ -1,12 +1,12 @@
 """``motions``: required motions with the payload, by inverse dynamics
-(:mod:`pkmlab.requirements.dynamics`); the results are kept in the context for ``actuators``."""
+(:mod:`pkmlab.motion.dynamics`); the results are kept in the context for ``actuators``."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from ...errors import ParameterError
-from ...requirements.dynamics import inverse_dynamics
+from ...motion.dynamics import inverse_dynamics
 from ...requirements.spec import MotionSpec, build_motions
 from .registry import Evaluator, metric, register_evaluator
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import dataclasses
 
 from ...errors import ParameterError
-from ...workspaces.optima import stroke_needed, supports_continuous
+from ...workspaces.optima.search import stroke_needed, supports_continuous
 from .registry import Evaluator, metric, register_evaluator
 
 
@@ -42,7 +42,7 @@ class NeededStroke(Evaluator):
                                  o.describe())
 
     def compute(self, mech, ctx) -> dict:
-        """The needed travel over continuous positions (:func:`pkmlab.workspaces.optima.
+        """The needed travel over continuous positions (:func:`pkmlab.workspaces.optima.search.
         stroke_needed`), the lower limit of the workspace's actuator window kept; null with a
         note for other families or constraints, or when no upper limit up to the search's cap
         gives a position."""

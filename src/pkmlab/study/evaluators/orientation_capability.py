@@ -7,8 +7,8 @@ import numpy as np
 
 from ...limits import CAPABILITY_MAX_DEG
 from ...workspaces import OrientationSet, workspace
-from ...workspaces.optima import orientation_capability as continuous_capability
-from ...workspaces.optima import supports_continuous
+from ...workspaces.optima.search import orientation_capability as continuous_capability
+from ...workspaces.optima.search import supports_continuous
 from .registry import Evaluator, finite, metric, register_evaluator
 
 __all__ = ["OrientationCapability", "capability"]
@@ -18,7 +18,7 @@ def capability(mech, request: dict, iterations: int = 8) -> tuple[float, float, 
     """Largest ``a`` (deg) whose ±a simultaneous Euler box has a non-empty dexterous workspace
     on ``request``'s grid, by bisection → ``(a, bracket, note)``: the fallback for families
     without radial column intervals or with constraints beyond the stroke (radial families
-    use :func:`pkmlab.workspaces.optima.orientation_capability`, continuous positions).
+    use :func:`pkmlab.workspaces.optima.search.orientation_capability`, continuous positions).
 
     The verified level ``a`` is non-empty and ``a + bracket`` was found empty (so the value is
     a lower bound of the grid's capability to within ``bracket``); ``note`` is non-empty when

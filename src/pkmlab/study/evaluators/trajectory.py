@@ -7,7 +7,7 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from ...trajectory import check_trajectory, paper_motion
+from ...motion import check_trajectory, paper_motion
 from .registry import Evaluator, finite, metric, register_evaluator
 
 

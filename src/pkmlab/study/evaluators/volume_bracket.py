@@ -1,11 +1,11 @@
 """``volume_bracket``: a guaranteed bracket of the workspace's volume over the continuous
-orientation set and positions (:mod:`pkmlab.workspaces.bracket`)."""
+orientation set and positions (:mod:`pkmlab.workspaces.bracket.columns`)."""
 
 from __future__ import annotations
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from ...workspaces.bracket import volume_bracket
+from ...workspaces.bracket.columns import volume_bracket
 from .registry import Evaluator, metric, register_evaluator
 
 KINDS = ("constant", "reachable", "dexterous")
