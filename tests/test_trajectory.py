@@ -16,7 +16,7 @@ from pkmlab import dexterity as dx
 from pkmlab.motion import (
     PAPER_AXES,
     check_trajectory,
-    load_csv,
+    load_motion_csv,
     lobe_profile,
     paper_motion,
     paper_motion_phases,
@@ -67,7 +67,8 @@ def test_lobe_profile_shape():
 @pytest.mark.parametrize("segment_time, dwell, rate", [(1.0, 1.0, 100.0), (0.5, 0.3, 7.0),
                                                        (0.8, 0.0, 33.0)])
 def test_paper_motion_axes_in_order_and_exact_peaks(segment_time, dwell, rate):
-    t, X = paper_motion(HOPKINS, segment_time=segment_time, dwell=dwell, rate_hz=rate)
+    motion = paper_motion(HOPKINS, segment_time=segment_time, dwell=dwell, rate_hz=rate)
+    t, X = motion.t, motion.poses
     nominal = HOPKINS.nominal_pose
     assert t.shape == (len(X),) and X.shape[1] == 6
     assert t[0] == 0.0 and np.all(np.diff(t) > 0)
@@ -126,7 +127,8 @@ def test_paper_motion_bad_parameters():
 
 @pytest.fixture(scope="module")
 def paper_report():
-    t, X = paper_motion(HOPKINS)
+    motion = paper_motion(HOPKINS)
+    t, X = motion.t, motion.poses
     return check_trajectory(HOPKINS, t, X, payload_mass_kg=1.0)
 
 
@@ -181,7 +183,8 @@ def test_paper_motion_z_lobes_use_exactly_the_full_stroke(paper_report):
     assert rep.fits                                # touching the limits is allowed
     # without the round-off allowance a peak of the z lobe (t = 12 s top or 14 s bottom, where
     # q lands within ~1e-13 mm of a limit, on either side depending on rounding) may fail
-    t, X = paper_motion(HOPKINS)
+    motion = paper_motion(HOPKINS)
+    t, X = motion.t, motion.poses
     strict = check_trajectory(HOPKINS, t, X, stroke_tolerance=0.0)
     if not strict.fits:
         v = strict.violations["stroke"]
@@ -244,7 +247,8 @@ def test_speed_limit_detected_at_known_sample(limit, index, value):
 
 
 def test_force_limit_and_no_solution_are_statuses_not_errors():
-    t, X = paper_motion(HOPKINS, rate_hz=20.0)
+    motion = paper_motion(HOPKINS, rate_hz=20.0)
+    t, X = motion.t, motion.poses
     X = X.copy()
     X[100, 0] = 1000.0                       # unreachable: no real solution
     X[200, 3] = math.nan                     # non-finite pose
@@ -297,7 +301,8 @@ def test_singular_jacobian_is_reported_not_raised():
 def test_condition_is_the_dexterity_kappa_with_its_length():
     # κ along a trajectory is pkmlab's one κ: the Jacobian homogenised with Angeles' length
     # (it was the unscaled 2-norm condition number, mixing mm and rad columns)
-    t, X = paper_motion(HOPKINS)
+    motion = paper_motion(HOPKINS)
+    t, X = motion.t, motion.poses
     rep = check_trajectory(HOPKINS, t, X)
     L = dx.resolve_length(HOPKINS)
     J = HOPKINS.jacobian(X)
@@ -347,7 +352,8 @@ def _q_of_frames(mech, p, R):
 
 
 def test_forces_balance_wrench_and_satisfy_virtual_work():
-    t, X = paper_motion(HOPKINS, rate_hz=10.0)
+    motion = paper_motion(HOPKINS, rate_hz=10.0)
+    t, X = motion.t, motion.poses
     com = np.array([12.0, -30.0, 40.0])
     rep = check_trajectory(HOPKINS, t, X, payload_mass_kg=2.5, payload_com=com,
                            gravity=(0.0, 0.0, -9810.0))
@@ -408,35 +414,41 @@ def test_load_csv_roundtrip(tmp_path):
                     "0, 0.0, 1, 2, 300, 0, 0\n"
                     "\n"
                     "30, 0.5, 1.5, 2, 300, -10, 5\n")
-    t, X = load_csv(path)
+    m = load_motion_csv(path, derivatives=False)
+    t, X = m.t, m.poses
+    assert m.twist is None and m.derivatives == "none"
     np.testing.assert_array_equal(t, [0.0, 0.5])
     np.testing.assert_allclose(X, [[1, 2, 300, 0, 0, 0],
                                    [1.5, 2, 300, math.radians(-10), math.radians(5),
                                     math.radians(30)]])
 
 
-@pytest.mark.parametrize("text, field, fragment", [
-    ("t,x,y,z,theta_x,theta_y\n0,0,0,0,0,0\n1,0,0,0,0,0\n", "(header)", "theta_z"),
-    ("t,x,y,z,theta_x,theta_y,theta_z,x_mm\n", "(header)", "x_mm"),
-    ("t,x,y,z,theta_x,theta_y,theta_z,t\n", "(header)", "duplicate"),
-    ("t,x,y,z,theta_x,theta_y,theta_z\n0,0,0,0,0,0,0\n1,0,abc,0,0,0,0\n", ":3 column 'y'", "abc"),
-    ("t,x,y,z,theta_x,theta_y,theta_z\n0,0,0,0,0,0,0\n1,0,0,0,nan,0,0\n", ":3 column 'theta_x'",
-     "nan"),
-    ("t,x,y,z,theta_x,theta_y,theta_z\n0,0,0,0,0,0,0\n1,0,0,0,0,0\n", ":3", "6 fields"),
+@pytest.mark.parametrize("text, field, line, fragment", [
+    ("t,x,y,z,theta_x,theta_y\n0,0,0,0,0,0\n1,0,0,0,0,0\n", "header", 1, "theta_z"),
+    ("t,x,y,z,theta_x,theta_y,theta_z,x_mm\n", "header", 1, "x_mm"),
+    ("t,x,y,z,theta_x,theta_y,theta_z,t\n", "header", 1, "duplicate"),
+    ("t,x,y,z,theta_x,theta_y,theta_z\n0,0,0,0,0,0,0\n1,0,abc,0,0,0,0\n", "column 'y'", 3,
+     "'abc'"),
+    ("t,x,y,z,theta_x,theta_y,theta_z\n0,0,0,0,0,0,0\n1,0,0,0,nan,0,0\n", "column 'theta_x'",
+     3, "nan"),
+    ("t,x,y,z,theta_x,theta_y,theta_z\n0,0,0,0,0,0,0\n1,0,0,0,0,0\n", "", 3, "6 fields"),
     ("t,x,y,z,theta_x,theta_y,theta_z\n0,0,0,0,0,0,0\n1,0,0,0,0,0,0\n1,0,0,0,0,0,0\n",
-     ":4 column 't'", "1.0"),
+     "column 't'", 4, "1.0"),
     ("t,x,y,z,theta_x,theta_y,theta_z\n0,0,0,0,0,0,0\n2,0,0,0,0,0,0\n1,0,0,0,0,0,0\n",
-     ":4 column 't'", "1.0"),
-    ("t,x,y,z,theta_x,theta_y,theta_z\n0,0,0,0,0,0,0\n", "", "1"),
-    ("# only a comment\n", "", "empty"),
+     "column 't'", 4, "1.0"),
+    ("t,x,y,z,theta_x,theta_y,theta_z\n0,0,0,0,0,0,0\n", "", None, "1"),
+    ("# only a comment\n", "", None, "empty"),
+    ("t,x,y,z,theta_x,theta_y,theta_z,x_ddot,y_ddot,z_ddot,theta_x_ddot,theta_y_ddot,"
+     "theta_z_ddot\n", "header", 1, "acceleration columns only"),
 ])
-def test_load_csv_errors_name_the_place(tmp_path, text, field, fragment):
+def test_load_csv_errors_name_the_place(tmp_path, text, field, line, fragment):
     path = tmp_path / "bad.csv"
     path.write_text(text)
     with pytest.raises(ParameterError) as exc:
-        load_csv(path)
-    assert exc.value.field.startswith(str(path))
-    assert exc.value.field.endswith(field) or field in exc.value.field
+        load_motion_csv(path, field="--csv", derivatives=False)
+    assert exc.value.field == f"--csv {field}".strip()
+    assert exc.value.where.startswith(str(path))
+    assert exc.value.where.endswith(f"line {line}") or line is None
     assert fragment in str(exc.value)
 
 

@@ -7,7 +7,8 @@ check against the same numbers, so that whatever validates also runs.
 from __future__ import annotations
 
 __all__ = ["SEGMENT_TIME_S", "MEMORY_FRACTION", "TIME_LIMIT_S", "LENGTH_MAX_MM", "RESOLUTION_MM",
-           "EULER_HALF_RANGE_DEG", "SAMPLES_PER_ANGLE", "GCI_SAMPLES", "CAPABILITY_MAX_DEG"]
+           "EULER_HALF_RANGE_DEG", "SAMPLES_PER_ANGLE", "GCI_SAMPLES", "CAPABILITY_MAX_DEG",
+           "CSV_MAX_BYTES", "CSV_MAX_ROWS", "MOTION_TIME_S"]
 
 #: Duration of one leg of the paper's lobe motion (s): 1 ms .. 1 day.
 SEGMENT_TIME_S = (1e-3, 86400.0)
@@ -30,3 +31,9 @@ SAMPLES_PER_ANGLE = (1, 101)
 GCI_SAMPLES = (10, 1_000_000)
 #: Upper end of the orientation-capability search (deg): the Euler box covers SO(3) there.
 CAPABILITY_MAX_DEG = 180.0
+#: Largest CSV input (bytes) and its most data rows: a million samples is 17 min at 1 kHz.
+CSV_MAX_BYTES = 256 * 2**20
+CSV_MAX_ROWS = 1_000_000
+#: Time stamps of recorded motions (s): magnitudes at most this (about 116 days), so that
+#: differences and rates stay finite.
+MOTION_TIME_S = 1.0e7

@@ -235,10 +235,11 @@ def trajectory(
                              if paper_motion else "neither"))
     try:
         if csv is not None:
-            t, poses = tr.load_csv(csv)
+            motion = tr.load_motion_csv(csv, field="--csv", derivatives=False)
         else:
-            t, poses = tr.paper_motion(mech, segment_time=segment_time)
-        rep = tr.check_trajectory(mech, t, poses, payload_mass_kg=payload,
+            motion = tr.paper_motion(mech, segment_time=segment_time)
+        t = motion.t
+        rep = tr.check_trajectory(mech, t, motion.poses, payload_mass_kg=payload,
                                   max_speed=max_speed, max_force=max_force)
     except ParameterError as exc:
         _fail(exc)

@@ -1,21 +1,20 @@
-"""Trajectories to check: the paper's Cartesian test motion and time-stamped poses from CSV.
+"""The paper's Cartesian test motion (Hopkins & Williams 2002, Sect. 6 / Fig. 13).
 
 Units follow the rest of pkmlab: poses are ``(x, y, z, θx, θy, θz)`` of the tool frame in the
 base frame in mm and rad (Z-Y-X Euler angles, :mod:`pkmlab.poses`), times in s.
 
-* :func:`paper_motion` builds the coordinated Cartesian motion of Hopkins & Williams (2002),
-  Sect. 6 / Fig. 13: from the nominal pose, "sinusoidal-like third-order polynomial" motions of
-  ``x_H, y_H, z_H, θz, θy, θx`` one at a time, each a pair of lobes of ±2 in / ±30°.
-* :func:`load_csv` reads a time-stamped pose list (``t,x,y,z,theta_x,theta_y,theta_z``; s, mm
-  and deg).
+:func:`paper_motion` builds, from the nominal pose, "sinusoidal-like third-order polynomial"
+motions of ``x_H, y_H, z_H, θz, θy, θx`` one at a time, each a pair of lobes of ±2 in / ±30°,
+as a :class:`~pkmlab.motion.motions.Motion` with the exact derivatives of its cubic lobes (the
+acceleration jumps at the knots: each side's value is exact on its own segment). It is the one
+paper motion of pkmlab: the trajectory check, ``compare``, the study evaluators and the
+requirement motions all use it.
 """
 
 from __future__ import annotations
 
-import csv
 import logging
 import math
-from pathlib import Path
 
 import numpy as np
 
@@ -24,19 +23,16 @@ from ..limits import SEGMENT_TIME_S
 from ..mechanisms.base import Mechanism
 from ._args import finite as _finite
 from ._args import positive as _positive
+from .motions import Motion, make_motion
 
 log = logging.getLogger(__name__)
 
-__all__ = ["PAPER_AXES", "CSV_COLUMNS", "MM_PER_IN", "lobe_profile", "paper_motion_phases",
-           "paper_motion", "load_csv"]
+__all__ = ["PAPER_AXES", "MM_PER_IN", "lobe_profile", "paper_motion_phases", "paper_motion"]
 
 #: Order of the paper's Cartesian test motions (Sect. 6): name and index into the pose vector.
 PAPER_AXES: tuple[tuple[str, int], ...] = (
     ("x", 0), ("y", 1), ("z", 2), ("theta_z", 5), ("theta_y", 4), ("theta_x", 3),
 )
-
-#: Columns of a trajectory CSV file and their units (converted to mm / rad on load).
-CSV_COLUMNS: tuple[str, ...] = ("t", "x", "y", "z", "theta_x", "theta_y", "theta_z")
 
 MM_PER_IN = 25.4
 
@@ -64,12 +60,19 @@ def lobe_profile(t: np.ndarray, amplitude: float, segment_time: float) -> np.nda
         ``s(τ) = 3τ² − 2τ³``, so position is continuous, velocity is zero at every knot, and the
         peak speed is ``1.5·A / segment_time`` (at the middle of each leg).
     """
+    return _lobes(t, amplitude, segment_time)[0]
+
+
+def _lobes(t, amplitude: float, segment_time: float):
+    """:func:`lobe_profile` and its first and second time derivatives (exact per leg)."""
     t = np.asarray(t, dtype=float)
     knots = np.array([0.0, amplitude, 0.0, -amplitude, 0.0])
     u = np.clip(t / segment_time, 0.0, 4.0)
     k = np.minimum(np.floor(u).astype(int), 3)
     tau = u - k
-    return knots[k] + (knots[k + 1] - knots[k]) * _smoothstep(tau)
+    dk = knots[k + 1] - knots[k]
+    return (knots[k] + dk * _smoothstep(tau), dk * (6.0 * tau - 6.0 * tau * tau) / segment_time,
+            dk * (6.0 - 12.0 * tau) / segment_time ** 2)
 
 
 def paper_motion_phases(segment_time: float = 1.0, dwell: float = 1.0
@@ -95,7 +98,7 @@ def paper_motion_phases(segment_time: float = 1.0, dwell: float = 1.0
 
 def paper_motion(mech: Mechanism, amplitude_mm: float = 2.0 * MM_PER_IN,
                  amplitude_rad: float = math.radians(30.0), segment_time: float = 1.0,
-                 dwell: float = 1.0, rate_hz: float = 100.0) -> tuple[np.ndarray, np.ndarray]:
+                 dwell: float = 1.0, rate_hz: float = 100.0, name: str = "paper") -> Motion:
     """The coordinated Cartesian test motion of Hopkins & Williams (2002), Sect. 6 / Fig. 13.
 
     Starting at ``mech.nominal_pose``, the axes ``x, y, z`` (by ``±amplitude_mm``) and then
@@ -122,9 +125,11 @@ def paper_motion(mech: Mechanism, amplitude_mm: float = 2.0 * MM_PER_IN,
         segment_time: duration of one cubic leg (nominal ↔ peak) in s.
         dwell: rest at nominal between axes and at both ends, in s (may be 0).
         rate_hz: nominal sampling rate in Hz.
+        name: the motion's name.
 
     Returns:
-        ``(t, poses)``: times ``(T,)`` in s starting at 0, and tool poses ``(T, 6)`` (mm, rad).
+        a :class:`Motion`: times ``(T,)`` in s starting at 0, tool poses ``(T, 6)`` (mm, rad)
+        and their exact derivatives.
     """
     amp_mm = _finite(amplitude_mm, "amplitude_mm", "mm")
     amp_rad = _finite(amplitude_rad, "amplitude_rad", "rad")
@@ -144,82 +149,13 @@ def paper_motion(mech: Mechanism, amplitude_mm: float = 2.0 * MM_PER_IN,
 
     nominal = mech.nominal_pose
     poses = np.tile(nominal, (len(t), 1))
-    for (name, t0, _t1), (_, idx) in zip(phases, PAPER_AXES):
-        amp = amp_rad if name.startswith("theta") else amp_mm
+    d1, d2 = np.zeros_like(poses), np.zeros_like(poses)
+    for (axis, t0, _t1), (_, idx) in zip(phases, PAPER_AXES):
+        amp = amp_rad if axis.startswith("theta") else amp_mm
         inside = (t >= t0) & (t <= t0 + 4.0 * segment_time)
-        poses[inside, idx] += lobe_profile(t[inside] - t0, amp, segment_time)
+        s0, s1, s2 = _lobes(t[inside] - t0, amp, segment_time)
+        poses[inside, idx] += s0
+        d1[inside, idx] = s1
+        d2[inside, idx] = s2
     log.debug("paper motion: %d samples over %.3f s", len(t), t[-1])
-    return t, poses
-
-
-# ---------------------------------------------------------------------------------------------
-# CSV input
-
-
-def load_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
-    """Read a trajectory from a CSV file.
-
-    The first non-comment line is the header and must name exactly the columns
-    ``t,x,y,z,theta_x,theta_y,theta_z`` (any order): time in s, position in mm, Z-Y-X Euler
-    angles in deg. Blank lines and lines starting with ``#`` are skipped. Time must be finite
-    and strictly increasing, and there must be at least two samples.
-
-    Returns:
-        ``(t, poses)``: times ``(T,)`` in s and poses ``(T, 6)`` in mm and rad.
-
-    Raises:
-        ParameterError: naming the file, line and column of the first problem (missing or
-            unknown column, wrong field count, non-numeric or non-finite entry, time not
-            increasing, fewer than two samples). ``FileNotFoundError`` if the file is missing.
-    """
-    path = Path(path)
-    with path.open(newline="") as fh:
-        lines = [(n, line) for n, line in enumerate(fh, start=1)
-                 if line.strip() and not line.lstrip().startswith("#")]
-    if not lines:
-        raise ParameterError(f"{path}", "a CSV file with header " + ",".join(CSV_COLUMNS),
-                             "an empty file")
-    rows = list(csv.reader([line for _, line in lines]))
-    header_line = lines[0][0]
-    header = [h.strip() for h in rows[0]]
-    where = f"{path}:{header_line} (header)"
-    dupes = sorted({h for h in header if header.count(h) > 1})
-    if dupes:
-        raise ParameterError(where, "each column named once", f"duplicate {dupes}")
-    unknown = [h for h in header if h not in CSV_COLUMNS]
-    if unknown:
-        raise ParameterError(where, f"only the columns {list(CSV_COLUMNS)} (s, mm, deg)",
-                             f"unknown column(s) {unknown}")
-    missing = [c for c in CSV_COLUMNS if c not in header]
-    if missing:
-        raise ParameterError(where, f"all of the columns {list(CSV_COLUMNS)} (s, mm, deg)",
-                             f"missing column(s) {missing}")
-    order = [header.index(c) for c in CSV_COLUMNS]
-
-    data = np.empty((len(rows) - 1, len(CSV_COLUMNS)))
-    for r, (row, (lineno, _)) in enumerate(zip(rows[1:], lines[1:])):
-        if len(row) != len(header):
-            raise ParameterError(f"{path}:{lineno}", f"{len(header)} comma-separated fields",
-                                 f"{len(row)} fields: {row}")
-        for j, col in enumerate(order):
-            text = row[col].strip()
-            try:
-                value = float(text)
-            except ValueError:
-                value = None
-            if value is None or not math.isfinite(value):
-                raise ParameterError(f"{path}:{lineno} column '{CSV_COLUMNS[j]}'",
-                                     "a finite number", text)
-            data[r, j] = value
-    if len(data) < 2:
-        raise ParameterError(f"{path}", "at least two data rows", len(data))
-    t = data[:, 0]
-    bad = np.flatnonzero(np.diff(t) <= 0)
-    if bad.size:
-        k = int(bad[0]) + 1
-        raise ParameterError(f"{path}:{lines[k + 1][0]} column 't'",
-                             f"strictly increasing time (> {t[k - 1]:g} s on the previous row)",
-                             float(t[k]))
-    poses = np.concatenate([data[:, 1:4], np.radians(data[:, 4:7])], axis=1)
-    log.debug("loaded %d samples from %s", len(t), path)
-    return t.copy(), poses
+    return make_motion(name, t, poses, d1, d2, "analytic")

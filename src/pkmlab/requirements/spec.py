@@ -11,7 +11,6 @@ the field: ``evaluate.task.size[0]: must be a length >= 0 mm; got '-5 mm'``.
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,10 +20,13 @@ import numpy as np
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSchema, create_model
 
 from ..config import read_yaml, validate_model
-from ..errors import ParameterError, format_value
+from ..errors import ParameterError, Shown, format_value
 from ..motion import motions as mo
+from ..motion.csvfile import load_motion_csv
+from ..motion.paper import paper_motion
 from ..motion.payload import MassProperties, combine, leg_end_masses, leg_rod_masses
 from ..quantities import Angle, Length
+from ..tables import read_table, shown
 from ..units import (
     ANGULAR_SPEED_UNITS,
     FORCE_UNITS,
@@ -129,27 +131,15 @@ class TaskPlan:
 
 
 def _read_points(path: Path, field: str) -> np.ndarray:
-    if not path.is_file():
-        raise ParameterError(field, "an existing CSV file x,y,z (mm), relative to the study "
-                             "file", str(path))
-    rows = [r for r in csv.reader(path.read_text(encoding="utf-8").splitlines())
-            if r and not r[0].lstrip().startswith("#")]
-    if not rows or [h.strip() for h in rows[0]] != ["x", "y", "z"]:
+    table = read_table(path, field, what="a CSV file with the header x,y,z (mm), relative to "
+                       "the study file")
+    if sorted(table.header) != ["x", "y", "z"]:
         raise ParameterError(f"{field} header", "the columns x,y,z (mm)",
-                             rows[0] if rows else "an empty file", where=str(path))
-    out = []
-    for i, r in enumerate(rows[1:], start=2):
-        try:
-            v = [float(x) for x in r]
-        except ValueError:
-            v = []
-        if len(v) != 3 or not all(math.isfinite(x) for x in v):
-            raise ParameterError(field, "rows of three finite numbers (mm)", r,
-                                 where=f"{path}, data row {i - 1}")
-        out.append(v)
-    if not out:
+                             Shown(", ".join(shown(h) for h in table.header)),
+                             where=table.where())
+    if not len(table.values):
         raise ParameterError(field, "at least one point", 0, where=str(path))
-    return np.array(out)
+    return np.stack([table.column(c) for c in "xyz"], axis=1)
 
 
 def build_task(data: Any, base: Path) -> TaskPlan:
@@ -255,7 +245,8 @@ class MotionsPlan:
         out = []
         for s in self.specs:
             if s.paper:
-                out.append(mo.paper_motion(mech, s.segment_time, s.rate, name=s.name))
+                out.append(paper_motion(mech, segment_time=s.segment_time, rate_hz=s.rate,
+                                        name=s.name))
             elif s.sinusoid is not None:
                 a, f, ph = (np.array([getattr(c, k) for k in mo.POSE_COLUMNS]) for c in
                             (s.sinusoid.amplitude, s.sinusoid.frequency, s.sinusoid.phase))
@@ -289,8 +280,8 @@ def build_motions(data: Any, base: Path) -> MotionsPlan:
         raw = dict(d)
         if s.file is not None:
             path = (base / s.file).resolve()
-            recorded[s.name] = mo.load_motion_csv(path, s.name, s.smoothing.window,
-                                                  s.smoothing.polyorder, field=f"{fi}.file")
+            recorded[s.name] = load_motion_csv(path, s.name, s.smoothing.window,
+                                               s.smoothing.polyorder, field=f"{fi}.file")
             raw["file"] = str(path)
         specs.append(s)
         source.append(raw)

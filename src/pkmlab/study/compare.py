@@ -93,7 +93,8 @@ def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
         gci = dx.gci_grid(mech, ref, grid=grid)
         kmin = dx.kappa_statistics(grid.kappa[grid.valid]).min
         wc = dx.worst_case(mech, ref, length, force_limit)
-        t, X = paper_motion(mech)
+        motion = paper_motion(mech)
+        t, X = motion.t, motion.poses
         rep = check_trajectory(mech, t, X, characteristic_length=length)
         q = rep.q[np.all(np.isfinite(rep.q), axis=1)]
         used = (q.max() - q.min()) / (mech.stroke[1] - mech.stroke[0]) if len(q) else math.nan

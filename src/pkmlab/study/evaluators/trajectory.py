@@ -37,7 +37,8 @@ class Trajectory(Evaluator):
 
     def compute(self, mech, ctx) -> dict:
         plan = ctx.evaluation.trajectory
-        t, X = paper_motion(mech, segment_time=plan.segment_time)
+        motion = paper_motion(mech, segment_time=plan.segment_time)
+        t, X = motion.t, motion.poses
         rep = check_trajectory(mech, t, X, payload_mass_kg=plan.payload)
         margins = np.concatenate([rep.margin_low, rep.margin_high])
         out = {"paper_motion_fits": float(rep.fits),
