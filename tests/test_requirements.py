@@ -23,8 +23,8 @@ from pkmlab import load_mechanism
 from pkmlab.cli import app
 from pkmlab.errors import ParameterError
 from pkmlab.mechanisms import PSU6, UPS6
-from pkmlab.motion.dynamics import inverse_dynamics
 from pkmlab.motion import load_motion_csv, sinusoid_motion
+from pkmlab.motion.dynamics import inverse_dynamics
 from pkmlab.motion.payload import GRAVITY, MassProperties
 from pkmlab.requirements.actuators import ActuatorSpec, fit
 from pkmlab.requirements.task import TaskRegion, task_contained, task_margins

@@ -24,8 +24,7 @@ from pydantic import (
 
 from . import limits
 from .errors import ParameterError, format_value, from_validation_error
-from .legspec import SixLegSpec
-from .mechanisms import PSU6, RSS6, UPS6, Luzi3, Mechanism
+from .mechanisms import Mechanism
 from .quantities import (  # noqa: F401 (re-exported for plugins' spec models)
     _NUMBER_OR_UNIT,
     Angle,
@@ -61,132 +60,40 @@ from .units import ANGLE_UNITS, LENGTH_UNITS, parse_angle, parse_length
 from .workspaces.constraints import ActuatorWindow
 from .yamlio import load_yaml, remember, where
 
-__all__ = ["load_mechanism", "mechanism_spec", "MechanismSpec", "FamilySpec", "mechanism_specs",
+__all__ = ["load_mechanism", "mechanism_spec", "FamilySpec", "mechanism_specs",
            "workspace_spec", "WorkspaceSpec",
            "load_workspace_study", "WorkspaceStudySpec", "to_display", "read_yaml",
            "validate_model"]
 
 
-class PSU6Spec(_Common):
-    family: Literal["psu6"]
-    generator: PairedCircles | None = None
-    link_length: LinkLengths
-
-    def build(self) -> Mechanism:
-        if self._explicit("generator"):
-            return PSU6(self.base_points, self.platform_points, self.link_length, self.stroke,
-                        self.tool_offset, **self._kw())
-        return PSU6.from_circles(**self.generator.model_dump(), link_length=self.link_length,
-                                 stroke=self.stroke, tool_offset=self.tool_offset, **self._kw())
-
-
-class UPS6Spec(_Common):
-    family: Literal["ups6"]
-    generator: PairedCircles | None = None
-
-    def build(self) -> Mechanism:
-        if self._explicit("generator"):
-            return UPS6(self.base_points, self.platform_points, self.stroke, self.tool_offset,
-                        **self._kw())
-        return UPS6.from_circles(**self.generator.model_dump(), stroke=self.stroke,
-                                 tool_offset=self.tool_offset, **self._kw())
-
-
-class ServoCircles(PairedCircles):
-    """Generator of the 6-RSS: servo pairs on the paired circles (see ``RSS6.from_circles``)."""
-
-    crank_plane: Literal["radial", "tangential"] = Field(
-        "radial", description="'radial': servo axes tangent to the base circle; 'tangential': "
-        "servo axes radial")
-    zero_direction: Literal["outward", "inward"] = Field(
-        "outward", description="crank zero direction (horizontal): radially out/in, or away "
-        "from / towards the pair partner")
-
-
-class RSS6Spec(_Common):
-    """6-RSS rotary-servo Stewart platform. ``stroke`` is the servo-angle range (deg)."""
-
-    family: Literal["rss6"]
-    generator: ServoCircles | None = None
-    stroke: AngleWindow = Field(description="servo-angle range [min, max] (deg or with units)")
-    crank_length: LinkLengths
-    rod_length: LinkLengths
-    servo_axes: Directions | None = None
-    zero_directions: Directions | None = None
-    branch: Branches = Field(default_factory=lambda: [-1.0] * 6)
-
-    def build(self) -> Mechanism:
-        if self._explicit("generator"):
-            if self.servo_axes is None or self.zero_directions is None:
-                raise ParameterError("servo_axes" if self.servo_axes is None
-                                     else "zero_directions",
-                                     "given with explicit base_points (or use a generator)",
-                                     None)
-            return RSS6(self.base_points, self.platform_points, self.servo_axes,
-                        self.zero_directions, self.crank_length, self.rod_length, self.stroke,
-                        self.branch, self.tool_offset, **self._kw())
-        if self.servo_axes is not None or self.zero_directions is not None:
-            raise ParameterError("servo_axes", "absent with a generator (it sets the axes)",
-                                 "given")
-        m = RSS6.from_circles(**self.generator.model_dump(), crank_length=self.crank_length,
-                              rod_length=self.rod_length, stroke=self.stroke,
-                              branch=self.branch, tool_offset=self.tool_offset, **self._kw())
-        return m
-
-
-class Luzi3Generator(_Model):
-    base_diameter: PositiveLength
-    phi: Angle = Field(description="angle between consecutive base points of different chains")
-    platform_diameter: PositiveLength
-
-
-class Luzi3Spec(_Common):
-    family: Literal["luzi3"]
-    generator: Luzi3Generator | None = None
-    upper_link: PositiveLength
-    tool_offset: Vector3 | Literal["centroid"] = "centroid"  # type: ignore[assignment]
-
-    def build(self) -> Mechanism:
-        explicit = self._explicit("generator")
-        offset = self.tool_offset
-        if explicit:
-            if offset == "centroid":
-                offset = np.mean(np.asarray(self.platform_points), axis=0)
-            return Luzi3(self.base_points, self.platform_points, self.upper_link, self.stroke,
-                         offset, **self._kw())
-        return Luzi3.from_paper(**self.generator.model_dump(), upper_link=self.upper_link,
-                                stroke=self.stroke,
-                                tool_offset=None if offset == "centroid" else offset,
-                                **self._kw())
-
-
-MechanismSpec = Annotated[PSU6Spec | UPS6Spec | Luzi3Spec | RSS6Spec | SixLegSpec,
-                          Field(discriminator="family")]
-_BUILTIN_SPECS = (PSU6Spec, UPS6Spec, Luzi3Spec, RSS6Spec, SixLegSpec)
 _ADAPTERS: dict[tuple, tuple[Any, TypeAdapter]] = {}
 
 
 def mechanism_specs() -> tuple[type[BaseModel], ...]:
-    """The YAML models of every registered family: built-ins, then plugins' ``spec_model``."""
+    """The YAML models of every registered family, built-in or plugin (each family class's
+    ``spec_model``), in registration order."""
     from .mechanisms import REGISTRY, load_plugins
 
     load_plugins()
-    plugins = tuple(cls.spec_model for name, cls in REGISTRY.items()
-                    if getattr(cls, "spec_model", None) is not None
-                    and cls.spec_model not in _BUILTIN_SPECS)
-    return _BUILTIN_SPECS + plugins
+    return tuple(cls.spec_model for cls in REGISTRY.values()
+                 if getattr(cls, "spec_model", None) is not None)
 
 
 def _mechanism_adapter() -> tuple[Any, TypeAdapter]:
     """``(union annotation, TypeAdapter)`` over :func:`mechanism_specs`, cached per set."""
     specs = mechanism_specs()
     if specs not in _ADAPTERS:
-        union = MechanismSpec if specs == _BUILTIN_SPECS else \
-            Annotated[typing.Union[specs], Field(discriminator="family")]  # noqa: UP007
+        union = Annotated[typing.Union[specs], Field(discriminator="family")]  # noqa: UP007
         _ADAPTERS[specs] = (union, TypeAdapter(union))
     return _ADAPTERS[specs]
-_GENERATOR_FIELDS = (set(ServoCircles.model_fields) | set(Luzi3Generator.model_fields)
-                     | {"phi"})
+
+
+def _generator_fields(spec: BaseModel) -> set[str]:
+    """Fields of the spec's ``generator`` model, if it has one (errors on them are reported
+    under ``generator.``)."""
+    generator = getattr(spec, "generator", None)
+    return set(type(generator).model_fields) | {"phi"} \
+        if isinstance(generator, BaseModel) else set()
 
 
 def _translate(exc: ValidationError, prefix: str = "") -> ParameterError:
@@ -437,7 +344,7 @@ def load_mechanism(source: str | Path | dict) -> Mechanism:
     try:
         return spec.build()
     except ParameterError as exc:
-        if exc.field in _GENERATOR_FIELDS and getattr(spec, "generator", None) is not None:
+        if exc.field in _generator_fields(spec):
             raise ParameterError(f"generator.{exc.field}", exc.allowed, exc.got) from None
         raise
 

@@ -1,6 +1,7 @@
 """Base pieces of the mechanism YAML models (pydantic v2), shared by :mod:`pkmlab.config` and
-the family specs that live in modules of their own (:mod:`pkmlab.legspec`): the frozen model
-base, the paired-circles generator and the fields common to every family."""
+the families' own YAML models (each in its family's module,
+:mod:`pkmlab.mechanisms.families`): the frozen model base, the paired-circles generator and the
+fields common to every family."""
 
 from __future__ import annotations
 

@@ -17,7 +17,6 @@ from pydantic import BaseModel, ConfigDict, Field
 from ..config import mechanism_spec, read_yaml, validate_model
 from ..errors import ParameterError, Shown
 from ..mechanisms import REGISTRY
-from ..mechanisms.legs.layout import PAIRED_ALIASES as _PAIRED
 from ..units import parse_angle, parse_length
 from .definition import Constraint, Evaluation, Objective, Study
 from .evaluators import EVALUATORS, check_requirements
@@ -25,32 +24,11 @@ from .metrics import KIND_VOLUMES, METRICS
 from .optimisers import check_memory
 from .space import Derived, DesignSpace, Expression, Variable, get_path, parse_path
 
-__all__ = ["load_study", "study_from_mapping", "StudySpec", "study_schema", "DESIGN_ALIASES"]
-
-#: named design variables → (path in the mechanism spec, quantity), per family
-DESIGN_ALIASES: dict[str, dict[str, tuple[str, str]]] = {
-    "psu6": {**_PAIRED, "link_length": ("link_length", "length")},
-    "ups6": dict(_PAIRED),
-    "rss6": {**{k: v for k, v in _PAIRED.items() if not k.startswith("stroke")},
-             "crank_length": ("crank_length", "length"),
-             "rod_length": ("rod_length", "length"),
-             "servo_min": ("stroke[0]", "angle"),
-             "servo_max": ("stroke[1]", "angle"),
-             "crank_plane": ("generator.crank_plane", "text"),
-             "zero_direction": ("generator.zero_direction", "text")},
-    "luzi3": {"base_diameter": ("generator.base_diameter", "length"),
-              "platform_diameter": ("generator.platform_diameter", "length"),
-              "phi": ("generator.phi", "angle"),
-              "upper_link": ("upper_link", "length"),
-              "stroke_min": ("stroke[0]", "length"),
-              "stroke_max": ("stroke[1]", "length")},
-}
-
+__all__ = ["load_study", "study_from_mapping", "StudySpec", "study_schema", "family_aliases"]
 
 def family_aliases(family: str) -> dict[str, tuple[str, str]]:
-    """Named design variables of a family: built-in, or a plugin class's ``design_aliases``."""
-    if family in DESIGN_ALIASES:
-        return DESIGN_ALIASES[family]
+    """Named design variables of a family: its class's ``design_aliases`` (path in the YAML
+    model, quantity), built-in or plugin alike."""
     return dict(getattr(REGISTRY.get(family), "design_aliases", None) or {})
 
 

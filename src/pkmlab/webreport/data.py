@@ -177,12 +177,12 @@ def build_values(study: Study, params: dict) -> tuple[dict, str | None]:
 def derived_rows(study: Study, params: dict, rounded: dict) -> list[dict]:
     """The derived mechanism fields of a design and of its rounded version."""
     from ..study.space import get_path
-    from ..study.spec import DESIGN_ALIASES
+    from ..study.spec import family_aliases
 
     if not study.space.derived:
         return []
     family = study.space.base_spec.family
-    aliases = DESIGN_ALIASES.get(family, {})
+    aliases = family_aliases(family)
     spec, spec_r = study.space.spec_of(params), study.space.spec_of(rounded)
     rows = []
     for d in study.space.derived:

@@ -30,13 +30,17 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from typing import ClassVar, Literal
 
 import numpy as np
 from numba import njit
 from numba.extending import register_jitable
+from pydantic import Field
 
 from ...errors import ParameterError
 from ...poses import as_frames, skew
+from ...quantities import Angle, PositiveLength, Vector3
+from ...specbase import _Common, _Model
 from ..base import Mechanism, as_points, as_positive, as_stroke, as_vector3
 from ..joints import DEFAULT_FIELDS, JointArrays, LegTemplate, ParamField, unit
 from ..kernels import ik as _kernels
@@ -112,6 +116,32 @@ def _luzi_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, 
         st[k] = s2 if ok else _kernels.DEGENERATE
 
 
+class Luzi3Generator(_Model):
+    base_diameter: PositiveLength
+    phi: Angle = Field(description="angle between consecutive base points of different chains")
+    platform_diameter: PositiveLength
+
+
+class Luzi3Spec(_Common):
+    family: Literal["luzi3"]
+    generator: Luzi3Generator | None = None
+    upper_link: PositiveLength
+    tool_offset: Vector3 | Literal["centroid"] = "centroid"  # type: ignore[assignment]
+
+    def build(self) -> Luzi3:
+        explicit = self._explicit("generator")
+        offset = self.tool_offset
+        if explicit:
+            if offset == "centroid":
+                offset = np.mean(np.asarray(self.platform_points), axis=0)
+            return Luzi3(self.base_points, self.platform_points, self.upper_link, self.stroke,
+                         offset, **self._kw())
+        return Luzi3.from_paper(**self.generator.model_dump(), upper_link=self.upper_link,
+                                stroke=self.stroke,
+                                tool_offset=None if offset == "centroid" else offset,
+                                **self._kw())
+
+
 @dataclass(frozen=True, eq=False)
 class Luzi3(Mechanism):
     """Three-chain over-constrained Gough–Stewart geometry.
@@ -125,6 +155,15 @@ class Luzi3(Mechanism):
     """
 
     family = "luzi3"
+    #: the YAML model (``family: luzi3``) and the named study variables (paths in it)
+    spec_model: ClassVar[type] = Luzi3Spec
+    design_aliases: ClassVar[dict] = {
+        "base_diameter": ("generator.base_diameter", "length"),
+        "platform_diameter": ("generator.platform_diameter", "length"),
+        "phi": ("generator.phi", "angle"),
+        "upper_link": ("upper_link", "length"),
+        "stroke_min": ("stroke[0]", "length"),
+        "stroke_max": ("stroke[1]", "length")}
     actuator_names = ("l11", "l12", "l21", "l22", "l31", "l32")
 
     base_points: np.ndarray

@@ -17,16 +17,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar, Literal
 
 import numpy as np
 from numba import njit
 from numba.extending import register_jitable
 
 from ...errors import ParameterError
+from ...quantities import LinkLengths
+from ...specbase import PairedCircles, _Common
 from ..base import NO_STROKE, Mechanism, as_points, as_positive, as_stroke, as_vector3
 from ..joints import DEFAULT_FIELDS, ParamField, kind_arrays, kind_template, platform_joints
 from ..kernels import ik as _kernels
-from ..legs.layout import build_paired
+from ..legs.layout import PAIRED_ALIASES, build_paired
 
 __all__ = ["PSU6"]
 
@@ -81,6 +84,19 @@ def _psu_column_leg(x, y, wx, wy, wz, l2, qmin, qmax):
     return qmin - wz + s, qmax - wz + s, h2 >= 0.0
 
 
+class PSU6Spec(_Common):
+    family: Literal["psu6"]
+    generator: PairedCircles | None = None
+    link_length: LinkLengths
+
+    def build(self) -> PSU6:
+        if self._explicit("generator"):
+            return PSU6(self.base_points, self.platform_points, self.link_length, self.stroke,
+                        self.tool_offset, **self._kw())
+        return PSU6.from_circles(**self.generator.model_dump(), link_length=self.link_length,
+                                 stroke=self.stroke, tool_offset=self.tool_offset, **self._kw())
+
+
 @dataclass(frozen=True, eq=False)
 class PSU6(Mechanism):
     """6-PSU geometry.
@@ -96,6 +112,9 @@ class PSU6(Mechanism):
     """
 
     family = "psu6"
+    #: the YAML model (``family: psu6``) and the named study variables (paths in it)
+    spec_model: ClassVar[type] = PSU6Spec
+    design_aliases: ClassVar[dict] = {**PAIRED_ALIASES, "link_length": ("link_length", "length")}
 
     base_points: np.ndarray
     platform_points: np.ndarray

@@ -42,20 +42,24 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar, Literal
 
 import numpy as np
 from numba import njit
 from numba.extending import register_jitable
+from pydantic import Field
 
 from ...errors import ParameterError
 from ...poses import as_frames
+from ...quantities import AngleWindow, Branches, Directions, LinkLengths
+from ...specbase import PairedCircles, _Common
 from ..base import NO_STROKE, Mechanism, as_points, as_positive, as_vector3
 from ..joints import DEFAULT_FIELDS, ParamField, kind_arrays, kind_template, platform_joints
 from ..kernels import ik as _kernels
 from ..kernels.set_columns import set_column_intervals
 from ..legs.crank import crank_column_leg, crank_params
 from ..legs.crank_cells import crank_cell_terms, crank_position_curvature
-from ..legs.layout import build_paired
+from ..legs.layout import PAIRED_ALIASES, build_paired
 from ..validation import unit_rows, without_component
 from .psu6 import _radii
 
@@ -202,6 +206,48 @@ def _angle_window(value) -> tuple[float, float]:
     return float(arr[0]), float(arr[1])
 
 
+class ServoCircles(PairedCircles):
+    """Generator of the 6-RSS: servo pairs on the paired circles (see ``RSS6.from_circles``)."""
+
+    crank_plane: Literal["radial", "tangential"] = Field(
+        "radial", description="'radial': servo axes tangent to the base circle; 'tangential': "
+        "servo axes radial")
+    zero_direction: Literal["outward", "inward"] = Field(
+        "outward", description="crank zero direction (horizontal): radially out/in, or away "
+        "from / towards the pair partner")
+
+
+class RSS6Spec(_Common):
+    """6-RSS rotary-servo Stewart platform. ``stroke`` is the servo-angle range (deg)."""
+
+    family: Literal["rss6"]
+    generator: ServoCircles | None = None
+    stroke: AngleWindow = Field(description="servo-angle range [min, max] (deg or with units)")
+    crank_length: LinkLengths
+    rod_length: LinkLengths
+    servo_axes: Directions | None = None
+    zero_directions: Directions | None = None
+    branch: Branches = Field(default_factory=lambda: [-1.0] * 6)
+
+    def build(self) -> RSS6:
+        if self._explicit("generator"):
+            if self.servo_axes is None or self.zero_directions is None:
+                raise ParameterError("servo_axes" if self.servo_axes is None
+                                     else "zero_directions",
+                                     "given with explicit base_points (or use a generator)",
+                                     None)
+            return RSS6(self.base_points, self.platform_points, self.servo_axes,
+                        self.zero_directions, self.crank_length, self.rod_length, self.stroke,
+                        self.branch, self.tool_offset, **self._kw())
+        if self.servo_axes is not None or self.zero_directions is not None:
+            raise ParameterError("servo_axes", "absent with a generator (it sets the axes)",
+                                 "given")
+        m = RSS6.from_circles(**self.generator.model_dump(), crank_length=self.crank_length,
+                              rod_length=self.rod_length, stroke=self.stroke,
+                              branch=self.branch, tool_offset=self.tool_offset, **self._kw())
+        return m
+
+
 @dataclass(frozen=True, eq=False)
 class RSS6(Mechanism):
     """6-RSS geometry (rotary servo Stewart platform).
@@ -219,6 +265,16 @@ class RSS6(Mechanism):
     """
 
     family = "rss6"
+    #: the YAML model (``family: rss6``) and the named study variables (paths in it)
+    spec_model: ClassVar[type] = RSS6Spec
+    design_aliases: ClassVar[dict] = {
+        **{k: v for k, v in PAIRED_ALIASES.items() if not k.startswith("stroke")},
+        "crank_length": ("crank_length", "length"),
+        "rod_length": ("rod_length", "length"),
+        "servo_min": ("stroke[0]", "angle"),
+        "servo_max": ("stroke[1]", "angle"),
+        "crank_plane": ("generator.crank_plane", "text"),
+        "zero_direction": ("generator.zero_direction", "text")}
     actuator_names = ("theta1", "theta2", "theta3", "theta4", "theta5", "theta6")
     actuator_unit = "rad"
 

@@ -14,16 +14,18 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from typing import ClassVar, Literal
 
 import numpy as np
 from numba import njit
 from numba.extending import register_jitable
 
 from ...poses import euler_to_matrix
+from ...specbase import PairedCircles, _Common
 from ..base import NO_STROKE, Mechanism, as_points, as_stroke, as_vector3
 from ..joints import DEFAULT_FIELDS, ParamField, kind_arrays, kind_template, platform_joints
 from ..kernels import ik as _kernels
-from ..legs.layout import build_paired
+from ..legs.layout import PAIRED_ALIASES, build_paired
 from .psu6 import _radii
 
 __all__ = ["UPS6", "working_sides"]
@@ -102,6 +104,18 @@ def _ups_column_leg(x, y, wx, wy, wz, side, qmin2, qmax2):
     return -wz - ro, -wz - ri, A >= 0.0
 
 
+class UPS6Spec(_Common):
+    family: Literal["ups6"]
+    generator: PairedCircles | None = None
+
+    def build(self) -> UPS6:
+        if self._explicit("generator"):
+            return UPS6(self.base_points, self.platform_points, self.stroke, self.tool_offset,
+                        **self._kw())
+        return UPS6.from_circles(**self.generator.model_dump(), stroke=self.stroke,
+                                 tool_offset=self.tool_offset, **self._kw())
+
+
 @dataclass(frozen=True, eq=False)
 class UPS6(Mechanism):
     """6-UPS geometry.
@@ -114,6 +128,9 @@ class UPS6(Mechanism):
     """
 
     family = "ups6"
+    #: the YAML model (``family: ups6``) and the named study variables (paths in it)
+    spec_model: ClassVar[type] = UPS6Spec
+    design_aliases: ClassVar[dict] = dict(PAIRED_ALIASES)
 
     base_points: np.ndarray
     platform_points: np.ndarray

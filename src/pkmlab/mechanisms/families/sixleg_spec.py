@@ -22,12 +22,12 @@ from typing import Annotated, Literal
 
 from pydantic import Field
 
-from .errors import ParameterError
-from .mechanisms import Mechanism
-from .mechanisms.families.sixleg import SixLeg
-from .mechanisms.families.sixleg_layout import paired_sixleg
-from .quantities import Angle, AngleWindow, PositiveLength, Stroke, Vector3
-from .specbase import PairedCircles, _Common, _Model
+from ...errors import ParameterError
+from ...quantities import Angle, AngleWindow, PositiveLength, Stroke, Vector3
+from ...specbase import PairedCircles, _Common, _Model
+from ..base import Mechanism
+from .sixleg import SixLeg
+from .sixleg_layout import paired_sixleg
 
 __all__ = ["SixLegSpec"]
 
