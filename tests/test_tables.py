@@ -51,7 +51,8 @@ def test_errors_never_show_the_files_contents(tmp_path, secret):
     with pytest.raises(ParameterError) as exc:
         load_motion_csv(p, field="file")
     assert "s3cr3t" not in str(exc.value)
-    p.write_text(HEADER + "\n" + "0,0,0,0,0,0,0\n1,0,0,0," + secret.replace(",", ";").replace("\x00", ";") + ",0,0\n")
+    cell = secret.replace(",", ";").replace("\x00", ";")
+    p.write_text(HEADER + "\n" + "0,0,0,0,0,0,0\n1,0,0,0," + cell + ",0,0\n")
     with pytest.raises(ParameterError) as exc:
         load_motion_csv(p, field="file")
     assert "s3cr3t" not in str(exc.value) and "not shown" in str(exc.value)
