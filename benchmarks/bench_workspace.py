@@ -8,7 +8,7 @@ Prints, in one run:
   orientation × every leg), the ratio, and whether the two voxel grids agree;
 * the time of the same request on two 6-UPS: one sized like the 6-PSU (radii 165/100 mm
   base, 80/50 mm platform, legs 250-350 mm) and the Kotlarski et al. Gough–Stewart of the
-  shipped studies (their exactness is tested in ``tests/test_workspace.py``);
+  shipped studies (their exactness is tested in ``tests/workspaces/test_workspace.py``);
 * peak memory (max RSS of a fresh process) of the 6-PSU case at 1 mm including its mesh;
 * the 6-RSS servo hexapod (``python benchmarks/bench_workspace.py rss6`` runs only this): the
   ±10° simultaneous dexterous workspace at 2 mm with 7×7×7 orientations by the exact crank
@@ -277,7 +277,7 @@ def main() -> None:
         t, res = timed(lambda m=mech: workspace(m, "dexterous", BOX, H), reps)
         print(f"{name}, same request: {t * 1e3:.0f} ms (target <= 50 ms); volume "
               f"{res.volume / 1e3:.1f} cm3 on {len(res.xs)} x {len(res.ys)} columns "
-              f"(exactness: tests/test_workspace.py)")
+              f"(exactness: tests/workspaces/test_workspace.py)")
     print(f"peak memory, 6-PSU case at 1 mm with mesh: {peak_memory_1mm():.0f} MB "
           "(target < 1024 MB)")
     ups_pruning()

@@ -48,7 +48,7 @@ def servo():
 
 def own():
     """Cranks in radial planes, 120 mm base, 60 mm platform, crank 35 mm, rod 140 mm, window
-    [-0.9, 1.3] rad (the test geometry of tests/test_bracket_rss6.py)."""
+    [-0.9, 1.3] rad (the test geometry of tests/workspaces/test_bracket_rss6.py)."""
     return RSS6.from_circles(base_radii=(120.0, 120.0), platform_radii=(60.0, 60.0),
                              crank_plane="radial", zero_direction="outward",
                              crank_length=35.0, rod_length=140.0, stroke=(-0.9, 1.3),

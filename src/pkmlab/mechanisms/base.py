@@ -55,7 +55,7 @@ method whose name starts with ``_``):
   offset and nominal pose are equal, whatever their names).
 
 What a new family implements (one module and a :data:`pkmlab.mechanisms.REGISTRY` entry; the
-contract suite in ``tests/test_contract.py`` then runs on it):
+contract suite in ``tests/mechanisms/test_contract.py`` then runs on it):
 
 * a frozen dataclass subclassing :class:`Mechanism`, declared with ``eq=False`` so that the
   geometric equality and hash defined here are kept, holding ``base_points``,

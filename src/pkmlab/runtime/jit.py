@@ -41,7 +41,7 @@ the same code: loading both is harmless. Ordinary module-level ``njit(cache=True
 without ``parallel=True`` need none of this. Their symbol is ``module.qualname`` + uid + types,
 numba discards their cache entries when their file changes, and the only other objects that
 contain a linked copy of one are kernels whose identity covers that file. Every ``parallel=True``
-function in pkmlab goes through :func:`cached_kernel` (``tests/test_kernel_cache.py`` checks
+function in pkmlab goes through :func:`cached_kernel` (``tests/runtime/test_kernel_cache.py`` checks
 this).
 
 If this numba has no ``FunctionIdentity._unique_ids`` counter, kernels are compiled uncached. Each

@@ -1,5 +1,5 @@
 """A minimal pkmlab family plugin: ``legs6``, six extensible legs (a bare 6-UPS without a
-working-mode check), used by tests/test_plugins.py and shown in the README."""
+working-mode check), used by tests/mechanisms/test_plugins.py and shown in the README."""
 
 import math
 from dataclasses import dataclass

@@ -1,6 +1,6 @@
 """A three-leg translational family written as a plugin: ``tri3``, three extensible legs
 between base points and platform points on a platform that only translates (a 3-UPU with its
-universal joints arranged for pure translation). Used by tests/test_mobility.py."""
+universal joints arranged for pure translation). Used by tests/mechanisms/test_mobility.py."""
 
 import math
 from dataclasses import dataclass

@@ -68,7 +68,7 @@ drive_euler``, and the gufuncs shared ``__numba_parfor_gufunc_<address>``. Their
 only by the per-process counter, so two processes could give two families' kernels the same
 symbol. A third process that loaded both then ran the first one's code for both: the ``legs``
 of psu6 behind the 6-UPS driver gave NaN, the frames driver of ups6 behind psu6 gave plausible
-wrong numbers (``tests/test_kernel_cache.py``).
+wrong numbers (``tests/runtime/test_kernel_cache.py``).
 
 Invalidation: editing this module, a family module, or anything a kernel compiles in changes
 the kernel's identity and so its name. The next process finds no cache entry under the new

@@ -62,7 +62,7 @@ items are evaluated in batches sized to take about 0.5 s, the clock is checked b
 a step whose next batch, or whose remaining items at twice the recent speed (plus the last
 step's bookkeeping), would end past the budget is abandoned: the result is the bracket of the
 last completed step, returned early when the next step clearly cannot fit. Overrun: about
-one misjudged batch (``tests/test_bracket.py`` allows ``0.25·budget + 1 s``).
+one misjudged batch (``tests/workspaces/test_bracket.py`` allows ``0.25·budget + 1 s``).
 
 **Connected to nominal.** Components are taken on the inner and outer sets separately (cells
 8-adjacent, z sets touching). The component of the inner set that contains the nominal

@@ -10,7 +10,7 @@ import tracemalloc
 
 import numpy as np
 import pytest
-from test_faults import HW, LUZI, cli, one_line, small_study
+from clihelp import HW, LUZI, cli, one_line, small_study
 
 import pkmlab
 from pkmlab.errors import ParameterError

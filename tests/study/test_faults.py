@@ -14,77 +14,9 @@ import time
 from pathlib import Path
 
 import pytest
-import yaml
-from conftest import MECH_DIR
+from clihelp import GS, HW, LUZI, cli, error_lines, mech_file, one_line, small_study
 
-from pkmlab.cli import run_cli
 from pkmlab.study import SerialRunner, load_study, run_study
-
-HW = MECH_DIR / "hopkins-williams-6psu.yaml"
-GS = MECH_DIR / "gough-stewart-6ups.yaml"
-LUZI = MECH_DIR / "luzi-3chain.yaml"
-
-
-def cli(capsys, *args, env: dict | None = None, monkeypatch=None) -> tuple[int, str, str]:
-    """Run the console entry point in process: (exit code, stdout, stderr)."""
-    if env and monkeypatch is not None:
-        for k, v in env.items():
-            monkeypatch.setenv(k, v)
-    old = sys.argv
-    sys.argv = ["pkmlab", *map(str, args)]
-    try:
-        run_cli()
-        code = 0
-    except SystemExit as exc:
-        code = exc.code
-    finally:
-        sys.argv = old
-    o, e = capsys.readouterr()
-    return code, o, e
-
-
-def error_lines(err: str) -> list[str]:
-    """stderr without pkmlab's progress log lines (``pkmlab: …``), which are not errors."""
-    return [ln for ln in err.strip().splitlines() if not ln.startswith("pkmlab: ")]
-
-
-def one_line(code, err, *fragments):
-    assert code == 2, (code, err)
-    lines = error_lines(err)
-    assert len(lines) == 1 and lines[0].startswith("error: "), err
-    assert "Traceback" not in err
-    for f in fragments:
-        assert f in lines[0], (f, lines[0])
-    return lines[0]
-
-
-def small_study(tmp_path: Path, **over) -> Path:
-    data = {
-        "study": "tiny",
-        "mechanism": {"file": str(HW)},
-        "design": {"link_length": {"low": "200 mm", "high": "260 mm"}},
-        "evaluate": {"workspace": {"kind": "constant", "samples": 1, "resolution": "8 mm"}},
-        "objectives": [{"maximize": "constant_volume"}],
-        "optimizer": {"method": "sobol", "samples": 4},
-        "seed": 1,
-        "output": str(tmp_path / "out"),
-    }
-    data.update(over)
-    p = tmp_path / "study.yaml"
-    p.write_text(yaml.safe_dump(data))
-    return p
-
-
-def mech_file(tmp_path: Path, src: Path, **replace) -> Path:
-    text = src.read_text()
-    for key, value in replace.items():
-        lines = [f"{key}: {value}" if ln.startswith(f"{key}:") else ln
-                 for ln in text.splitlines()]
-        text = "\n".join(lines) + "\n"
-    p = tmp_path / f"{src.stem}-edited.yaml"
-    p.write_text(text)
-    return p
-
 
 # ---- 1. memory budget --------------------------------------------------------------------------
 

@@ -29,7 +29,7 @@ from pkmlab.study import (
 )
 from pkmlab.study import evaluators as ev_mod
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 HOPKINS = MECH_DIR / "hopkins-williams-6psu.yaml"
 SHIPPED = sorted((ROOT / "studies").glob("*.yaml")) + sorted(
     (ROOT / "studies" / "templates").glob("*.yaml"))

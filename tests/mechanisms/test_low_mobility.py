@@ -17,7 +17,7 @@ from pkmlab.errors import ParameterError
 from pkmlab.mechanisms import REGISTRY, register_family
 from pkmlab.workspaces import OrientationSet
 
-sys.path.insert(0, str(Path(__file__).parent / "data" / "plugin3"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "data" / "plugin3"))
 import pkmlab_tri3_family as tri3  # noqa: E402
 
 H = 20.0                       # mm: a coarse grid keeps the file fast (about 1 s per workspace)

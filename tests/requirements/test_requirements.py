@@ -32,7 +32,7 @@ from pkmlab.study import load_study, study_from_mapping
 from pkmlab.study.evaluators import evaluate_design
 from pkmlab.workspaces import OrientationSet
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 # ---- task containment against brute force ---------------------------------------------------

@@ -17,7 +17,7 @@ from pkmlab.mechanisms.kernels import ik as _kernels
 from pkmlab.mechanisms.mobility import Mobility
 from pkmlab.testing import run_contract
 
-sys.path.insert(0, str(Path(__file__).parent / "data" / "plugin3"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "data" / "plugin3"))
 import pkmlab_tri3_family as tri3  # noqa: E402
 
 
@@ -129,7 +129,7 @@ def test_mobility_declarations():
         TRANSLATIONAL.full(np.zeros((2, 4)), np.zeros(6))
 
 
-# the workspace, dexterity and study layers on this family: tests/test_low_mobility.py
+# the workspace, dexterity and study layers on this family: tests/mechanisms/test_low_mobility.py
 
 
 def test_the_fk_mode_check_moves_the_free_coordinates_only(tripod):
@@ -142,7 +142,7 @@ def test_pkmlab_fk_takes_one_value_per_declared_actuator(tripod, tmp_path, capsy
     """`pkmlab fk` asked for six values whatever the family declared (and then refused six)."""
     import json
 
-    from test_faults import cli
+    from clihelp import cli
 
     f = tmp_path / "tri3.yaml"
     f.write_text("family: tri3\nbase_points: " + str(tri3.circle(300.0).tolist())

@@ -17,7 +17,7 @@ import pkmlab
 from pkmlab.mechanisms import RSS6
 from pkmlab.workspaces import Constraints, OrientationSet, workspace
 
-FILE = Path(__file__).resolve().parents[1] / "studies" / "mechanisms" / \
+FILE = Path(__file__).resolve().parents[2] / "studies" / "mechanisms" / \
     "instructables-servo-6rss.yaml"
 DZ = 0.05          # brute-force z step (mm)
 EPS = 1e-9         # boundary probe (mm)

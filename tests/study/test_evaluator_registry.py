@@ -36,7 +36,7 @@ from pkmlab.study.evaluators import (
 from pkmlab.study.metrics import METRICS
 from pkmlab.study.store import Store
 
-sys.path.insert(0, str(Path(__file__).parent / "data" / "plugin3"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "data" / "plugin3"))
 import pkmlab_tri3_family as tri3  # noqa: E402
 
 HW = MECH_DIR / "hopkins-williams-6psu.yaml"

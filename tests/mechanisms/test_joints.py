@@ -18,7 +18,7 @@ from pkmlab.mechanisms import NO_STROKE, PSU6, RSS6, UPS6, Luzi3
 from pkmlab.mechanisms.joints import JointsMixin, chain_errors
 from pkmlab.poses import as_frames
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).resolve().parents[1] / "data"
 sys.path[:0] = [str(DATA / "plugin"), str(DATA / "plugin3")]
 import pkmlab_demo_family as demo  # noqa: E402
 import pkmlab_tri3_family as tri3  # noqa: E402

@@ -22,7 +22,7 @@ import pkmlab
 from pkmlab.poses import euler_to_matrix  # plain NumPy
 
 SRC = Path(pkmlab.__file__).resolve().parents[1]
-MECH_DIR = Path(__file__).resolve().parents[1] / "studies" / "mechanisms"
+MECH_DIR = Path(__file__).resolve().parents[2] / "studies" / "mechanisms"
 # psu6 and ups6 pass geometry tuples of the same length, so their kernels have the same argument
 # types and, before pkmlab.runtime.jit, could get the same symbols (luzi3's could not: 28 floats).
 FILES = {"psu6": "hopkins-williams-6psu.yaml", "ups6": "gough-stewart-6ups.yaml"}

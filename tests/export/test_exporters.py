@@ -7,20 +7,12 @@ import json
 
 import numpy as np
 import pytest
+from clihelp import cli, small_study
+from clihelp import off_bytes as _off
 from conftest import MECH_DIR
-from test_faults import cli, small_study
 
 from pkmlab.export import EXPORTERS, Exporter, exporters, register_exporter
 from pkmlab.export.meshes import STL_HEADER
-
-
-def _off(mesh) -> bytes:
-    """Object File Format (text): 'OFF', counts, vertices (mm), faces."""
-    v, f = np.asarray(mesh.vertices), np.asarray(mesh.faces)
-    lines = ["OFF", f"{len(v)} {len(f)} 0"]
-    lines += [f"{a:.6f} {b:.6f} {c:.6f}" for a, b, c in v]
-    lines += [f"3 {a} {b} {c}" for a, b, c in f]
-    return ("\n".join(lines) + "\n").encode()
 
 
 @pytest.fixture

@@ -21,7 +21,7 @@ from pkmlab.study.evaluators import EVALUATORS, Context
 from pkmlab.workspaces import Constraints, JointLimits, OrientationSet, workspace
 from pkmlab.workspaces.constraints import check, joint_angles, segment_distances
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 FILE = ROOT / "studies" / "mechanisms" / "instructables-servo-6rss.yaml"
 PSU = ROOT / "studies" / "mechanisms" / "hopkins-williams-6psu.yaml"
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import sqlite3
 
 import pytest
-from test_faults import cli, small_study
+from clihelp import cli, small_study
 
 from pkmlab.errors import ParameterError
 from pkmlab.study import SerialRunner, load_study, run_study
@@ -134,7 +134,7 @@ def test_overwrite_refuses_user_files_named_like_scratch_files(capsys, tmp_path,
 
 def test_overwrite_accepts_meshes_of_a_registered_format(capsys, tmp_path):
     """A study writes every registered mesh format; --overwrite must know them as pkmlab's."""
-    from test_exporters import _off
+    from clihelp import off_bytes as _off
 
     from pkmlab.export import EXPORTERS, Exporter, register_exporter
 

@@ -17,7 +17,7 @@ from pkmlab.poses import as_frames
 from pkmlab.testing import random_valid_poses
 
 REASON = {v: k for k, v in LEG_STATUS.items()}
-FILE = Path(__file__).resolve().parents[1] / "studies" / "mechanisms" / \
+FILE = Path(__file__).resolve().parents[2] / "studies" / "mechanisms" / \
     "instructables-servo-6rss.yaml"
 
 GEOMETRIES = {

@@ -106,7 +106,7 @@ def test_bad_mechanism_file_exits_2(tmp_path):
 
 # ---- bad input: one line on stderr naming the field (and where in the file), exit 2 ----------
 
-BAD_DIR = Path(__file__).parent / "data" / "bad"
+BAD_DIR = Path(__file__).resolve().parents[1] / "data" / "bad"
 HW = (MECH_DIR / "hopkins-williams-6psu.yaml").read_text()
 
 
@@ -199,7 +199,7 @@ def test_utf16_without_a_byte_order_mark(tmp_path):
 
 
 def test_one_line_in_a_real_process_on_a_narrow_terminal():
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[1] / "src"), "COLUMNS": "60"}
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[2] / "src"), "COLUMNS": "60"}
     p = subprocess.run([sys.executable, "-m", "pkmlab.cli", "validate",
                         str(BAD_DIR / "unknown-key-typo.yaml")], capture_output=True, text=True,
                        env=env, timeout=120)

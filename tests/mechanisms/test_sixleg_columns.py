@@ -41,7 +41,7 @@ def _tilted():
 GEOMETRIES = {
     "file": lambda: pkmlab.load_mechanism(FILE),
     "tilted": _tilted,
-    # tests/test_rss6_columns.py's sized geometry: non-empty ±10° dexterous workspace
+    # tests/mechanisms/test_rss6_columns.py's sized geometry: non-empty ±10° dexterous workspace
     "sized": lambda: RSS6.from_circles(base_radii=(102.0, 102.0), platform_radii=(80.0, 80.0),
                                        crank_length=46.0, rod_length=183.0,
                                        crank_plane="tangential"),
