@@ -156,3 +156,52 @@ def test_pkmlab_fk_takes_one_value_per_declared_actuator(tripod, tmp_path, capsy
     assert abs(pose["z"] - 400.0) < 1e-6 and abs(pose["x"]) < 1e-6
     code, _, err = cli(capsys, "fk", f, "--actuators", "1,2,3,4,5,6")
     assert code == 2 and "--actuators: must be 3 comma-separated values" in err, err
+
+
+def _tri3_file(tmp_path):
+    f = tmp_path / "tri3.yaml"
+    f.write_text("family: tri3\nbase_points: " + str(tri3.circle(300.0).tolist())
+                 + "\nplatform_points: " + str(tri3.circle(60.0).tolist())
+                 + "\nstroke: [250, 600]\n")
+    return f
+
+
+def test_pkmlab_ik_takes_the_free_coordinates_and_prints_them(tripod, tmp_path, capsys):
+    """`pkmlab ik --pose` asked for six coordinates whatever the mobility."""
+    import json
+
+    from clihelp import cli
+
+    f = _tri3_file(tmp_path)
+    code, out, err = cli(capsys, "ik", f, "--pose", "5,-3,400", "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    q = tripod.inverse([[5.0, -3.0, 400.0]]).q[0]
+    assert data["valid"] and np.allclose(list(data["actuators"].values()), q, atol=1e-9)
+    code, out, err = cli(capsys, "ik", f, "--pose", "5,-3,400")
+    assert code == 0 and "pose: x=5.0000 y=-3.0000 z=400.0000 mm\n" in out, out
+    code, _, err = cli(capsys, "ik", f, "--pose", "5,-3")
+    assert code == 2 and "--pose: must be 3 comma-separated values (x,y,z) or all six" in err
+
+
+def test_the_trajectory_check_balances_the_payload_on_the_tripods_three_legs(tripod):
+    """check_trajectory refused any mechanism but a six-DOF one. On the tripod the paper's motion
+    moves x, y, z only, and the leg forces balance the payload's weight: Σ f_i·u_i = −m·g with
+    u_i the unit leg directions from an independent NumPy computation (to 1e-9 N)."""
+    from pkmlab.motion import check_trajectory, paper_motion
+
+    motion = paper_motion(tripod)
+    assert np.ptp(motion.poses[:, 3:], axis=0).max() == 0.0      # the angles stay nominal
+    assert np.ptp(motion.poses[:, :3], axis=0) == pytest.approx([101.6] * 3)
+    rep = check_trajectory(tripod, motion.t, motion.poses, payload_mass_kg=5.0,
+                           max_force=30.0)
+    assert rep.q.shape == (len(motion.t), 3) and rep.force.shape == (len(motion.t), 3)
+    W = motion.poses[:, None, :3] + tripod.platform_points[None] - tripod.tool_offset
+    u = W - tripod.base_points[None]
+    u /= np.linalg.norm(u, axis=2, keepdims=True)
+    total = np.einsum("ti,tij->tj", rep.force, u)
+    np.testing.assert_allclose(total, np.broadcast_to([0.0, 0.0, 5.0 * 9.81],
+                                                      total.shape), atol=1e-9)
+    assert rep.violations["force"] is None and rep.fits
+    same = check_trajectory(tripod, motion.t, motion.poses[:, :3], payload_mass_kg=5.0)
+    np.testing.assert_array_equal(same.force, rep.force)

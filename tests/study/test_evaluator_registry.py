@@ -116,7 +116,6 @@ def test_validate_refuses_what_a_translational_family_cannot_serve(tri3_family, 
               "orientation_capability",
               r"needs rotations \(a free orientation coordinate\); family 'tri3' has "
               r"translational mobility \(x, y, z\)\); got True"),
-             ({"trajectory": {}}, "paper_motion_fits", "trajectory", "needs rotations"),
              ({"workspace": {"kind": "dexterous", "box": [5, 5, 5], "resolution": "10 mm"}},
               "dexterous_volume", "workspace", "needs rotations"),
              ({"workspace": ws, "volume_bracket": {}}, "constant_volume", "volume_bracket",
@@ -137,7 +136,9 @@ def test_validate_refuses_what_a_translational_family_cannot_serve(tri3_family, 
     ({}, "base_outer_radius"),
     # a constant workspace and dexterity (refused before: "needs six free pose coordinates")
     ({"workspace": {"kind": "constant", "resolution": "20 mm"},
-      "dexterity": {"gci_samples": 200}}, "worst_kappa")])
+      "dexterity": {"gci_samples": 200}}, "worst_kappa"),
+    # the paper's motion on the free coordinates (refused before: "needs rotations")
+    ({"trajectory": {"payload": 2.0}}, "paper_motion_margin")])
 def test_what_validates_for_a_translational_family_runs(tri3_family, tmp_path, evaluate,
                                                         objective):
     data = tri3_study(tmp_path, evaluate, objective)
@@ -154,9 +155,12 @@ def test_what_validates_for_a_translational_family_runs(tri3_family, tmp_path, e
     for row in rows:      # the base joints lie on a 300 mm circle in the base plane
         assert row["metrics"]["base_outer_radius"] == pytest.approx(300.0, abs=1e-9)
         assert row["metrics"]["servo_range"] is None
-        if evaluate:      # κ of the unit leg directions, no characteristic length
+        if "dexterity" in evaluate:      # κ of the unit leg directions, no characteristic length
             assert row["metrics"]["worst_kappa"] > row["metrics"]["nominal_kappa"] >= 1.0
             assert row["metrics"]["characteristic_length"] is None
+        if "trajectory" in evaluate:     # x, y, z by ±2 in: the stroke is far from binding
+            assert row["metrics"]["paper_motion_fits"] == 1.0
+            assert 0.0 < row["metrics"]["paper_motion_margin"] < 350.0
 
 
 def test_an_actuator_of_the_wrong_kind_is_refused_at_load(tmp_path):

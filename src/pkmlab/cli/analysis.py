@@ -161,7 +161,7 @@ def _print_dexterity(rep, force_limit, well_conditioned, force_required, written
     d, mech = rep.data, rep.mechanism
     n, agg, cl = d["nominal"], d["aggregates"], d["characteristic_length"]
     out.print(f"[bold]{escape(mech.name or mech.family)}[/] at the nominal pose "
-              f"{_pose_str(mech.nominal_pose)}:")
+              f"{_pose_str(mech.nominal_pose, mech)}:")
     out.print(escape(f"  {_kappa_text(n)}, LCI = {n['lci']:.4f}, σ_min = "
                      f"{g(n['sigma_min'], '.4g')}; singularity: {n['singularity']}"),
               highlight=False)

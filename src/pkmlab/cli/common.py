@@ -16,7 +16,8 @@ from rich.text import Text
 
 from ..config import load_mechanism
 from ..errors import ParameterError
-from ..mechanisms import Mechanism
+from ..mechanisms import SPATIAL, Mechanism
+from ..mechanisms.mobility import POSE
 from ..units import parse_angle, parse_length
 from ..yamlio import locate_error
 
@@ -25,7 +26,7 @@ app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_
 out = Console()
 err = Console(stderr=True, soft_wrap=True)  # one line per error, whatever the width
 
-POSE_KEYS = ("x", "y", "z", "theta_x", "theta_y", "theta_z")
+POSE_KEYS = POSE
 JSON_HELP = ("Print JSON. Pose keys: x, y, z (mm), theta_x, theta_y, theta_z (deg, Z-Y-X Euler); "
              "actuators: {name: value} with the family's actuator names, in mm (prismatic) or "
              "deg (rotary families such as rss6; the key actuator_unit says which).")
@@ -73,14 +74,23 @@ def _parse_csv(text: str, field: str, n: int) -> list[str]:
     return parts
 
 
-def _parse_pose(text: str, field: str = "--pose") -> np.ndarray:
-    parts = _parse_csv(text, field, 6)
+def _parse_pose(text: str, field: str = "--pose", mech: Mechanism | None = None) -> np.ndarray:
+    """A pose in the mechanism's free coordinates (``x,y,z`` for a translational one, ``x,y,θz``
+    for a planar one; mm and deg unless units are given) or all six; returns six coordinates
+    (the others at the nominal pose)."""
+    mob = SPATIAL if mech is None else mech.mobility
+    parts = [p.strip() for p in text.split(",")]
+    coords = POSE if len(parts) == len(POSE) else mob.coordinates
+    if len(parts) != len(coords) or any(p == "" for p in parts):
+        also = "" if mob.is_spatial else " or all six (x,y,z,θx,θy,θz)"
+        _fail(ParameterError(field, f"{mob.width} comma-separated values "
+                             f"({','.join(mob.coordinates)}){also}", text))
     try:
-        lin = [parse_length(p, f"{field}[{i}]") for i, p in enumerate(parts[:3])]
-        ang = [parse_angle(p, f"{field}[{i + 3}]") for i, p in enumerate(parts[3:])]
+        values = np.array([(parse_angle if c.startswith("theta") else parse_length)(
+            p, f"{field}[{i}]") for i, (c, p) in enumerate(zip(coords, parts))])
     except ParameterError as exc:
         _fail(exc)
-    return np.array(lin + ang)
+    return values if len(coords) == len(POSE) else mob.full(values, mech.nominal_pose)[0]
 
 
 def _pose_json(pose: np.ndarray) -> dict:
@@ -120,11 +130,15 @@ def _parse_actuators(mech: Mechanism, text: str) -> np.ndarray:
         _fail(exc)
 
 
-def _pose_str(pose: np.ndarray) -> str:
-    p = _pose_json(pose)
-    return (f"x={p['x']:.4f} y={p['y']:.4f} z={p['z']:.4f} mm, θx={p['theta_x']:.4f} "
-            f"θy={p['theta_y']:.4f} θz={p['theta_z']:.4f} deg") if None not in p.values() \
-        else "undefined"
+def _pose_str(pose: np.ndarray, mech: Mechanism | None = None) -> str:
+    """The pose's coordinates (the free ones of ``mech``'s mobility when given) in mm and deg."""
+    p = _pose_json(np.asarray(pose, dtype=float).reshape(-1)[:len(POSE)])
+    coords = POSE if mech is None else mech.mobility.coordinates
+    if any(p[c] is None for c in coords):
+        return "undefined"
+    lin = " ".join(f"{c}={p[c]:.4f}" for c in coords if not c.startswith("theta"))
+    ang = " ".join(f"θ{c[-1]}={p[c]:.4f}" for c in coords if c.startswith("theta"))
+    return ", ".join(s for s in (lin and lin + " mm", ang and ang + " deg") if s)
 
 
 def _emit(data: dict) -> None:

@@ -69,7 +69,7 @@ def inspect(mech_file: MechArg, as_json: JsonOpt = False) -> None:
         table.add_row(str(i + 1), *[(" ".join(f"{c:9.3f}" for c in g[k][i])
                                      if i < len(g[k]) else "") for k in pts])
     out.print(table)
-    out.print(f"nominal pose: {_pose_str(nominal)}")
+    out.print(f"nominal pose: {_pose_str(nominal, mech)}")
     out.print(f"nominal actuators ({_act_unit(mech)}): "
               + _act_str(mech, mech.inverse(nominal).q[0]) + escape(f"  [{rep['reason']}]"))
     out.print(escape(f"at nominal: {_kappa_text(rep)}"), highlight=False)
@@ -79,14 +79,16 @@ def inspect(mech_file: MechArg, as_json: JsonOpt = False) -> None:
 
 @app.command()
 def ik(mech_file: MechArg,
-       pose: Annotated[str, typer.Option(help='Tool pose "x,y,z,θx,θy,θz" in mm and deg '
-                                              '(units may be given, e.g. "2 in").')],
+       pose: Annotated[str, typer.Option(help='Tool pose in the mechanism\'s free coordinates, '
+                                              'mm and deg: "x,y,z,θx,θy,θz" (six-DOF), "x,y,z" '
+                                              '(translational), "x,y,θz" (planar); all six are '
+                                              'accepted too; units may be given, e.g. "2 in".')],
        as_json: JsonOpt = False) -> None:
     """Inverse kinematics: actuator values of one pose, with validity, reason and κ."""
     from ..dexterity.report import pose_report
 
     mech = _load(mech_file)
-    X = _parse_pose(pose)
+    X = _parse_pose(pose, mech=mech)
     rep = pose_report(mech, X)
     legs = [rep["reason"]] if rep["valid"] else [
         f"{n}: {st}" for n, st in rep["leg_status"].items() if st != "ok"]
@@ -97,7 +99,7 @@ def ik(mech_file: MechArg,
     if as_json:
         _emit(data)
         return
-    out.print(f"pose: {_pose_str(X)}")
+    out.print(f"pose: {_pose_str(X, mech)}")
     out.print(f"actuators ({_act_unit(mech)}): " + _act_str(mech, mech.inverse(X).q[0], 6))
     out.print(("[green]valid[/]" if rep["valid"] else "[red]invalid[/]") + ": "
               + escape("; ".join(legs)))
@@ -125,7 +127,7 @@ def fk(mech_file: MechArg,
     """Forward kinematics (Newton from the nominal pose or --guess); --all for every mode."""
     mech = _load(mech_file)
     q = _parse_actuators(mech, actuators)
-    g = None if guess is None else _parse_pose(guess, "--guess")
+    g = None if guess is None else _parse_pose(guess, "--guess", mech)
     res = mech.forward(q, g, modes=True)
     amb = bool(res.ambiguous[0])
     data = {"actuator_unit": _act_unit(mech), "actuators": _act_json(mech, q),
@@ -149,11 +151,11 @@ def fk(mech_file: MechArg,
     out.print(f"forward kinematics: [{'green' if res.converged[0] else 'red'}]"
               f"{res.status[0]}[/] after {res.iterations[0]} iterations, "
               f"residual {res.residual[0]:.3g} mm")
-    out.print(f"pose: {_pose_str(res.pose[0])}")
+    out.print(f"pose: {_pose_str(res.pose[0], mech)}")
     if amb:
         out.print(f"[yellow]ambiguous[/]: another working-mode assembly mode has the same "
                   f"actuator values, {res.next_mode_mm[0]:.4g} mm and "
-                  f"{res.next_mode_deg[0]:.4g}° away: {_pose_str(res.next_mode[0])} "
+                  f"{res.next_mode_deg[0]:.4g}° away: {_pose_str(res.next_mode[0], mech)} "
                   "(--all lists every mode found)")
     elif res.converged[0]:
         out.print(f"no other working-mode assembly mode reached from {res.mode_starts} starts "
@@ -182,7 +184,7 @@ def demo(folder: Annotated[Path, typer.Argument(help="Folder of mechanism YAML f
         mech = _load(f)
         X = mech.nominal_pose + np.array([10.0, -5.0, 8.0, *np.radians([5.0, -4.0, 10.0])])
         res = mech.inverse(X)
-        out.print(f"IK of a displaced pose {_pose_str(X)}:")
+        out.print(f"IK of a displaced pose {_pose_str(X, mech)}:")
         out.print("  " + _act_str(mech, res.q[0])
                   + escape(f" {_act_unit(mech)} [{res.reason_text[0]}]"))
         back = mech.forward(res.q[0])

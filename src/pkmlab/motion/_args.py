@@ -31,13 +31,14 @@ def finite(value: Any, name: str, unit: str) -> float:
     return v
 
 
-def limit6(value: Any, name: str, unit: str) -> np.ndarray | None:
+def per_actuator(value: Any, name: str, unit: str, n: int) -> np.ndarray | None:
+    """A limit given once or per actuator → ``(n,)`` positive finite values (None: no limit)."""
     if value is None:
         return None
     arr = np.asarray(value, dtype=float)
     if arr.shape == ():
-        arr = np.full(6, float(arr))
-    if arr.shape != (6,) or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
-        raise ParameterError(name, f"None, a number > 0 ({unit}) or six of them",
+        arr = np.full(n, float(arr))
+    if arr.shape != (n,) or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise ParameterError(name, f"None, a number > 0 ({unit}) or one per actuator ({n})",
                              value if np.ndim(value) else float(arr.ravel()[0]))
     return arr

@@ -25,10 +25,9 @@ import numpy as np
 from ..dexterity.metrics import CharacteristicLength, condition_number, resolve_length
 from ..errors import ParameterError
 from ..mechanisms.base import LEG_STATUS, Mechanism
-from ..mechanisms.mobility import require_spatial
 from ..poses import as_frames
 from ..tolerances import TOL
-from ._args import limit6 as _limit6
+from ._args import per_actuator as _per_actuator
 from ._args import positive as _positive
 
 log = logging.getLogger(__name__)
@@ -72,17 +71,17 @@ class Violation:
 
 @dataclass(frozen=True)
 class TrajectoryReport:
-    """Result of :func:`check_trajectory` for T samples of a 6-actuator mechanism.
+    """Result of :func:`check_trajectory` for T samples of a mechanism with L actuators.
 
     Attributes:
         t: ``(T,)`` times in s.
         poses: ``(T, 6)`` tool poses (mm, rad).
-        q: ``(T, 6)`` actuator values in mm (from ``mech.inverse``; NaN only where the sample's
+        q: ``(T, L)`` actuator values in mm (from ``mech.inverse``; NaN only where the sample's
             ``status`` says the pose has no inverse-kinematics solution).
-        qdot: ``(T, 6)`` actuator speeds in mm/s, ``np.gradient(q, t)`` (second-order central
+        qdot: ``(T, L)`` actuator speeds in mm/s, ``np.gradient(q, t)`` (second-order central
             differences inside, one-sided at the ends); NaN where a sample used for the
             difference has no solution (``status`` says so).
-        force: ``(T, 6)`` static actuator forces in N holding the payload: the force each
+        force: ``(T, L)`` static actuator forces in N holding the payload: the force each
             actuator applies along its own +q direction (positive pushes the moving side
             towards larger q), from ``Jᵀ·force = −wrench``. NaN where the Jacobian is singular
             or undefined (``status`` says so).
@@ -98,13 +97,13 @@ class TrajectoryReport:
         violations: first :class:`Violation` per kind, keys ``"stroke"``, ``"jacobian"``,
             ``"speed"``, ``"force"`` (value ``None`` if that kind never occurs; speed and force
             are only checked when a limit was given).
-        margin_low, margin_high: ``(6,)`` minimum over the samples with a solution of
+        margin_low, margin_high: ``(L,)`` minimum over the samples with a solution of
             ``q − qmin`` and ``qmax − q`` in mm (negative: the stroke is exceeded by that much;
             NaN only if no sample has a solution).
-        margin_low_index, margin_high_index: ``(6,)`` sample index of each minimum (−1 if none).
+        margin_low_index, margin_high_index: ``(L,)`` sample index of each minimum (−1 if none).
         actuator_names: actuator names, as ``mech.actuator_names``.
-        actuator_limits: ``(6, 2)`` stroke [min, max] per actuator in mm.
-        max_speed, max_force: ``(6,)`` limits used (mm/s, N), or ``None``.
+        actuator_limits: ``(L, 2)`` stroke [min, max] per actuator in mm.
+        max_speed, max_force: ``(L,)`` limits used (mm/s, N), or ``None``.
         payload_mass_kg: payload mass in kg.
         fits: True when every sample is ``"ok"``: all poses valid and within stroke, no
             singular Jacobian, and no speed/force limit exceeded.
@@ -141,10 +140,10 @@ class TrajectoryReport:
         both = np.concatenate([self.margin_low, self.margin_high])
         if not np.any(np.isfinite(both)):
             return math.nan, "", -1, ""
-        k = int(np.nanargmin(both))
-        side = "min" if k < 6 else "max"
-        idx = (self.margin_low_index if k < 6 else self.margin_high_index)[k % 6]
-        return float(both[k]), self.actuator_names[k % 6], int(idx), side
+        k, n = int(np.nanargmin(both)), len(self.margin_low)
+        side = "min" if k < n else "max"
+        idx = (self.margin_low_index if k < n else self.margin_high_index)[k % n]
+        return float(both[k]), self.actuator_names[k % n], int(idx), side
 
     def summary(self) -> dict:
         """Plain-Python dict (JSON-serialisable) of the result.
@@ -164,7 +163,7 @@ class TrajectoryReport:
 
         def peak(a: np.ndarray) -> np.ndarray:
             finite = np.isfinite(a)
-            out = np.full(6, np.nan)
+            out = np.full(a.shape[1], np.nan)
             has = finite.any(axis=0)
             out[has] = np.max(np.where(finite, np.abs(a), -np.inf), axis=0)[has]
             return out
@@ -229,12 +228,17 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
     Args:
         mech: the mechanism.
         t: times ``(T,)`` in s, finite and strictly increasing, T >= 2.
-        poses: tool poses ``(T, 6)`` (mm, rad; non-finite entries are reported, not raised).
+        poses: tool poses ``(T, 6)``, or ``(T, width)`` in a lower mobility's free coordinates
+            (mm, rad; non-finite entries are reported, not raised).
         payload_mass_kg: payload mass in kg (>= 0).
         payload_com: payload centre of mass ``(3,)`` in mm in the tool frame.
         gravity: gravitational acceleration ``(3,)`` in mm/s², base frame.
-        max_speed: actuator speed limit in mm/s, scalar or ``(6,)``, compared with ``|q̇|``.
-        max_force: actuator force limit in N, scalar or ``(6,)``, compared with ``|f|``.
+        max_speed: actuator speed limit in mm/s, scalar or one per actuator, compared with
+            ``|q̇|``.
+        max_force: actuator force limit in N, scalar or one per actuator, compared with
+            ``|f|``. On a lower-mobility mechanism the forces balance the wrench's free
+            components (the constraint wrench takes the rest); with more actuators than free
+            coordinates they are the least-norm solution.
         stroke_tolerance: round-off allowance in mm: an actuator value at most this far
             outside its window still counts as inside (a motion planned to touch a limit
             exactly, as the paper's z motion does, is not a violation).
@@ -247,7 +251,7 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
     Raises:
         ParameterError: for malformed inputs (shapes, non-monotonic time, negative mass, ...).
     """
-    require_spatial(mech, "trajectory checks")
+    mob, n_act = mech.mobility, mech.n_actuators
     t = np.array(t, dtype=float)
     if t.ndim != 1 or len(t) < 2:
         raise ParameterError("t", "an array of shape (T,) with T >= 2 (s)", t.shape)
@@ -260,9 +264,11 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
         raise ParameterError(f"t[{k}]", f"strictly increasing time (> {t[k - 1]:g} s)",
                              float(t[k]))
     X = np.array(poses, dtype=float)
+    if X.ndim == 2 and X.shape == (len(t), mob.width) and not mob.is_spatial:
+        X = mob.full(X, mech.nominal_pose)
     if X.shape != (len(t), 6):
-        raise ParameterError("poses", f"an array of shape ({len(t)}, 6) matching t (mm, rad)",
-                             X.shape)
+        raise ParameterError("poses", f"an array of shape ({len(t)}, 6) or ({len(t)}, "
+                             f"{mob.width}) matching t (mm, rad)", X.shape)
     mass = _positive(payload_mass_kg, "payload_mass_kg", "kg", allow_zero=True)
     com = np.asarray(payload_com, dtype=float)
     if com.shape != (3,) or not np.all(np.isfinite(com)):
@@ -270,8 +276,8 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
     g = np.asarray(gravity, dtype=float)
     if g.shape != (3,) or not np.all(np.isfinite(g)):
         raise ParameterError("gravity", "[gx, gy, gz] in mm/s², base frame", gravity)
-    vmax = _limit6(max_speed, "max_speed", "mm/s")
-    fmax = _limit6(max_force, "max_force", "N")
+    vmax = _per_actuator(max_speed, "max_speed", "mm/s", n_act)
+    fmax = _per_actuator(max_force, "max_force", "N", n_act)
     length = resolve_length(mech, characteristic_length)
     L = length.length
 
@@ -293,7 +299,7 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
 
     # --- statics -----------------------------------------------------------------------------
     finite_pose = np.all(np.isfinite(X), axis=1)
-    J = np.full((T, 6, 6), np.nan)
+    J = np.full((T, n_act, mob.width), np.nan)
     if np.any(finite_pose):
         with np.errstate(all="ignore"):
             J[finite_pose] = mech.jacobian(X[finite_pose])
@@ -308,10 +314,12 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
         r = R @ com                                              # (N, 3) mm, base frame
         wrench[finite_pose, :3] = F
         wrench[finite_pose, 3:] = np.cross(r, F)                 # N·mm
-    force = np.full((T, 6), np.nan)
+    force = np.full((T, n_act), np.nan)
     if np.any(j_ok):
         Jt = np.swapaxes(J[j_ok], 1, 2)
-        force[j_ok] = np.linalg.solve(Jt, -wrench[j_ok][..., None])[..., 0]
+        w_free = -wrench[j_ok][:, mob.twist_columns, None]
+        force[j_ok] = (np.linalg.solve(Jt, w_free) if n_act == mob.width
+                       else np.linalg.pinv(Jt) @ w_free)[..., 0]
 
     # --- per-sample status and first violations -------------------------------------------------
     issues: list[list[str]] = [[] for _ in range(T)]
@@ -320,7 +328,7 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
 
     for k in np.flatnonzero(~ik_valid):
         st = ik.leg_status[k]
-        legs = [names[i] for i in range(6) if st[i] != 0]
+        legs = [names[i] for i in range(n_act) if st[i] != 0]
         issues[k].append(f"{ik_reason[k]} ({', '.join(legs)})")
     if not ik_valid.all():
         k = int(np.flatnonzero(~ik_valid)[0])
@@ -376,11 +384,11 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
     ok = status == "ok"
 
     # --- stroke margins ------------------------------------------------------------------------
-    margin_low = np.full(6, np.nan)
-    margin_high = np.full(6, np.nan)
-    idx_low = np.full(6, -1)
-    idx_high = np.full(6, -1)
-    for i in range(6):
+    margin_low = np.full(n_act, np.nan)
+    margin_high = np.full(n_act, np.nan)
+    idx_low = np.full(n_act, -1)
+    idx_high = np.full(n_act, -1)
+    for i in range(n_act):
         fin = np.isfinite(q[:, i])
         if fin.any():
             dl = np.where(fin, q[:, i] - lo[i], np.inf)

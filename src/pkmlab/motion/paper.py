@@ -105,7 +105,9 @@ def paper_motion(mech: Mechanism, amplitude_mm: float = 2.0 * MM_PER_IN,
     ``θz, θy, θx`` (by ``±amplitude_rad``, added to the nominal Z-Y-X Euler angles) move one
     at a time, each through a pair of lobes nominal → +A → nominal → −A → nominal (see
     :func:`lobe_profile`). The paper gives the amplitudes (±2 in, ±30°) and the shape
-    ("sinusoidal-like third-order polynomial"), but not the time axis of Fig. 13.
+    ("sinusoidal-like third-order polynomial"), but not the time axis of Fig. 13. On a
+    lower-mobility mechanism only its free coordinates move; the others rest at nominal
+    during their windows (the timing is the same).
 
     Timing assumption (defaults): each of the four cubic legs of a lobe pair takes
     ``segment_time = 1 s`` — the paper sized its motors to move the platform over the full range
@@ -150,7 +152,10 @@ def paper_motion(mech: Mechanism, amplitude_mm: float = 2.0 * MM_PER_IN,
     nominal = mech.nominal_pose
     poses = np.tile(nominal, (len(t), 1))
     d1, d2 = np.zeros_like(poses), np.zeros_like(poses)
+    free = set(mech.mobility.coordinates)
     for (axis, t0, _t1), (_, idx) in zip(phases, PAPER_AXES):
+        if axis not in free:        # a lower mobility: the axis keeps its nominal value
+            continue
         amp = amp_rad if axis.startswith("theta") else amp_mm
         inside = (t >= t0) & (t <= t0 + 4.0 * segment_time)
         s0, s1, s2 = _lobes(t[inside] - t0, amp, segment_time)

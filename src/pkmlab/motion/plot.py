@@ -49,7 +49,7 @@ def plot_actuators(report: TrajectoryReport, path: str | Path, title: str | None
     bad = ~np.asarray(report.ok)
     if bad.any():
         # every actuator value of a failing sample; samples without a solution as bottom ticks
-        tb = np.repeat(t[bad], 6)
+        tb = np.repeat(t[bad], q_in.shape[1])
         qb = q_in[bad].ravel()
         fin = np.isfinite(qb)
         ax.plot(tb[fin], qb[fin], "x", color="red", ms=5, mew=1.5, label="status not ok")
