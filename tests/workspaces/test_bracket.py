@@ -310,8 +310,8 @@ def test_time_budget_is_honoured_within_its_tolerance(psu):
 
 
 def test_bracket_refuses_what_it_cannot_guarantee(psu):
-    # rss6 is bracketed on cells (tests/workspaces/test_bracket_rss6.py); its generic sixleg declaration
-    # (crank columns, not radial, no cell bounds) is still refused
+    # rss6 is bracketed on cells (tests/workspaces/test_bracket_rss6.py); its generic sixleg
+    # declaration (crank columns, not radial, no cell bounds) is still refused
     six = SixLeg.from_mechanism(load_mechanism(MECH_DIR / "instructables-servo-6rss.yaml"))
     with pytest.raises(ParameterError, match="bracket"):
         volume_bracket(six, "constant")
