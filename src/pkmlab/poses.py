@@ -11,7 +11,15 @@ import numpy as np
 
 from .errors import ParameterError
 
+#: the six pose coordinates of pkmlab (mm, mm, mm, rad, rad, rad; R = Rz·Ry·Rx); a mechanism's
+#: mobility frees a subset of them (:mod:`pkmlab.mechanisms.mobility`)
+POSE = ("x", "y", "z", "theta_x", "theta_y", "theta_z")
+#: the number of pose coordinates, and of components of a rigid-body twist [v; ω] or wrench
+POSE_SIZE = len(POSE)
+
 __all__ = [
+    "POSE",
+    "POSE_SIZE",
     "euler_to_matrix",
     "matrix_to_euler",
     "as_frames",
@@ -58,11 +66,11 @@ def as_frames(poses: np.ndarray, field: str = "poses") -> tuple[np.ndarray, np.n
     Accepts ``(6,)`` or ``(N, 6)`` Euler poses and ``(4, 4)`` or ``(N, 4, 4)`` transforms.
     """
     X = np.asarray(poses, dtype=float)
-    if X.ndim == 1 and X.shape == (6,):
+    if X.ndim == 1 and X.shape == (POSE_SIZE,):
         X = X[None, :]
     elif X.ndim == 2 and X.shape == (4, 4):
         X = X[None, :, :]
-    if X.ndim == 2 and X.shape[1] == 6:
+    if X.ndim == 2 and X.shape[1] == POSE_SIZE:
         return X[:, :3].copy(), euler_to_matrix(X[:, 3:])
     if X.ndim == 3 and X.shape[1:] == (4, 4):
         return X[:, :3, 3].copy(), X[:, :3, :3].copy()

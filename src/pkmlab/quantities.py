@@ -9,6 +9,7 @@ from typing import Annotated, Any
 from pydantic import BeforeValidator, WithJsonSchema
 
 from .errors import ParameterError, format_value
+from .poses import POSE_SIZE
 from .units import parse_angle, parse_length
 
 
@@ -60,7 +61,7 @@ def _points(v: Any) -> list[list[float]]:
 
 
 def _pose(v: Any) -> list[float]:
-    if not isinstance(v, list | tuple) or len(v) != 6:
+    if not isinstance(v, list | tuple) or len(v) != POSE_SIZE:
         raise _Invalid("must be [x, y, z, θx, θy, θz] (lengths in mm, angles in deg or with "
                        f"units); got {format_value(v)}")
     return [_length(x) for x in v[:3]] + [_angle(x) for x in v[3:]]
@@ -126,7 +127,7 @@ Stroke = Annotated[list[float], BeforeValidator(_stroke), _json_list(2)]
 Points = Annotated[list[list[float]], BeforeValidator(_points),
                    _json_list(None, {"type": "array", "items": _NUMBER_OR_UNIT})]
 Vector3 = Annotated[list[float], BeforeValidator(_length_list(3)), _json_list(3)]
-Pose = Annotated[list[float], BeforeValidator(_pose), _json_list(6)]
+Pose = Annotated[list[float], BeforeValidator(_pose), _json_list(POSE_SIZE)]
 LinkLengths = Annotated[float | list[float], BeforeValidator(_link_lengths),
                         WithJsonSchema({"anyOf": [_NUMBER_OR_UNIT,
                                                   {"type": "array", "items": _NUMBER_OR_UNIT}]})]

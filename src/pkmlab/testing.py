@@ -43,7 +43,7 @@ from __future__ import annotations
 import numpy as np
 
 from .mechanisms import LEG_STATUS, NO_STROKE
-from .poses import as_frames, euler_to_matrix, exp_so3, log_so3
+from .poses import POSE_SIZE, as_frames, euler_to_matrix, exp_so3, log_so3
 
 __all__ = ["random_valid_poses", "rotation_error", "check_declaration", "check_round_trip",
            "check_jacobian",
@@ -56,7 +56,7 @@ REASON = {v: k for k, v in LEG_STATUS.items()}
 
 def _moves(mech) -> np.ndarray:
     """``(6,)`` 1 for the pose coordinates the mechanism's mobility frees, else 0."""
-    m = np.zeros(6)
+    m = np.zeros(POSE_SIZE)
     m[mech.mobility.index] = 1.0
     return m
 
@@ -113,7 +113,7 @@ def _central(mech, p, R, h):
     cols = mech.mobility.twist_columns
     out = np.empty((len(p), mech.n_actuators, len(cols)))
     for c, j in enumerate(cols):
-        d = np.zeros(6)
+        d = np.zeros(POSE_SIZE)
         d[j] = h
         if j < 3:
             qp = mech.inverse((p + d[:3], R), stroke=NO_STROKE).q

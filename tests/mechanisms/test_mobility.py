@@ -205,3 +205,26 @@ def test_the_trajectory_check_balances_the_payload_on_the_tripods_three_legs(tri
     assert rep.violations["force"] is None and rep.fits
     same = check_trajectory(tripod, motion.t, motion.poses[:, :3], payload_mass_kg=5.0)
     np.testing.assert_array_equal(same.force, rep.force)
+
+
+def test_inverse_dynamics_of_the_tripod_balances_newtons_law(tripod):
+    """Newton–Euler refused lower mobilities. On the translating tripod a sinusoid in x, y, z
+    carrying 3 kg: Σ f_i·u_i = m·(a − g) at every sample (g = −9806.65 mm/s² ẑ) (to 1e-9 N), from NumPy leg
+    directions; the angles are the tripod's own (0) even if a motion is built around them."""
+    from pkmlab.motion.dynamics import inverse_dynamics
+    from pkmlab.motion.motions import sinusoid_motion
+    from pkmlab.motion.payload import GRAVITY, MassProperties
+
+    m = sinusoid_motion(tripod, [20.0, -15.0, 30.0, 0, 0, 0], [1.0, 1.5, 2.0, 0, 0, 0],
+                        duration=1.0, rate=100.0)
+    body = MassProperties(3.0, np.zeros(3), np.eye(3) * 1e3)
+    res = inverse_dynamics(tripod, m, body)
+    assert res.force.shape == (101, 3) and np.all(res.code == 0)
+    W = m.poses[:, None, :3] + tripod.platform_points[None] - tripod.tool_offset
+    u = W - tripod.base_points[None]
+    u /= np.linalg.norm(u, axis=2, keepdims=True)
+    total = np.einsum("ti,tij->tj", res.force, u)                    # N
+    expected = 3.0 * (m.accel[:, :3] + [0.0, 0.0, GRAVITY]) * 1e-3    # kg·mm/s² → N
+    np.testing.assert_allclose(total, expected, atol=1e-9)
+    np.testing.assert_allclose(res.qdot, np.einsum("tij,tj->ti", u, m.twist[:, :3]),
+                               atol=1e-9)

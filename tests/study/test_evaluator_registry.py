@@ -119,8 +119,6 @@ def test_validate_refuses_what_a_translational_family_cannot_serve(tri3_family, 
              ({"workspace": {"kind": "dexterous", "box": [5, 5, 5], "resolution": "10 mm"}},
               "dexterous_volume", "workspace", "needs rotations"),
              ({"workspace": ws, "volume_bracket": {}}, "constant_volume", "volume_bracket",
-              "needs six free pose coordinates"),
-             ({"motions": [{"name": "p", "paper": True}]}, "motions_feasible", "motions",
               "needs six free pose coordinates")]
     for evaluate, objective, block, need in cases:
         path = write(tmp_path, tri3_study(tmp_path, evaluate, objective))
@@ -138,7 +136,11 @@ def test_validate_refuses_what_a_translational_family_cannot_serve(tri3_family, 
     ({"workspace": {"kind": "constant", "resolution": "20 mm"},
       "dexterity": {"gci_samples": 200}}, "worst_kappa"),
     # the paper's motion on the free coordinates (refused before: "needs rotations")
-    ({"trajectory": {"payload": 2.0}}, "paper_motion_margin")])
+    ({"trajectory": {"payload": 2.0}}, "paper_motion_margin"),
+    # Newton–Euler balanced on the free coordinates (refused before: "needs six free pose
+    # coordinates")
+    ({"motions": [{"name": "p", "paper": True, "rate": "20 Hz"}],
+      "payload": {"mass": "2 kg"}}, "peak_actuator_force")])
 def test_what_validates_for_a_translational_family_runs(tri3_family, tmp_path, evaluate,
                                                         objective):
     data = tri3_study(tmp_path, evaluate, objective)
@@ -158,6 +160,9 @@ def test_what_validates_for_a_translational_family_runs(tri3_family, tmp_path, e
         if "dexterity" in evaluate:      # κ of the unit leg directions, no characteristic length
             assert row["metrics"]["worst_kappa"] > row["metrics"]["nominal_kappa"] >= 1.0
             assert row["metrics"]["characteristic_length"] is None
+        if "motions" in evaluate:        # 2 kg held by three inclined legs, and moved
+            assert row["metrics"]["motions_feasible"] == 1.0
+            assert row["metrics"]["peak_actuator_force"] > 2.0 * 9.80665 / 3
         if "trajectory" in evaluate:     # x, y, z by ±2 in: the stroke is far from binding
             assert row["metrics"]["paper_motion_fits"] == 1.0
             assert 0.0 < row["metrics"]["paper_motion_margin"] < 350.0

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
+from ..poses import POSE_SIZE
 from .metrics import block_columns, is_singular
 
 log = logging.getLogger(__name__)
@@ -50,7 +51,7 @@ def _jac(J, square: bool = True, any_width: bool = False) -> np.ndarray:
     J = np.asarray(J, dtype=float)
     if J.ndim == 2:
         J = J[None]
-    w = J.shape[-1] if any_width and J.ndim == 3 and 1 <= J.shape[-1] <= 6 else 6
+    w = J.shape[-1] if any_width and J.ndim == 3 and 1 <= J.shape[-1] <= POSE_SIZE else POSE_SIZE
     ok = J.ndim == 3 and J.shape[-1] == w and (J.shape[-2] == w if square else
                                                  J.shape[-2] >= w)
     if not ok:
@@ -82,12 +83,12 @@ def _directions(direction, n: int) -> np.ndarray:
 
 def _payload(payload, n: int) -> np.ndarray:
     if payload is None:
-        return np.zeros((n, 6))
+        return np.zeros((n, POSE_SIZE))
     w = np.asarray(payload, dtype=float)
-    if w.shape not in ((6,), (n, 6)) or not np.all(np.isfinite(w)):
+    if w.shape not in ((POSE_SIZE,), (n, POSE_SIZE)) or not np.all(np.isfinite(w)):
         raise ParameterError("payload", f"a finite wrench [F (N); M (N·mm)], (6,) or ({n}, 6)",
                              w.shape)
-    return np.broadcast_to(w, (n, 6)).copy()
+    return np.broadcast_to(w, (n, POSE_SIZE)).copy()
 
 
 def transpose_inverse(J: np.ndarray, L: float | None = None
@@ -206,7 +207,7 @@ def force_along_closed_form(J: np.ndarray, f_max, direction, payload=None,
     """
     J = _jac(J)
     n = len(J)
-    f = _fmax(f_max, 6)
+    f = _fmax(f_max, J.shape[1])
     u = _directions(direction, n)
     wp = _payload(payload, n)
     G, finite, singular = transpose_inverse(J, L)
@@ -268,9 +269,9 @@ def force_along(J: np.ndarray, f_max, direction, payload=None, *,
     f = _fmax(f_max, m)
     u = _directions(direction, n)
     wp = _payload(payload, n)
-    JT = cp.Parameter((6, m))
-    wdir = cp.Parameter(6)
-    wpay = cp.Parameter(6)
+    JT = cp.Parameter((POSE_SIZE, m))
+    wdir = cp.Parameter(POSE_SIZE)
+    wpay = cp.Parameter(POSE_SIZE)
     fv = cp.Variable(m)
     s = cp.Variable()
     prob = cp.Problem(cp.Maximize(s), [JT @ fv == s * wdir + wpay, fv <= f, fv >= -f, s >= 0])

@@ -45,7 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..poses import as_frames
+from ..poses import POSE_SIZE, as_frames
 from ..tolerances import TOL
 from ._linalg import singular_values
 
@@ -80,7 +80,7 @@ KAPPA_SINGULAR = 1.0 / SINGULAR_RTOL
 
 def _as_jacobian(J) -> np.ndarray:
     J = np.asarray(J, dtype=float)
-    if J.ndim < 2 or not (1 <= J.shape[-1] <= 6 and J.shape[-2] >= J.shape[-1]):
+    if J.ndim < 2 or not (1 <= J.shape[-1] <= POSE_SIZE and J.shape[-2] >= J.shape[-1]):
         raise ParameterError("J", "an array of shape (6, 6) or (..., 6, 6), or (..., n, w) "
                              "with 1 <= w <= 6 and w <= n (a lower mobility's free twist "
                              "columns)", J.shape)
@@ -104,7 +104,7 @@ def _rotational(J: np.ndarray, L, rotational=None) -> tuple[tuple[int, ...], flo
     if L is None:
         return (), None
     if rotational is None:
-        if J.shape[-1] != 6:
+        if J.shape[-1] != POSE_SIZE:
             raise ParameterError("L", "None or a CharacteristicLength (whose rotational columns "
                                  f"say what to homogenise) for a {J.shape[-1]}-column Jacobian",
                                  L)
@@ -159,7 +159,7 @@ def homogenised_jacobian(J: np.ndarray, L, rotational=None) -> np.ndarray:
     J = _as_jacobian(J)
     cols, val = _rotational(J, L, rotational)
     Jh = J.copy()
-    if cols == (3, 4, 5) and J.shape[-1] == 6:
+    if cols == (3, 4, 5) and J.shape[-1] == POSE_SIZE:
         Jh[..., 3:] /= val
     elif cols:
         Jh[..., list(cols)] /= val
@@ -207,7 +207,7 @@ def is_singular(J: np.ndarray, L: float | None = None) -> np.ndarray:
             (``L = 1 mm``).
     """
     J = _as_jacobian(J)
-    return ~np.isfinite(condition_number(J, 1.0 if L is None and J.shape[-1] == 6 else L))
+    return ~np.isfinite(condition_number(J, 1.0 if L is None and J.shape[-1] == POSE_SIZE else L))
 
 
 def lci(J: np.ndarray, L: float) -> np.ndarray:
@@ -359,7 +359,7 @@ def characteristic_length(mech, pose=None) -> CharacteristicLength:
     rot = rotational_columns(mech.mobility)
     if not rot:
         return _not_applicable(mech, J, where)
-    spatial = rot == (3, 4, 5) and J.shape[-1] == 6
+    spatial = rot == (3, 4, 5) and J.shape[-1] == POSE_SIZE
     r = joint_radius(mech)
     if not np.all(np.isfinite(J)):
         reason = (f"the Jacobian is undefined at {where} (a leg has no real solution or is at "
@@ -473,14 +473,14 @@ def block_columns(J: np.ndarray, mobility=None, rotational: bool = False):
     positions of its free twist columns below (at and above) 3. A J of another width without
     its mobility is refused."""
     if mobility is None:
-        if J.shape[-1] != 6:
+        if J.shape[-1] != POSE_SIZE:
             raise ParameterError("mobility", f"the mechanism's mobility for a {J.shape[-1]}-"
                                  "column Jacobian (which columns translate)", None)
-        return slice(3, 6) if rotational else slice(0, 3)
+        return slice(3, POSE_SIZE) if rotational else slice(0, 3)
     tc = np.asarray(mobility.twist_columns)
     if len(tc) != J.shape[-1]:
         raise ParameterError("mobility", f"a mobility with {J.shape[-1]} free coordinates",
                              f"{mobility.name} ({len(tc)})")
-    if len(tc) == 6:
-        return slice(3, 6) if rotational else slice(0, 3)
+    if len(tc) == POSE_SIZE:
+        return slice(3, POSE_SIZE) if rotational else slice(0, 3)
     return np.nonzero(tc >= 3 if rotational else tc < 3)[0]

@@ -69,7 +69,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..poses import matrix_to_euler
+from ..poses import POSE_SIZE, matrix_to_euler
 from ._boundary import column_ends
 from ._linalg import KAPPA_BRACKET, KAPPA_ROUND, kappa_upper
 from .aggregate import _CHUNK, _ik_valid, _units, _voxels, orientation_batches
@@ -214,9 +214,9 @@ class WorstCase:
 
 def _nan_result(status, reason, V, M, L, length, fmax, t0, method) -> WorstCase:
     nan = float("nan")
-    return WorstCase(nan, nan, False, reason, nan, nan, np.full(6, nan), np.full(6, nan), 0, 0,
-                     0, V, M, 0, 0, 0, L, fmax, method, status, time.perf_counter() - t0,
-                     length)
+    none = np.full(POSE_SIZE, nan)
+    return WorstCase(nan, nan, False, reason, nan, nan, none, none.copy(), 0, 0, 0, V, M, 0, 0,
+                     0, L, fmax, method, status, time.perf_counter() - t0, length)
 
 
 def _unit_feasibility(mech, pos, Rs, voxel_unit, U) -> np.ndarray:
@@ -416,7 +416,7 @@ def worst_case(mech, result, L: float | CharacteristicLength | None = None,
         reasons.append(f"det J changes sign between {changes + b_changes:,} pair(s) of "
                        f"neighbouring samples or column ends, first {example}: a singular "
                        "pose lies between them")
-    kpose = _pose(unit_pos[k_arg[0]], Rs[k_arg[1]]) if k_arg else np.full(6, np.nan)
+    kpose = _pose(unit_pos[k_arg[0]], Rs[k_arg[1]]) if k_arg else np.full(POSE_SIZE, np.nan)
     if not k_arg:                                     # no feasible sample (cannot happen)
         kmax = math.nan
     f_exact, fpose = _force_at(mech, unit_pos, Rs, vox.f_arg, fmax, L)
@@ -456,7 +456,7 @@ def _force_at(mech, unit_pos, Rs, arg, fmax, L):
     ``(unit, orientation)`` with its pose; ``(0.0, NaN pose)`` when ``arg`` is None (every
     pose has a non-finite J); 0 where the force is not finite."""
     if arg is None:
-        return 0.0, np.full(6, np.nan)
+        return 0.0, np.full(POSE_SIZE, np.nan)
     u, m = arg
     f = float(max_force_all_directions(mech.jacobian((unit_pos[u][None], Rs[m][None])), fmax,
                                        L, mech.mobility)[0])

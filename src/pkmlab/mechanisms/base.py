@@ -91,7 +91,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import ParameterError
-from ..poses import as_frames, log_so3
+from ..poses import POSE_SIZE, as_frames, log_so3
 from ..runtime.threads import threads_for
 from ..tolerances import TOL
 from .joints import JointsMixin
@@ -282,7 +282,7 @@ class Mechanism(JointsMixin):
         L = self.n_actuators
         q = (self._run_ik(p, R, *NO_STROKE).q if self._jac_uses_q
              else np.empty((len(p), L)))
-        J = np.empty((len(p), L, 6))
+        J = np.empty((len(p), L, POSE_SIZE))
         g = self._ik_geometry
         _kernels.make_jacobian_driver(jac, len(g))(p, R, g, q, J)
         return J
@@ -373,8 +373,8 @@ class Mechanism(JointsMixin):
             p, R = _frames_tuple(poses)
             return self._run_ik(p, R, lo, hi)
         X = self._free_to_full(np.asarray(poses, dtype=float))
-        if X.ndim <= 2 and X.shape[-1] == 6:
-            return self._run_ik(np.ascontiguousarray(X.reshape(-1, 6)), None, lo, hi)
+        if X.ndim <= 2 and X.shape[-1] == POSE_SIZE:
+            return self._run_ik(np.ascontiguousarray(X.reshape(-1, POSE_SIZE)), None, lo, hi)
         p, R = as_frames(X)
         return self._run_ik(p, R, lo, hi)
 
@@ -437,7 +437,7 @@ class Mechanism(JointsMixin):
         p, R = _kernels.carray(p), _kernels.carray(R)
         lo, hi = self.stroke if stroke is None else (float(stroke[0]), float(stroke[1]))
         n, g, L = len(p), self._ik_geometry, self.n_actuators
-        q, J = np.empty((n, L)), np.empty((n, L, 6))
+        q, J = np.empty((n, L)), np.empty((n, L, POSE_SIZE))
         st, reason = np.empty((n, L), dtype=np.int8), np.empty(n, dtype=np.int8)
         drive = _kernels.make_kinematics_driver(type(self)._ik_one, jac, len(g), L)
         drive(p, R, g, float(lo), float(hi), q, st, reason, J)
@@ -554,13 +554,13 @@ class Mechanism(JointsMixin):
         angles within ±30° of the nominal pose (seeded; 20 batches of 4,096 draws at most)."""
         X0 = np.asarray(self.nominal_pose, float)
         rng = np.random.default_rng(20221)
-        span = np.zeros(6)              # the free coordinates only (:mod:`.mobility`)
+        span = np.zeros(POSE_SIZE)              # the free coordinates only (:mod:`.mobility`)
         span[self.mobility.index] = np.array([self.scale / 8] * 3
                                              + [np.radians(30.0)] * 3)[self.mobility.index]
         keep = [X0[None]]
         count = 1
         for _ in range(20):
-            X = X0 + rng.uniform(-1.0, 1.0, (4096, 6)) * span
+            X = X0 + rng.uniform(-1.0, 1.0, (4096, POSE_SIZE)) * span
             X = X[self.inverse(X).valid][:_MODE_STARTS - count]
             keep.append(X)
             count += len(X)

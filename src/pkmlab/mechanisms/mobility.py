@@ -25,11 +25,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
+from ..poses import POSE, POSE_SIZE
 
 __all__ = ["POSE", "Mobility", "SPATIAL", "TRANSLATIONAL", "PLANAR", "require_spatial"]
 
-#: the six pose coordinates of pkmlab (mm, mm, mm, rad, rad, rad; R = Rz·Ry·Rx)
-POSE = ("x", "y", "z", "theta_x", "theta_y", "theta_z")
 
 
 @dataclass(frozen=True)
@@ -90,7 +89,7 @@ class Mobility:
             raise ParameterError("poses", f"an array of shape ({self.width},) or (N, "
                                  f"{self.width}) ({', '.join(self.coordinates)})", X.shape)
         X = X.reshape(-1, self.width)
-        out = np.repeat(np.asarray(fixed, dtype=float).reshape(1, 6), len(X), axis=0)
+        out = np.repeat(np.asarray(fixed, dtype=float).reshape(1, POSE_SIZE), len(X), axis=0)
         out[:, self.index] = X
         return out
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ParameterError
-from ..poses import as_frames, frames_to_poses, log_so3
+from ..poses import POSE_SIZE, as_frames, frames_to_poses, log_so3
 from ..tolerances import TOL
 from .kernels import ik as _kernels
 from .results import NO_STROKE, AssemblyModes, FKResult, step_frames
@@ -78,7 +78,7 @@ def newton(mech, p, R, q, *, tol: float, max_iter: int, polish: int = 2):
         if cols is None:
             step = -_solve(G, f)
         else:
-            step = np.zeros((len(active), 6))
+            step = np.zeros((len(active), POSE_SIZE))
             step[:, cols] = -_solve(G[:, :, cols], f)
         lin = np.linalg.norm(step[:, :3], axis=1)
         ang = np.linalg.norm(step[:, 3:], axis=1)
@@ -160,7 +160,7 @@ def other_modes(mech, q, p, R, ok, pa, Ra, *, tol: float, tol_mode: float):
     ``|Δp| + scale·angle``, as :meth:`Mechanism.assembly_modes` orders them. A heuristic
     search: a mode no start reaches is missed (a check that can fail, not a proof)."""
     n, k = len(q), len(pa)
-    nxt = np.full((n, 6), np.nan)
+    nxt = np.full((n, POSE_SIZE), np.nan)
     dmm, ddeg = np.full(n, np.inf), np.full(n, np.inf)
     idx = np.flatnonzero(ok)
     if idx.size == 0 or k == 0:
@@ -212,6 +212,6 @@ def multistart_modes(mech, q, *, starts: int, seed: int, tol: float) -> Assembly
     p, R, res, dist = p[order], R[order], res[order], dist[order]
     working = _working_mode(mech, p, R, qq[: p.shape[0]], max(1e3 * tol, TOL.working_mode_mm)) \
         if k.size else np.zeros(0, dtype=bool)
-    return AssemblyModes(pose=frames_to_poses(p, R) if k.size else np.zeros((0, 6)),
+    return AssemblyModes(pose=frames_to_poses(p, R) if k.size else np.zeros((0, POSE_SIZE)),
                          residual=res, working_mode=working, distance=dist,
                          starts=int(p0.shape[0]))

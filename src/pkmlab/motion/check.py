@@ -25,7 +25,7 @@ import numpy as np
 from ..dexterity.metrics import CharacteristicLength, condition_number, resolve_length
 from ..errors import ParameterError
 from ..mechanisms.base import LEG_STATUS, Mechanism
-from ..poses import as_frames
+from ..poses import POSE_SIZE, as_frames
 from ..tolerances import TOL
 from ._args import per_actuator as _per_actuator
 from ._args import positive as _positive
@@ -266,7 +266,7 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
     X = np.array(poses, dtype=float)
     if X.ndim == 2 and X.shape == (len(t), mob.width) and not mob.is_spatial:
         X = mob.full(X, mech.nominal_pose)
-    if X.shape != (len(t), 6):
+    if X.shape != (len(t), POSE_SIZE):
         raise ParameterError("poses", f"an array of shape ({len(t)}, 6) or ({len(t)}, "
                              f"{mob.width}) matching t (mm, rad)", X.shape)
     mass = _positive(payload_mass_kg, "payload_mass_kg", "kg", allow_zero=True)
@@ -307,7 +307,7 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
     condition = condition_number(J, L)                          # inf: singular or undefined
     j_ok = np.isfinite(condition)
 
-    wrench = np.full((T, 6), np.nan)
+    wrench = np.full((T, POSE_SIZE), np.nan)
     F = mass * g * 1e-3                                          # kg·mm/s² → N
     if np.any(finite_pose):
         _, R = as_frames(X[finite_pose])

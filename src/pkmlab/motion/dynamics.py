@@ -54,7 +54,8 @@ class DynamicsResult:
 
     Attributes:
         motion: the motion's name; t ``(T,)`` s.
-        q ``(T, 6)`` mm, qdot ``(T, 6)`` mm/s, force ``(T, 6)`` N, power ``(T, 6)`` W.
+        q ``(T, L)`` mm, qdot ``(T, L)`` mm/s, force ``(T, L)`` N, power ``(T, L)`` W (L
+        actuators).
         wrench ``(T, 6)`` [N; N·mm] the actuators exert on the platform.
         code ``(T,)`` int8: 0 ok, 1 no inverse kinematics within the stroke (``reasons``:
         sample → the IK reason), 2 singular; :attr:`status` spells it out.
@@ -95,15 +96,15 @@ class DynamicsResult:
         return f"{self.motion}: t = {self.t[k]:.4g} s: {self.status[k]}"
 
     def summary(self) -> dict:
-        """Per actuator (arrays ``(6,)``): ``peak_force`` |f| N, ``rms_force`` N,
+        """Per actuator (arrays ``(L,)``): ``peak_force`` |f| N, ``rms_force`` N,
         ``peak_speed`` |q̇| mm/s, ``peak_power`` |f·q̇| W, ``travel`` (min q, max q) mm (for
         rotary actuators: torques in N·mm, speeds in rad/s, travel in rad); over the samples
         that are ``ok`` (NaN if none)."""
         ok = self.ok
         if not np.any(ok):
-            nan = np.full(6, np.nan)
+            nan = np.full(self.q.shape[1], np.nan)
             return {"peak_force": nan, "rms_force": nan, "peak_speed": nan,
-                    "peak_power": nan, "travel": np.full((6, 2), np.nan)}
+                    "peak_power": nan, "travel": np.full((len(nan), 2), np.nan)}
         f, v, P, q = self.force[ok], self.qdot[ok], self.power[ok], self.q[ok]
         t = self.t[ok]
         if len(t) > 1:
@@ -274,7 +275,12 @@ def _euler_frames(X, p, R):
 def inverse_dynamics(mech, motion: Motion, body: MassProperties,
                      gravity: float = GRAVITY) -> DynamicsResult:
     """Actuator forces, speeds and powers of ``mech`` along ``motion`` carrying ``body``
-    (in chunks of ``_CHUNK`` samples: the (T, 6, 6) Jacobians are never all in memory)."""
+    (in chunks of ``_CHUNK`` samples: the (T, 6, 6) Jacobians are never all in memory).
+
+    A lower-mobility mechanism (``mech.mobility`` not spatial) takes :func:`_free_dynamics`:
+    the same wrench, balanced on its free components only."""
+    if not mech.mobility.is_spatial:
+        return _free_dynamics(mech, motion, body, gravity)
     n = len(motion.t)
     q, f, qd, pw, w = (np.empty((n, 6)) for _ in range(5))
     piv = np.empty(n)
@@ -314,3 +320,33 @@ def inverse_dynamics(mech, motion: Motion, body: MassProperties,
     return DynamicsResult(motion.name, motion.t, q, qd, f, pw, w, code, reasons,
                           tuple(mech.actuator_names), tuple(mech.stroke),
                           mech.actuator_unit)
+
+
+def _free_dynamics(mech, motion: Motion, body: MassProperties, gravity: float) -> DynamicsResult:
+    """Inverse dynamics of a lower-mobility mechanism (NumPy): the Newton–Euler wrench of
+    :func:`platform_wrench`, balanced on the free twist components ``c`` of the mobility,
+    ``J_cᵀ f = w_c`` (least-norm when there are more actuators than free coordinates); the
+    constraint wrench of the joints carries the other components. ``q̇ = J_c t_c``."""
+    cols = mech.mobility.twist_columns
+    poses = np.asarray(motion.poses, dtype=float)
+    n, L = len(poses), mech.n_actuators
+    p, R = np.empty((n, 3)), np.empty((n, 3, 3))
+    _euler_frames(np.ascontiguousarray(poses), p, R)
+    ik, J = mech.inverse_and_jacobian((p, R))                       # J (n, L, free)
+    w = platform_wrench(p, R, motion.twist, motion.accel, body, mech.tool_offset, gravity)
+    valid = np.asarray(ik.valid, dtype=bool)
+    singular = valid & is_singular(J)
+    ok = valid & ~singular
+    f = np.full((n, L), np.nan)
+    if ok.any():
+        Jt = np.swapaxes(J[ok], 1, 2)
+        rhs = w[ok][:, cols, None]
+        f[ok] = (np.linalg.solve(Jt, rhs) if L == len(cols) else np.linalg.pinv(Jt) @ rhs)[..., 0]
+    with np.errstate(invalid="ignore"):
+        qd = np.einsum("nij,nj->ni", J, motion.twist[:, cols])
+    code = np.where(~valid, 1, np.where(singular, 2, 0)).astype(np.int8)
+    bad = np.flatnonzero(~valid)
+    reasons = dict(zip(bad.tolist(), np.asarray(ik.reason_text)[bad].tolist()))
+    return DynamicsResult(motion.name, motion.t, np.asarray(ik.q, dtype=float), qd, f,
+                          f * qd * 1e-3, w, code, reasons, tuple(mech.actuator_names),
+                          tuple(mech.stroke), mech.actuator_unit)

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
+from ..poses import POSE_SIZE
 
 __all__ = ["Motion", "euler_rates_to_twist", "make_motion", "sinusoid_motion", "differentiate",
            "POSE_COLUMNS"]
@@ -50,7 +51,7 @@ class Motion:
 def euler_rates_to_twist(poses, rates, rates2) -> tuple[np.ndarray, np.ndarray]:
     """Pose derivatives ``(T, 6)`` (ẋ in mm/s, Euler rates in rad/s) and second derivatives
     → base-frame twist ``[v; ω]`` and its derivative ``[a; α]``, each ``(T, 6)``."""
-    poses, rates, rates2 = (np.asarray(a, dtype=float).reshape(-1, 6)
+    poses, rates, rates2 = (np.asarray(a, dtype=float).reshape(-1, POSE_SIZE)
                             for a in (poses, rates, rates2))
     ty, tz = poses[:, 4], poses[:, 5]
     cz, sz, cy, sy = np.cos(tz), np.sin(tz), np.cos(ty), np.sin(ty)
@@ -74,11 +75,11 @@ def make_motion(name, t, poses, d1, d2, how) -> Motion:
     return Motion(name, np.asarray(t, float), np.asarray(poses, float), tw, ac, how)
 
 
-def sinusoid_motion(mech, amplitude, frequency, phase=(0.0,) * 6, duration: float = 2.0,
+def sinusoid_motion(mech, amplitude, frequency, phase=(0.0,) * POSE_SIZE, duration: float = 2.0,
                     rate: float = 200.0, name: str = "sinusoid") -> Motion:
     """``pose_k(t) = nominal_k + A_k·sin(2π f_k t + φ_k)`` for the six coordinates (A in mm and
     rad, f in Hz, φ in rad), sampled at ``rate`` Hz over ``duration`` s; exact derivatives."""
-    A, f, ph = (np.broadcast_to(np.asarray(v, dtype=float), (6,)) for v in
+    A, f, ph = (np.broadcast_to(np.asarray(v, dtype=float), (POSE_SIZE,)) for v in
                 (amplitude, frequency, phase))
     n = max(2, int(round(duration * rate)) + 1)
     t = np.linspace(0.0, duration, n)

@@ -257,7 +257,35 @@ class MotionsPlan:
                     m = mo.Motion(m.name, m.t, m.poses + mech.nominal_pose, m.twist, m.accel,
                                   m.derivatives)
                 out.append(m)
+        mob = mech.mobility
+        if mob.is_spatial:
+            return out
+        # a lower mobility: the other coordinates are the mechanism's own (its plane, its
+        # orientation), whatever a recording says; check_mobility refused varying ones
+        fixed = np.setdiff1d(np.arange(len(mech.nominal_pose)), mob.index)
+        for m in out:
+            m.poses[:, fixed] = mech.nominal_pose[fixed]
         return out
+
+    def check_mobility(self, mech) -> None:
+        """Refuse a motion that moves a coordinate the mechanism cannot move (a sinusoid's
+        amplitude, a recording's column that varies), naming it."""
+        mob = mech.mobility
+        if mob.is_spatial:
+            return
+        for i, (s, m) in enumerate(zip(self.specs, self.motions(mech))):
+            moving = []
+            if s.sinusoid is not None:
+                moving = [k for k in mo.POSE_COLUMNS if k not in mob.coordinates
+                          and getattr(s.sinusoid.amplitude, k) != 0.0]
+            elif s.file is not None:
+                rec = self.recorded[s.name].poses
+                moving = [k for j, k in enumerate(mo.POSE_COLUMNS) if k not in mob.coordinates
+                          and np.ptp(rec[:, j]) > 1e-9]
+            if moving:
+                raise ParameterError(f"evaluate.motions[{i}]", "a motion of the mechanism's "
+                                     f"free coordinates ({', '.join(mob.coordinates)}) only",
+                                     f"a motion of {', '.join(moving)}")
 
 
 def build_motions(data: Any, base: Path) -> MotionsPlan:

@@ -23,7 +23,7 @@ import numpy as np
 from ..dexterity.metrics import is_singular
 from ..motion.dynamics import platform_wrench
 from ..motion.payload import GRAVITY, MassProperties
-from ..poses import matrix_to_euler
+from ..poses import POSE_SIZE, matrix_to_euler
 
 __all__ = ["StaticLoads", "static_loads"]
 
@@ -57,7 +57,7 @@ def static_loads(mech, result, body: MassProperties, gravity: float = GRAVITY) -
     unit = "N·mm" if mech.actuator_unit == "rad" else "N"
     P = result.voxel_centres()
     Rs = result.orientations.rotations()
-    peak, pose, leg, count, singular = 0.0, np.full(6, np.nan), -1, 0, False
+    peak, pose, leg, count, singular = 0.0, np.full(POSE_SIZE, np.nan), -1, 0, False
     for Rm in Rs:
         for s in range(0, len(P), _CHUNK):
             p = P[s:s + _CHUNK]
@@ -77,9 +77,12 @@ def static_loads(mech, result, body: MassProperties, gravity: float = GRAVITY) -
             good = ~sing
             if not np.any(good):
                 continue
-            zero = np.zeros((int(good.sum()), 6))
+            zero = np.zeros((int(good.sum()), POSE_SIZE))
             w = platform_wrench(p[good], R[good], zero, zero, body, mech.tool_offset, gravity)
-            tau = np.linalg.solve(np.transpose(J[good], (0, 2, 1)), w[..., None])[..., 0]
+            Jt = np.transpose(J[good], (0, 2, 1))     # (n, free, L): the free wrench parts
+            rhs = w[:, mech.mobility.twist_columns, None]
+            tau = (np.linalg.solve(Jt, rhs) if Jt.shape[1] == Jt.shape[2]
+                   else np.linalg.pinv(Jt) @ rhs)[..., 0]
             a = np.abs(tau)
             k = int(np.argmax(a.max(axis=1)))
             if not singular and a[k].max() > peak:

@@ -57,8 +57,9 @@ def refine_columns(mech, xs, ys, oset, lo, hi, iterations: int = 14):
         return lo, hi, 0
     params = oset.parameters()
     R = oset.rotations()
-    W = mech.leg_offsets(R)                                 # (M, 6, 3)
-    P = np.asarray(mech.column_params(), dtype=float)       # (6, 3)
+    W = mech.leg_offsets(R)                                 # (M, legs, 3)
+    P = np.asarray(mech.column_params(), dtype=float)       # (legs, 3)
+    n = W.shape[1]
     U, B = mech.tool_points, mech.base_points
     ev = make_leg_eval(type(mech).column_leg)
     bounds = oset.bounds()
@@ -67,17 +68,17 @@ def refine_columns(mech, xs, ys, oset, lo, hi, iterations: int = 14):
     for start in range(0, len(alive[0]), _CHUNK):
         ix, iy = alive[0][start:start + _CHUNK], alive[1][start:start + _CHUNK]
         C, M = len(ix), len(R)
-        # values at every sample: (C, M, 6)
-        x = np.broadcast_to(xs[ix, None, None], (C, M, 6)).ravel()
-        y = np.broadcast_to(ys[iy, None, None], (C, M, 6)).ravel()
-        a, b, ok = ev(x, y, np.broadcast_to(W, (C, M, 6, 3)).reshape(-1, 3),
-                      np.broadcast_to(P, (C, M, 6, 3)).reshape(-1, 3))
-        a = np.where(ok, a, np.inf).reshape(C, M, 6)
-        b = np.where(ok, b, -np.inf).reshape(C, M, 6)
+        # values at every sample: (C, M, legs)
+        x = np.broadcast_to(xs[ix, None, None], (C, M, n)).ravel()
+        y = np.broadcast_to(ys[iy, None, None], (C, M, n)).ravel()
+        a, b, ok = ev(x, y, np.broadcast_to(W, (C, M, n, 3)).reshape(-1, 3),
+                      np.broadcast_to(P, (C, M, n, 3)).reshape(-1, 3))
+        a = np.where(ok, a, np.inf).reshape(C, M, n)
+        b = np.where(ok, b, -np.inf).reshape(C, M, n)
         best = []
         for vals, sign in ((a, 1.0), (b, -1.0)):              # maximise a, minimise b
-            m0 = np.argmax(sign * vals, axis=1)                # (C, 6)
-            theta = params[m0]                                 # (C, 6, 3)
+            m0 = np.argmax(sign * vals, axis=1)                # (C, legs)
+            theta = params[m0]                                 # (C, legs, 3)
             f = sign * np.take_along_axis(vals, m0[:, None, :], axis=1)[:, 0, :]
             theta, f = _pattern_search(mech, oset, ev, xs[ix], ys[iy], U, B, P, theta, f, sign,
                                        bounds, step0, iterations)
@@ -94,16 +95,16 @@ def refine_columns(mech, xs, ys, oset, lo, hi, iterations: int = 14):
 
 
 def _pattern_search(mech, oset, ev, x, y, U, B, P, theta, f, sign, bounds, step0, iterations):
-    """Compass search maximising ``sign·bound`` per (column, leg) from ``theta (C, 6, 3)``."""
-    C = theta.shape[0]
-    allowed = _allowed_axes(oset, theta.reshape(-1, 3)).reshape(C, 6, 3)
-    step = np.broadcast_to(step0 * 0.5, (C, 6, 3)).copy()
-    leg = np.broadcast_to(np.arange(6), (C, 6))
-    xx = np.broadcast_to(x[:, None], (C, 6))
-    yy = np.broadcast_to(y[:, None], (C, 6))
+    """Compass search maximising ``sign·bound`` per (column, leg) from ``theta (C, legs, 3)``."""
+    C, n = theta.shape[:2]
+    allowed = _allowed_axes(oset, theta.reshape(-1, 3)).reshape(C, n, 3)
+    step = np.broadcast_to(step0 * 0.5, (C, n, 3)).copy()
+    leg = np.broadcast_to(np.arange(n), (C, n))
+    xx = np.broadcast_to(x[:, None], (C, n))
+    yy = np.broadcast_to(y[:, None], (C, n))
     finite = np.isfinite(f)
     for _ in range(iterations):
-        improved = np.zeros((C, 6), dtype=bool)
+        improved = np.zeros((C, n), dtype=bool)
         for k in range(3):
             for direction in (1.0, -1.0):
                 cand = theta.copy()

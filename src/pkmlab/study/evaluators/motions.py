@@ -21,7 +21,7 @@ class Motions(Evaluator):
     name = "motions"
     block = list[MotionSpec]
     description = "required motions: [{name, file | sinusoid | paper: true}]"
-    requires = frozenset({"spatial"})        # Newton–Euler on six coordinates
+    requires = frozenset()        # Newton–Euler, balanced on the free coordinates
     metrics = (
         metric("motions_feasible", "", "flag",
                "1 if every sample of every required motion is within the stroke and not "
@@ -60,6 +60,7 @@ class Motions(Evaluator):
         if evaluation.payload is None:
             raise ParameterError("evaluate.payload", "given with evaluate.motions (the mass "
                                  "the motions move: payload and platform)", None)
+        plan.check_mobility(mech)
 
     def compute(self, mech, ctx) -> dict:
         ev = ctx.evaluation

@@ -12,7 +12,7 @@ class Payload(Evaluator):
     name = "payload"
     block = PayloadSpec
     description = "mass, com, inertia; platform; legs"
-    requires = frozenset({"spatial"})        # the gravity wrench on six coordinates
+    requires = frozenset()     # the gravity wrench, balanced on the free coordinates
     after = ("workspace",)      # the static torque is computed over it (skipped without one)
     metrics = (
         metric("peak_servo_torque", "N·mm", "worst-case",
