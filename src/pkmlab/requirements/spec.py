@@ -273,7 +273,7 @@ class MotionsPlan:
         mob = mech.mobility
         if mob.is_spatial:
             return
-        for i, (s, m) in enumerate(zip(self.specs, self.motions(mech))):
+        for i, s in enumerate(self.specs):
             moving = []
             if s.sinusoid is not None:
                 moving = [k for k in mo.POSE_COLUMNS if k not in mob.coordinates
