@@ -209,8 +209,8 @@ def test_the_trajectory_check_balances_the_payload_on_the_tripods_three_legs(tri
 
 def test_inverse_dynamics_of_the_tripod_balances_newtons_law(tripod):
     """Newton–Euler refused lower mobilities. On the translating tripod a sinusoid in x, y, z
-    carrying 3 kg: Σ f_i·u_i = m·(a − g) at every sample (g = −9806.65 mm/s² ẑ) (to 1e-9 N), from NumPy leg
-    directions; the angles are the tripod's own (0) even if a motion is built around them."""
+    carrying 3 kg: Σ f_i·u_i = m·(a − g) at every sample (g = −9806.65 mm/s² ẑ), to 1e-9 N,
+    from NumPy leg directions."""
     from pkmlab.motion.dynamics import inverse_dynamics
     from pkmlab.motion.motions import sinusoid_motion
     from pkmlab.motion.payload import GRAVITY, MassProperties
