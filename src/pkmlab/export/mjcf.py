@@ -120,7 +120,7 @@ def mjcf_text(mech, pose=None, mass: MassModel | None = None) -> str:
     density = model.mass.density
     out = ['<?xml version="1.0" encoding="utf-8"?>',
            f"<!-- pkmlab {mech.family} mechanism {mech.name or '(unnamed)'}: exported by "
-           "pkmlab export --format mjcf. SI units (m, kg, s, rad); pkmlab works in mm. "
+           "pkmlab export, format mjcf. SI units (m, kg, s, rad); pkmlab works in mm. "
            "Actuated joint qpos = pkmlab actuator value (slide: mm/1000). Closed loops: "
            "equality connect (cut spherical joints) and weld (other cut joints). "
            f"Masses: {model.mass.source}. Link diameter {model.link_diameter:.6g} mm. -->",

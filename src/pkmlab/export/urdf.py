@@ -167,7 +167,7 @@ def urdf_text(mech, pose=None, mass: MassModel | None = None) -> str:
         extra.append(f"  <pkmlab:loop_closure{_a(name=cl.name, type='point' if cl.kind == 'connect' else 'weld', frame_a=cl.name + '__a', frame_b=cl.name + '__b', cut_joint_type=cl.protocol_type)}/>")
     head = ['<?xml version="1.0" encoding="utf-8"?>',
             f"<!-- pkmlab {mech.family} mechanism {mech.name or '(unnamed)'}: exported by pkmlab "
-            "export --format urdf. SI units (m, kg, rad). A spanning tree; loops closed by "
+            "export, format urdf. SI units (m, kg, rad). A spanning tree; loops closed by "
             "the <pkmlab:loop_closure> elements (frames __a and __b coincide: 'point' their "
             "origins, 'weld' their poses). Actuated joint value = pkmlab actuator value - "
             f"offset. Masses: {model.mass.source}. -->",
