@@ -12,7 +12,6 @@ from pkmlab.mechanisms import REGISTRY, register_family
 
 sys.path.insert(0, str(Path(__file__).parent / "data" / "plugin3"))
 import pkmlab_tri3_family as tri3  # noqa: E402
-
 from conftest import MECHANISMS  # noqa: E402
 
 register_family(tri3.Tri3)

@@ -168,10 +168,10 @@ def test_step_skeleton_or_the_reason_it_is_skipped(tmp_path):
 
 
 def test_cli_export_of_a_mechanism_file(tmp_path):
+    from conftest import MECH_DIR
     from typer.testing import CliRunner
 
     from pkmlab.cli import app
-    from conftest import MECH_DIR
 
     r = CliRunner().invoke(app, ["export", str(MECH_DIR / "luzi-3chain.yaml"), "--format",
                                  "joints", "-o", str(tmp_path), "--json"])

@@ -13,8 +13,6 @@ from ..errors import ParameterError
 from .common import JsonOpt, _emit, _fail, _load, app, out
 
 
-
-
 @app.command("export")
 def export_cmd(
     source: Annotated[Path, typer.Argument(help="a mechanism YAML file or a study's results "

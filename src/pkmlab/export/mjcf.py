@@ -78,6 +78,10 @@ def _a(**kw) -> str:
                    if v is not None)
 
 
+def _tag(pad: str, element: str, /, **attrs) -> str:
+    return f"{pad}<{element}{_a(**attrs)}/>"
+
+
 def _masses(model):
     """Per link body the geoms ``[(fromto m | None, pos m, radius m)]`` and its mass (kg) or
     None (MuJoCo's density); the platform's explicit inertial or None."""
@@ -149,7 +153,9 @@ def mjcf_text(mech, pose=None, mass: MassModel | None = None) -> str:
         lines = []
         if b.name == "base":
             lines.append(f"{pad}<body{_a(name='base')}>")
-            lines.append(f"{pad}  <geom{_a(name='base_plate', type='cylinder', pos=_v((bc - [0, 0, bt]) * M), size=_v([brad * M, bt * M]), rgba='0.3 0.3 0.35 1', contype='0', conaffinity='0')}/>")
+            lines.append(_tag(pad + "  ", "geom", name="base_plate", type="cylinder",
+                              pos=_v((bc - [0, 0, bt]) * M), size=_v([brad * M, bt * M]),
+                              rgba="0.3 0.3 0.35 1", contype="0", conaffinity="0"))
         else:
             pos, Rr = relative(model.bodies[b.parent], b)
             lines.append(f"{pad}<body{_a(name=b.name, pos=_v(pos * M), quat=_v(quat(Rr)))}>")
@@ -166,7 +172,8 @@ def mjcf_text(mech, pose=None, mass: MassModel | None = None) -> str:
                     f = M if tj.kind == "slide" else 1.0
                     kw = dict(ref=_f(tj.value * f), range_=_v([lo * f, hi * f]),
                               damping="0")
-                lines.append(f"{pad}  <joint{_a(name=tj.name, type=tj.kind, pos=_v(loc), axis=_v(axis), **kw)}/>")
+                lines.append(_tag(pad + "  ", "joint", name=tj.name, type=tj.kind, pos=_v(loc),
+                                  axis=_v(axis), **kw))
                 qpos0.append(tj.value * (M if tj.kind == "slide" else 1.0) if tj.actuated
                              else 0.0)
             if b.kind == "platform":
@@ -174,12 +181,16 @@ def mjcf_text(mech, pose=None, mass: MassModel | None = None) -> str:
                 c, rad, th = _platform_disc(model)
                 zloc = b.R.T @ (c - b.pos) * M
                 gkw = dict(density=_f(density)) if pm is None else dict(mass="0")
-                lines.append(f"{pad}  <geom{_a(name='platform_plate', type='cylinder', pos=_v(zloc), size=_v([rad * M, 0.5 * th * M]), rgba='0.85 0.55 0.2 1', **gkw)}/>")
+                lines.append(_tag(pad + "  ", "geom", name="platform_plate", type="cylinder",
+                                  pos=_v(zloc), size=_v([rad * M, 0.5 * th * M]),
+                                  rgba="0.85 0.55 0.2 1", **gkw))
                 if pm is not None:
                     com = model.p + model.R @ (np.asarray(pm.com) - mech.tool_offset)
                     com = b.R.T @ (com - b.pos)         # platform frame → body frame
-                    J = np.asarray(pm.inertia) * M * M
-                    lines.append(f"{pad}  <inertial{_a(pos=_v(com * M), mass=_f(float(pm.mass)), fullinertia=_v([J[0, 0], J[1, 1], J[2, 2], J[0, 1], J[0, 2], J[1, 2]]))}/>")
+                    J = _regular_inertia(pm, model.link_diameter) * M * M
+                    full = [J[0, 0], J[1, 1], J[2, 2], J[0, 1], J[0, 2], J[1, 2]]
+                    lines.append(_tag(pad + "  ", "inertial", pos=_v(com * M),
+                                      mass=_f(pm.mass), fullinertia=_v(full)))
                 tool = b.R.T @ (model.p - b.pos) * M
                 lines.append(f"{pad}  <site{_a(name='tool', pos=_v(tool), size='0.005')}/>")
             for k, (a, c, rad) in enumerate(geoms.get(b.name, ())):
@@ -213,10 +224,12 @@ def mjcf_text(mech, pose=None, mass: MassModel | None = None) -> str:
         b1, b2 = model.bodies[cl.body1], model.bodies[cl.body2]
         if cl.kind == "connect":
             anchor = b1.R.T @ (cl.anchor - b1.pos) * M
-            out.append(f"    <connect{_a(name=cl.name, body1=cl.body1, body2=cl.body2, anchor=_v(anchor))}/>")
+            out.append(_tag("    ", "connect", name=cl.name, body1=cl.body1, body2=cl.body2,
+                            anchor=_v(anchor)))
         else:
             pos, Rr = relative(b1, b2)
-            out.append(f"    <weld{_a(name=cl.name, body1=cl.body1, body2=cl.body2, relpose=_v(np.r_[pos * M, quat(Rr)]))}/>")
+            out.append(_tag("    ", "weld", name=cl.name, body1=cl.body1, body2=cl.body2,
+                            relpose=_v(np.r_[pos * M, quat(Rr)])))
     out.append("  </equality>")
     out.append("  <actuator>")
     w = 2 * math.pi * SERVO_HZ
@@ -227,7 +240,8 @@ def mjcf_text(mech, pose=None, mass: MassModel | None = None) -> str:
         else:                    # a crank: the share of the mass at the next joint's centre
             arm = _arm(model, tj) * M
             kp, f = share * arm * arm * w * w, 1.0
-        out.append(f"    <position{_a(name=tj.actuator, joint=tj.name, kp=_f(kp), dampratio='1', ctrlrange=_v([lo * f, hi * f]))}/>")
+        out.append(_tag("    ", "position", name=tj.actuator, joint=tj.name, kp=_f(kp),
+                        dampratio="1", ctrlrange=_v([lo * f, hi * f])))
     out.append("  </actuator>")
     out.append("  <sensor>")
     out.append('    <framepos name="tool_pos" objtype="site" objname="tool"/>')
@@ -239,6 +253,15 @@ def mjcf_text(mech, pose=None, mass: MassModel | None = None) -> str:
     out.append("  </keyframe>")
     out.append("</mujoco>")
     return "\n".join(out) + "\n"
+
+
+def _regular_inertia(pm, link_diameter: float) -> np.ndarray:
+    """The payload's inertia (kg·mm²), plus that of a solid sphere of its mass and the link
+    diameter when it is not positive definite (a point mass, which MuJoCo refuses)."""
+    J = np.asarray(pm.inertia, dtype=float)
+    if np.linalg.eigvalsh(J)[0] <= 1e-12 * max(1.0, float(np.abs(J).max())):
+        J = J + 0.4 * float(pm.mass) * (0.5 * link_diameter) ** 2 * np.eye(3)
+    return J
 
 
 def _arm(model, tj) -> float:

@@ -32,7 +32,10 @@ joints it carries (a sphere when they coincide), of diameter ``link_diameter``; 
 disc through its joints. Default: solid aluminium (2700 kg/m³), ``link_diameter`` 2.5 % of the
 mechanism's size (``mech.scale``), the platform disc 1/10 of its radius thick. A study's
 payload (platform and payload as one rigid body) replaces the platform's, and its leg mass is
-spread over each leg's links in proportion to their volumes.
+spread over each leg's links in proportion to their volumes. A payload given without inertia
+(a point mass) gets that of a solid sphere of its mass and the link diameter, since MuJoCo
+needs a positive-definite inertia. Joint bodies (U crosses, closure bodies) are spheres of
+half the link diameter in the same material.
 """
 
 from __future__ import annotations

@@ -31,7 +31,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from .mjcf import M, _masses, _platform_disc
+from .mjcf import M, _masses, _platform_disc, _regular_inertia
 from .model import MassModel, build_model
 
 __all__ = ["urdf_text", "rpy"]
@@ -52,11 +52,16 @@ def _a(**kw) -> str:
     return "".join(f" {k}={quoteattr(str(v))}" for k, v in kw.items())
 
 
+def _tag(pad: str, element: str, /, **attrs) -> str:
+    return f"{pad}<{element}{_a(**attrs)}/>"
+
+
 def _inertial(mass: float, com_local, radius: float) -> list[str]:
     I = 0.4 * mass * radius * radius          # a solid sphere's (kg m²): a documented stand-in
     return ["    <inertial>", f"      <origin{_a(xyz=_v(com_local), rpy='0 0 0')}/>",
             f"      <mass{_a(value=repr(float(mass)))}/>",
-            f"      <inertia{_a(ixx=repr(I), ixy='0', ixz='0', iyy=repr(I), iyz='0', izz=repr(I))}/>",
+            _tag("      ", "inertia", ixx=repr(I), ixy="0", ixz="0", iyy=repr(I), iyz="0",
+                 izz=repr(I)),
             "    </inertial>"]
 
 
@@ -101,13 +106,17 @@ def urdf_text(mech, pose=None, mass: MassModel | None = None) -> str:
             else:
                 com = body.R.T @ (model.p + model.R @ (np.asarray(pm.com) - mech.tool_offset)
                                   - body.pos) * M
-                J = np.asarray(pm.inertia) * M * M
+                J = _regular_inertia(pm, model.link_diameter) * M * M
                 lines += ["    <inertial>", f"      <origin{_a(xyz=_v(com), rpy='0 0 0')}/>",
                           f"      <mass{_a(value=repr(float(pm.mass)))}/>",
-                          f"      <inertia{_a(ixx=repr(J[0, 0]), ixy=repr(J[0, 1]), ixz=repr(J[0, 2]), iyy=repr(J[1, 1]), iyz=repr(J[1, 2]), izz=repr(J[2, 2]))}/>",
+                          _tag("      ", "inertia", **{
+                              k: repr(float(J[i, j])) for k, (i, j) in (
+                                  ("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)),
+                                  ("iyy", (1, 1)), ("iyz", (1, 2)), ("izz", (2, 2)))}),
                           "    </inertial>"]
             lines += ["    <visual>", f"      <origin{_a(xyz=_v(loc), rpy='0 0 0')}/>",
-                      f"      <geometry><cylinder{_a(radius=repr(rad * M), length=repr(th * M))}/></geometry>",
+                      "      <geometry>" + _tag("", "cylinder", radius=repr(rad * M),
+                                                 length=repr(th * M)) + "</geometry>",
                       "    </visual>"]
         elif body is None or body.kind != "base":
             lines += _inertial(1e-6, np.zeros(3), 1e-3)          # a massless frame link
@@ -122,7 +131,8 @@ def urdf_text(mech, pose=None, mass: MassModel | None = None) -> str:
             lines.append(f"    <axis{_a(xyz=_v(axis))}/>")
         if limit is not None:
             lo, hi = limit
-            lines.append(f"    <limit{_a(lower=repr(lo), upper=repr(hi), effort='1000', velocity='10')}/>")
+            lines.append(_tag("    ", "limit", lower=repr(lo), upper=repr(hi), effort="1000",
+                              velocity="10"))
         lines.append("  </joint>")
         joints.extend(lines)
 
@@ -153,7 +163,8 @@ def urdf_text(mech, pose=None, mass: MassModel | None = None) -> str:
             f = M if tj.kind == "slide" else 1.0
             lo, hi = mech.stroke
             limit = ((lo - tj.value) * f, (hi - tj.value) * f)
-            extra.append(f"  <pkmlab:actuator{_a(name=tj.actuator, joint=tj.name, offset=repr(tj.value * f), unit='m' if f == M else 'rad')}/>")
+            extra.append(_tag("  ", "pkmlab:actuator", name=tj.actuator, joint=tj.name,
+                              offset=repr(tj.value * f), unit="m" if f == M else "rad"))
         joint(tj.name, kind, b.parent, b.name, pos, Rrel, b.R.T @ tj.axis, limit)
     tool = model.bodies["platform"]
     link("tool")
@@ -164,7 +175,10 @@ def urdf_text(mech, pose=None, mass: MassModel | None = None) -> str:
             link(f"{cl.name}__{side}")
             joint(f"{cl.name}__{side}", "fixed", body, f"{cl.name}__{side}",
                   b.R.T @ (cl.anchor - b.pos) * M, b.R.T)
-        extra.append(f"  <pkmlab:loop_closure{_a(name=cl.name, type='point' if cl.kind == 'connect' else 'weld', frame_a=cl.name + '__a', frame_b=cl.name + '__b', cut_joint_type=cl.protocol_type)}/>")
+        extra.append(_tag("  ", "pkmlab:loop_closure", name=cl.name,
+                          type="point" if cl.kind == "connect" else "weld",
+                          frame_a=cl.name + "__a", frame_b=cl.name + "__b",
+                          cut_joint_type=cl.protocol_type))
     head = ['<?xml version="1.0" encoding="utf-8"?>',
             f"<!-- pkmlab {mech.family} mechanism {mech.name or '(unnamed)'}: exported by pkmlab "
             "export, format urdf. SI units (m, kg, rad). A spanning tree; loops closed by "

@@ -7,9 +7,10 @@ report and :func:`pkmlab.open_results` need later is written here, so they only 
 ``designs/NN-key/`` (``NN``: 1 = the knee, then the extremes, then the spread designs; see
 :mod:`.selection`) holds ``mechanism.yaml``, the mechanism in every mechanism format of the
 exporter registry (``mechanism.mjcf.xml``, ``mechanism.urdf``, ``mechanism.joints.csv`` and
-``.json``, ``mechanism.step`` when build123d is installed), ``design.json`` (why it was chosen, its Pareto
-rank, values, slice layout, files), ``workspace.stl`` (mm), ``workspace.ply`` (mm, κ per
-vertex as a property), ``workspace.glb`` (m, coloured by κ), ``slices.png`` and
+``.json``, ``mechanism.step`` when build123d is installed), ``design.json`` (why it was
+chosen, its Pareto rank, values, slice layout, files), ``workspace.stl`` (mm),
+``workspace.ply`` (mm, κ per vertex as a property), ``workspace.glb`` (m, coloured by κ),
+``slices.png`` and
 ``kappa_slices.png``; ``designs/index.json`` lists them and the exports that failed.
 
 With requirements (:mod:`pkmlab.requirements`): the task region is drawn in red into the
