@@ -22,8 +22,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "data" / "plugin3"))
 
-import pkmlab  # noqa: E402
 import pkmlab_tri3_family as tri3  # noqa: E402
+
+import pkmlab  # noqa: E402
 from pkmlab.export import roundtrip as rt  # noqa: E402
 from pkmlab.study import load_study  # noqa: E402
 from pkmlab.study.candidates import mass_model  # noqa: E402

@@ -2,7 +2,7 @@
 
     pkmlab export results/hopkins-6psu-redesign/designs/01-*/mechanism.yaml --format mjcf -o sim
     python examples/play_paper_motion.py results/hopkins-6psu-redesign/designs/01-*/mechanism.yaml \
-        sim/*.mjcf.xml [--amplitude-deg 10] [--view]
+        sim/*.mjcf.xml [--amplitude-mm 25] [--amplitude-deg 15] [--view]
 
 The position servos follow pkmlab's inverse kinematics of the motion (``ctrl`` interpolated
 at MuJoCo's time step); the script prints how closely the simulated tool follows the
@@ -50,9 +50,9 @@ def main() -> None:
     site = model.site("tool").id
     viewer = None
     if a.view:
-        import mujoco.viewer
+        from mujoco import viewer as mjviewer
 
-        viewer = mujoco.viewer.launch_passive(model, data)
+        viewer = mjviewer.launch_passive(model, data)
     worst_mm = worst_rad = 0.0
     p, R = mech._frames(X)
     for k in range(len(t) - 1):
