@@ -95,6 +95,31 @@ def _urdf_frames(text: str) -> tuple[dict, dict]:
     return frames, closures, joints
 
 
+_NUMERIC = {"xyz", "rpy", "value", "ixx", "ixy", "ixz", "iyy", "iyz", "izz", "radius",
+            "length", "lower", "upper", "effort", "velocity", "offset", "pos", "quat", "size",
+            "fromto", "axis", "ref", "range", "kp", "ctrlrange", "anchor", "relpose", "mass",
+            "density", "fullinertia", "qpos", "ctrl", "timestep", "tolerance", "gravity",
+            "solref", "damping", "armature"}
+
+
+@pytest.mark.parametrize("family", FAMILIES)
+def test_every_number_written_parses_as_a_number(family):
+    """URDF and MJCF readers (urdfdom, MuJoCo) need plain decimal numbers in every numeric
+    attribute (a numpy repr such as 'np.float64(1.0)' was once written for inertias)."""
+    from pkmlab.export.model import MassModel
+    from pkmlab.requirements.payload import MassProperties
+
+    mech = sample(family)
+    payload = MassModel(platform=MassProperties(1.5, [0, 0, 10.0], [0.0, 0.0, 0.0]),
+                        leg_mass=0.2)
+    for text in (urdf_text(mech), mjcf_text(mech), urdf_text(mech, mass=payload),
+                 mjcf_text(mech, mass=payload)):
+        for el in ET.fromstring(text).iter():
+            for k, v in el.attrib.items():
+                if k in _NUMERIC:
+                    [float(x) for x in v.split()]
+
+
 @pytest.mark.parametrize("family", FAMILIES)
 def test_urdf_joint_frames_and_loop_closures_at_several_poses(family):
     mech = sample(family)

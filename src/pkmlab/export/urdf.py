@@ -44,8 +44,12 @@ def rpy(R: np.ndarray) -> np.ndarray:
     return np.array([math.atan2(R[2, 1], R[2, 2]), pitch, math.atan2(R[1, 0], R[0, 0])])
 
 
+def _r(x) -> str:
+    return repr(float(x))
+
+
 def _v(x) -> str:
-    return " ".join(repr(float(v)) for v in np.ravel(x))
+    return " ".join(_r(v) for v in np.ravel(x))
 
 
 def _a(**kw) -> str:
@@ -57,11 +61,11 @@ def _tag(pad: str, element: str, /, **attrs) -> str:
 
 
 def _inertial(mass: float, com_local, radius: float) -> list[str]:
-    I = 0.4 * mass * radius * radius          # a solid sphere's (kg m²): a documented stand-in
+    I = float(0.4 * mass * radius * radius)   # a solid sphere's (kg m²): a documented stand-in
     return ["    <inertial>", f"      <origin{_a(xyz=_v(com_local), rpy='0 0 0')}/>",
-            f"      <mass{_a(value=repr(float(mass)))}/>",
-            _tag("      ", "inertia", ixx=repr(I), ixy="0", ixz="0", iyy=repr(I), iyz="0",
-                 izz=repr(I)),
+            f"      <mass{_a(value=_r(mass))}/>",
+            _tag("      ", "inertia", ixx=_r(I), ixy="0", ixz="0", iyy=_r(I), iyz="0",
+                 izz=_r(I)),
             "    </inertial>"]
 
 
@@ -85,10 +89,10 @@ def urdf_text(mech, pose=None, mass: MassModel | None = None) -> str:
                 L = np.linalg.norm(c - a)
                 mid = body.R.T @ (0.5 * (a + c) - body.pos) * M
                 if L < 1e-9:
-                    shape = f"<sphere{_a(radius=repr(r * M))}/>"
+                    shape = f"<sphere{_a(radius=_r(r * M))}/>"
                     rot = np.eye(3)
                 else:
-                    shape = f"<cylinder{_a(radius=repr(r * M), length=repr(L * M))}/>"
+                    shape = f"<cylinder{_a(radius=_r(r * M), length=_r(L * M))}/>"
                     z = body.R.T @ ((c - a) / L)
                     x = np.cross(z, [1.0, 0, 0]) if abs(z[0]) < 0.9 else np.cross(z, [0, 1.0, 0])
                     x /= np.linalg.norm(x)
@@ -108,15 +112,15 @@ def urdf_text(mech, pose=None, mass: MassModel | None = None) -> str:
                                   - body.pos) * M
                 J = _regular_inertia(pm, model.link_diameter) * M * M
                 lines += ["    <inertial>", f"      <origin{_a(xyz=_v(com), rpy='0 0 0')}/>",
-                          f"      <mass{_a(value=repr(float(pm.mass)))}/>",
+                          f"      <mass{_a(value=_r(pm.mass))}/>",
                           _tag("      ", "inertia", **{
-                              k: repr(float(J[i, j])) for k, (i, j) in (
+                              k: _r(J[i, j]) for k, (i, j) in (
                                   ("ixx", (0, 0)), ("ixy", (0, 1)), ("ixz", (0, 2)),
                                   ("iyy", (1, 1)), ("iyz", (1, 2)), ("izz", (2, 2)))}),
                           "    </inertial>"]
             lines += ["    <visual>", f"      <origin{_a(xyz=_v(loc), rpy='0 0 0')}/>",
-                      "      <geometry>" + _tag("", "cylinder", radius=repr(rad * M),
-                                                 length=repr(th * M)) + "</geometry>",
+                      "      <geometry>" + _tag("", "cylinder", radius=_r(rad * M),
+                                                 length=_r(th * M)) + "</geometry>",
                       "    </visual>"]
         elif body is None or body.kind != "base":
             lines += _inertial(1e-6, np.zeros(3), 1e-3)          # a massless frame link
@@ -131,7 +135,7 @@ def urdf_text(mech, pose=None, mass: MassModel | None = None) -> str:
             lines.append(f"    <axis{_a(xyz=_v(axis))}/>")
         if limit is not None:
             lo, hi = limit
-            lines.append(_tag("    ", "limit", lower=repr(lo), upper=repr(hi), effort="1000",
+            lines.append(_tag("    ", "limit", lower=_r(lo), upper=_r(hi), effort="1000",
                               velocity="10"))
         lines.append("  </joint>")
         joints.extend(lines)
@@ -164,7 +168,7 @@ def urdf_text(mech, pose=None, mass: MassModel | None = None) -> str:
             lo, hi = mech.stroke
             limit = ((lo - tj.value) * f, (hi - tj.value) * f)
             extra.append(_tag("  ", "pkmlab:actuator", name=tj.actuator, joint=tj.name,
-                              offset=repr(tj.value * f), unit="m" if f == M else "rad"))
+                              offset=_r(tj.value * f), unit="m" if f == M else "rad"))
         joint(tj.name, kind, b.parent, b.name, pos, Rrel, b.R.T @ tj.axis, limit)
     tool = model.bodies["platform"]
     link("tool")
