@@ -180,16 +180,23 @@ def test_mjcf_is_one_tree_under_one_root_body_with_an_actuator_per_leg(family):
 
 
 def test_step_skeleton_or_the_reason_it_is_skipped(tmp_path):
-    pytest.importorskip("build123d", reason="STEP needs the optional extra cad (build123d)")
+    bd = pytest.importorskip("build123d", reason="STEP needs the optional extra cad "
+                             "(build123d)")
+    from pkmlab.export.step import JOINT_SPHERE
+
     mech = sample("rss6")
     [path] = export_mechanism(mech, "step", tmp_path)
-    text = path.read_text(errors="replace")
-    assert text.startswith("ISO-10303-21;")
-    assert "MANIFOLD_SOLID_BREP" in text
-    # one sphere per joint, one cylinder per link segment, two plates
+    assert path.read_text(errors="replace").startswith("ISO-10303-21;")
+    shape = bd.import_step(str(path))
+    # two plates, a sphere per joint, a cylinder per crank and per rod
     n_joints = len({j.name for leg in mech.legs() for j in leg.joints})
-    assert text.count("MANIFOLD_SOLID_BREP") >= n_joints + 2
-    assert "'MILLI'" in text or "MILLI" in text
+    assert len(shape.solids()) == 2 + n_joints + 2 * len(mech.legs())
+    # in mm: the joint centres, padded by the joint spheres, bound the skeleton
+    P = np.array([j.location for leg in mech.legs() for j in leg.joints])
+    bb = shape.bounding_box()
+    pad = 0.5 * JOINT_SPHERE * 0.025 * mech.scale
+    assert np.allclose([bb.min.Z, bb.max.Z], [P[:, 2].min() - pad, P[:, 2].max() + pad],
+                       atol=1e-3)
 
 
 def test_cli_export_of_a_mechanism_file(tmp_path):
