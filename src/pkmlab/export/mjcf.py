@@ -17,7 +17,8 @@ Conventions (MuJoCo XML reference, mujoco.readthedocs.io/en/stable/XMLreference.
   joint's ``range`` the stroke or servo window, ``kp`` giving a 20 Hz servo on an equal share
   of the moving mass, critically damped (``dampratio="1"``);
 * contacts are excluded between every two bodies of one leg's chain (base and platform
-  included); legs can still touch each other;
+  included) and between two bodies whose shapes already touch at the exported pose (links
+  meeting at neighbouring joints); legs can still touch each other elsewhere;
 * a site ``tool`` at the tool point with the platform's orientation; sensors ``tool_pos``
   and ``tool_quat`` read it; a keyframe ``home`` holds the exported pose.
 """
@@ -208,7 +209,8 @@ def mjcf_text(mech, pose=None, mass: MassModel | None = None) -> str:
 
     out += body_xml(model.bodies["base"], 2)
     out.append("  </worldbody>")
-    # contacts: none between the bodies of one chain
+    # contacts: none between the bodies of one chain, nor between two that already touch at
+    # the exported pose (links meeting at neighbouring joints)
     pairs = []
     for chain in model.chains.values():
         for i, a in enumerate(chain):
@@ -216,6 +218,14 @@ def mjcf_text(mech, pose=None, mass: MassModel | None = None) -> str:
                 key = tuple(sorted((a, c)))
                 if key not in pairs and a != c:
                     pairs.append(key)
+    names = sorted(geoms)
+    for i, a in enumerate(names):
+        for c in names[i + 1:]:
+            key = tuple(sorted((a, c)))
+            if key not in pairs and min(
+                    _segment_distance(g[0], g[1], h[0], h[1]) - g[2] - h[2]
+                    for g in geoms[a] for h in geoms[c]) <= 0:
+                pairs.append(key)
     out.append("  <contact>")
     out += [f"    <exclude{_a(body1=a, body2=c)}/>" for a, c in pairs]
     out.append("  </contact>")
@@ -253,6 +263,17 @@ def mjcf_text(mech, pose=None, mass: MassModel | None = None) -> str:
     out.append("  </keyframe>")
     out.append("</mujoco>")
     return "\n".join(out) + "\n"
+
+
+def _segment_distance(a, b, c, d) -> float:
+    """Shortest distance (mm) between the segments ``ab`` and ``cd`` (a point when its ends
+    coincide): the minimum over a fine grid of the first segment of the exact point-segment
+    distance to the second (to 1e-3 of the first's length: a contact filter)."""
+    u, v = b - a, d - c
+    vv = float(v @ v)
+    P = a + np.linspace(0.0, 1.0, 1001)[:, None] * u
+    t = np.zeros(len(P)) if vv == 0 else np.clip((P - c) @ v / vv, 0.0, 1.0)
+    return float(np.min(np.linalg.norm(P - (c + t[:, None] * v), axis=1)))
 
 
 def _regular_inertia(pm, link_diameter: float) -> np.ndarray:
