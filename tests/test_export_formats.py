@@ -217,23 +217,37 @@ def test_cli_export_of_a_mechanism_file(tmp_path):
 
 
 def test_cli_exports_any_candidate_of_a_study_feasible_or_not(tiny_report, tmp_path):
-    import csv as _csv
-
     from typer.testing import CliRunner
 
     from pkmlab.cli import app
+    from pkmlab.cli.study import _open_results
+    from pkmlab.study.run import feasible
 
     out, _ = tiny_report
-    rows = list(_csv.DictReader((out / "evaluations.csv").open()))
-    infeasible = [r for r in rows if r.get("feasible") in ("False", "false", "0")]
-    picks = [rows[0]["seq"]] + ([infeasible[0]["seq"]] if infeasible else [])
-    for seq in picks:
+    study, records = _open_results(out)
+    ok = [r for r in records if r["status"] == "ok"]
+    good = feasible(study, ok)
+    picks = {"feasible": ok[int(np.flatnonzero(good)[0])],
+             "infeasible": ok[int(np.flatnonzero(~good)[0])]}
+    for what, rec in picks.items():
+        seq = str(rec["seq"])
         r = CliRunner().invoke(app, ["export", str(out), "--seq", seq, "--format", "urdf",
                                      "-o", str(tmp_path), "--json"])
-        assert r.exit_code == 0, r.output
+        assert r.exit_code == 0, (what, r.output)
         files = json.loads(r.output)["files"]
-        assert any(f.endswith(f"-seq{seq}.yaml") for f in files)
+        yaml_file = next(f for f in files if f.endswith(f"-seq{seq}.yaml"))
         assert any(f.endswith(f"-seq{seq}.urdf") for f in files)
+        # the candidate's own geometry: its mechanism file rebuilds the same mechanism
+        import pkmlab
+        from pkmlab.study.candidates import candidate_mechanism
+
+        got, want = pkmlab.load_mechanism(yaml_file), candidate_mechanism(study, rec)
+        assert np.allclose(got.parameters().values, want.parameters().values, atol=1e-9)
+    invalid = [r for r in records if r["status"] == "invalid"]
+    if invalid:                 # a candidate whose geometry cannot be built: said, exit 2
+        r = CliRunner().invoke(app, ["export", str(out), "--seq", str(invalid[0]["seq"]),
+                                     "--format", "urdf", "-o", str(tmp_path)])
+        assert r.exit_code == 2 and "error" in r.output
     r = CliRunner().invoke(app, ["export", str(out), "--seq", "99999", "--format", "urdf",
                                  "-o", str(tmp_path)])
     assert r.exit_code == 2 and "--seq" in r.output
