@@ -31,7 +31,7 @@ PLUGIN_GROUP = "pkmlab.exporters"
 PLUGIN_ERRORS: dict[str, str] = {}
 #: format → exporter, in registration order
 EXPORTERS: dict[str, Exporter] = {}
-SUBJECTS = ("mesh",)
+SUBJECTS = ("mesh", "mechanism")
 
 
 @dataclass(frozen=True)
@@ -48,6 +48,10 @@ class Exporter:
             colours; ``"values"``: ``{name: (n,)}`` vertex values); others are not passed.
         trimesh: ``write`` needs a ``trimesh.Trimesh`` (else plain vertices and faces do).
         study: written for every design a study exports.
+        files: the file suffixes a ``"mechanism"`` exporter writes (``write`` then returns
+            ``{suffix: bytes}`` when there are several); default ``("." + format,)``.
+        requires: a module ``write`` imports that is an optional extra (``"build123d"``):
+            :meth:`available` says whether it is installed.
     """
 
     format: str
@@ -57,6 +61,8 @@ class Exporter:
     options: frozenset[str] = field(default_factory=frozenset)
     trimesh: bool = True
     study: bool = True
+    files: tuple[str, ...] = ()
+    requires: str | None = None
 
     def __post_init__(self):
         if not (self.format.isascii() and self.format.isalnum() and self.format.islower()):
@@ -70,7 +76,18 @@ class Exporter:
 
     @property
     def suffix(self) -> str:
-        return "." + self.format
+        return self.files[0] if self.files else "." + self.format
+
+    def available(self) -> tuple[bool, str]:
+        """``(True, "")``, or ``(False, why)`` when its optional extra is not installed."""
+        if self.requires is None:
+            return True, ""
+        import importlib.util
+
+        if importlib.util.find_spec(self.requires) is None:
+            return False, (f"format {self.format!r} needs the package {self.requires!r} "
+                           "(pip install 'pkmlab[cad]')")
+        return True, ""
 
 
 def register_exporter(exporter: Exporter, *, replace: bool = False) -> Exporter:

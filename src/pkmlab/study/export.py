@@ -5,9 +5,12 @@ The only part of reporting that computes: each exported design's workspace is ev
 report and :func:`pkmlab.open_results` need later is written here, so they only read files.
 
 ``designs/NN-key/`` (``NN``: 1 = the knee, then the extremes, then the spread designs; see
-:mod:`.selection`) holds ``mechanism.yaml``, ``design.json`` (why it was chosen, its Pareto
-rank, values, slice layout, files), ``workspace.stl`` (mm), ``workspace.ply`` (mm, κ per
-vertex as a property), ``workspace.glb`` (m, coloured by κ), ``slices.png`` and
+:mod:`.selection`) holds ``mechanism.yaml``, the mechanism in every mechanism format of the
+exporter registry (``mechanism.mjcf.xml``, ``mechanism.urdf``, ``mechanism.joints.csv`` and
+``.json``, ``mechanism.step`` when build123d is installed), ``design.json`` (why it was
+chosen, its Pareto rank, values, slice layout, files), ``workspace.stl`` (mm),
+``workspace.ply`` (mm, κ per vertex as a property), ``workspace.glb`` (m, coloured by κ),
+``slices.png`` and
 ``kappa_slices.png``; ``designs/index.json`` lists them and the exports that failed.
 
 With requirements (:mod:`pkmlab.requirements`): the task region is drawn in red into the
@@ -154,6 +157,8 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
     info: dict = {"number": number, "pareto_rank": rank, "why": why, "seq": r["seq"],
                   "key": r["key"], "params": params, "metrics": r["metrics"],
                   "notes": r.get("notes", {}), "files": files}
+    step("simulator and CAD formats")
+    _mechanism_formats(d, study, spec.build(), files, info)
     ev = study.evaluation
     mech = spec.build() if (ev.workspace is not None or ev.task is not None
                             or ev.motions is not None) else None
@@ -228,6 +233,23 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
         files += [pic.path.name for pic in pictures]
     atomic.write_text(d / "design.json", json.dumps(_plain(info), indent=2) + "\n")
     return info
+
+
+def _mechanism_formats(d: Path, study: Study, mech, files: list, info: dict) -> None:
+    """``mechanism.<suffix>`` in every mechanism format of the exporter registry written by
+    studies (MJCF, URDF, joint frames, STEP), with the study's masses; a format whose
+    optional package is missing is listed in ``info["formats_skipped"]`` with the reason."""
+    from ..export import export_mechanism, mechanism_formats
+    from .candidates import mass_model
+
+    mass = mass_model(study)
+    for fmt, ex in mechanism_formats(study=True).items():
+        ok, why = ex.available()
+        if not ok:
+            info.setdefault("formats_skipped", {})[fmt] = why
+            continue
+        for p in export_mechanism(mech, fmt, d, stem="mechanism", mass=mass):
+            files.append(p.name)
 
 
 # ---- requirement outputs (task region, actuators over the motions) ---------------------------

@@ -40,6 +40,9 @@ def _what(name: str) -> str:
     ex = exporters("mesh").get(fmt)
     if stem == "workspace" and ex is not None:
         return "workspace hull, " + ex.description
+    for mex in exporters("mechanism").values():      # mechanism.mjcf.xml, .urdf, ...
+        if any(name == "mechanism" + sfx for sfx in mex.files or (mex.suffix,)):
+            return f"mechanism, {mex.format.upper()}: {mex.description}"
     return _FILES.get(name, "slices coloured by the metric" if name.endswith("_slices.png")
                       else "")
 
