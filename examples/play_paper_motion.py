@@ -21,8 +21,8 @@ import numpy as np
 
 import pkmlab
 from pkmlab.export.roundtrip import actuator_targets
+from pkmlab.motion import paper_motion
 from pkmlab.poses import log_so3
-from pkmlab.trajectory.motions import paper_motion
 
 
 def main() -> None:
@@ -36,8 +36,9 @@ def main() -> None:
     a = ap.parse_args()
 
     mech = pkmlab.load_mechanism(a.mechanism)
-    t, X = paper_motion(mech, amplitude_mm=a.amplitude_mm,
-                        amplitude_rad=math.radians(a.amplitude_deg))
+    motion = paper_motion(mech, amplitude_mm=a.amplitude_mm,
+                          amplitude_rad=math.radians(a.amplitude_deg))
+    t, X = motion.t, motion.poses
     q = actuator_targets(mech, X)
     bad = np.flatnonzero(np.isnan(q).any(axis=1))
     if len(bad):

@@ -66,8 +66,8 @@ def _candidate_yaml(study, rec, stem: str, folder: Path) -> Path:
 
     import yaml
 
-    from ..atomic import write_text
     from ..config import to_display
+    from ..runtime.atomic import write_text
     from ..study.candidates import mechanism_spec
 
     spec = mechanism_spec(study, rec, stem)

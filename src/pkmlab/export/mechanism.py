@@ -69,7 +69,7 @@ def export_mechanism(mech, fmt: str, out: str | Path, *, stem: str | None = None
     """Write ``mech`` in format ``fmt`` into the folder ``out`` as ``<stem><suffix>`` for
     each of the format's files (``stem`` default: the mechanism's name or family); returns
     the paths. A format whose optional extra is missing raises a ParameterError saying so."""
-    from ..atomic import write_bytes
+    from ..runtime.atomic import write_bytes
 
     ex = mechanism_formats().get(fmt)
     if ex is None:

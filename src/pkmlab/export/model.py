@@ -64,7 +64,7 @@ class MassModel:
     Attributes:
         link_diameter: mm (None: :data:`LINK_DIAMETER_SHARE` of ``mech.scale``).
         density: kg/m³ of links and platform when no mass is given.
-        platform: a :class:`pkmlab.requirements.payload.MassProperties` of the platform and
+        platform: a :class:`pkmlab.motion.payload.MassProperties` of the platform and
             payload together (platform frame), or None for the default disc.
         leg_mass: kg per leg, spread over its links by volume, or None (density).
         source: a sentence saying where the masses come from (written into the files).

@@ -107,7 +107,7 @@ def test_every_number_written_parses_as_a_number(family):
     """URDF and MJCF readers (urdfdom, MuJoCo) need plain decimal numbers in every numeric
     attribute (a numpy repr such as 'np.float64(1.0)' was once written for inertias)."""
     from pkmlab.export.model import MassModel
-    from pkmlab.requirements.payload import MassProperties
+    from pkmlab.motion.payload import MassProperties
 
     mech = sample(family)
     payload = MassModel(platform=MassProperties(1.5, [0, 0, 10.0], [0.0, 0.0, 0.0]),
