@@ -97,7 +97,7 @@ def exp_so3(w: np.ndarray) -> np.ndarray:
     w = np.asarray(w, dtype=float)
     theta = np.linalg.norm(w, axis=-1)[..., None, None]
     K = skew(w)
-    small = theta < 1e-8
+    small = theta < 1e-8       # algorithm constant: the series is exact to round-off below
     safe = np.where(small, 1.0, theta)
     a = np.where(small, 1.0 - theta**2 / 6.0, np.sin(safe) / safe)
     b = np.where(small, 0.5 - theta**2 / 24.0, (1.0 - np.cos(safe)) / safe**2)
@@ -112,7 +112,7 @@ def log_so3(R: np.ndarray) -> np.ndarray:
     v = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
                   R[..., 1, 0] - R[..., 0, 1]], axis=-1)
     s = np.sin(theta)
-    small = s < 1e-6
+    small = s < 1e-6           # algorithm constant: the series is exact to round-off below
     ratio = theta / (2 * np.where(small, 1.0, s))
     out = np.where(small[..., None], 0.5 * v, v * ratio[..., None])
     # Near θ = π the antisymmetric part vanishes: use the symmetric part instead.

@@ -32,6 +32,19 @@ class Tolerances:
     #: Trajectory checks: a computed actuator value outside the stroke by less than this (mm)
     #: is round-off, not a violation.
     stroke_roundoff_mm: float = 1e-9
+    #: A direction (an axis, a link, a joint offset) shorter than this (mm, or unitless for a
+    #: unit-vector candidate) is degenerate: it has no direction.
+    direction_norm: float = 1e-9
+    #: A zero direction whose part orthogonal to its axis is shorter than this fraction of its
+    #: length lies along the axis: the crank has no zero angle.
+    perpendicular_rel: float = 1e-6
+    #: Two points closer than this × the mechanism's scale (mm) are the same point (a loop
+    #: closure, two samples of a rigid body).
+    same_point_rel: float = 1e-9
+    #: An inertia matrix is symmetric and positive semi-definite to this × its largest entry.
+    symmetric_rel: float = 1e-9
+    #: Time steps equal to this × the mean step count as uniform sampling (differentiation).
+    uniform_time_rel: float = 1e-6
 
 
 #: The tolerances in force.

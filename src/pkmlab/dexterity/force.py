@@ -76,7 +76,7 @@ def _directions(direction, n: int) -> np.ndarray:
         raise ParameterError("direction", f"a vector (3,) or an array ({n}, 3)", d.shape)
     d = np.broadcast_to(d, (n, 3))
     norm = np.linalg.norm(d, axis=1)
-    if not np.all(np.isfinite(norm)) or np.any(norm < 1e-300):
+    if not np.all(np.isfinite(norm)) or np.any(norm < 1e-300):   # algorithm constant: zero
         raise ParameterError("direction", "non-zero finite vectors", direction)
     return d / norm[:, None]
 
@@ -218,7 +218,7 @@ def force_along_closed_form(J: np.ndarray, f_max, direction, payload=None,
         dn = np.where(g > 0, (-f - fp) / g, np.where(g < 0, (f - fp) / g, -np.inf))
     s_hi = np.min(up, axis=1)
     s_lo = np.maximum(np.max(dn, axis=1), 0.0)
-    tol = 1e-12 * (1.0 + np.abs(s_hi))
+    tol = 1e-12 * (1.0 + np.abs(s_hi))     # algorithm constant: round-off of s
     zero_ok = np.all((g != 0) | (np.abs(fp) <= f * (1 + 1e-12)), axis=1)
     feasible = (s_lo <= s_hi + tol) & zero_ok
     status = np.full(n, "optimal", dtype=object)

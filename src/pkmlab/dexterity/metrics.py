@@ -396,7 +396,7 @@ def characteristic_length(mech, pose=None) -> CharacteristicLength:
                           options={"xatol": 1e-10, "maxiter": 200})
     x, val = (float(res.x), float(res.fun)) if res.fun <= kap[k] else (float(grid[k]),
                                                                          float(kap[k]))
-    at_bound = bool(min(x - lo, hi - x) < 1e-3 * (hi - lo))
+    at_bound = bool(min(x - lo, hi - x) < 1e-3 * (hi - lo))   # algorithm constant: 0.1 %
     L = math.exp(x)
     if at_bound:
         reason = (f"κ at {where} is smallest on the edge of the search bracket [1e-3, 1e3] × "

@@ -19,6 +19,7 @@ import json
 
 import numpy as np
 
+from ..tolerances import TOL
 from .model import MassModel, build_model
 
 __all__ = ["joint_rows", "joints_csv", "joints_json", "frame_of"]
@@ -34,7 +35,7 @@ def _perp(z: np.ndarray, v) -> np.ndarray | None:
         return None
     v = np.asarray(v, dtype=float) - (np.asarray(v, dtype=float) @ z) * z
     n = np.linalg.norm(v)
-    return v / n if n > 1e-9 else None
+    return v / n if n > TOL.direction_norm else None
 
 
 def frame_of(joint, following=None) -> np.ndarray:

@@ -30,6 +30,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from ..tolerances import TOL
 from .model import MassModel, build_model, relative, segments
 
 __all__ = ["mjcf_text", "quat", "GRAVITY", "SERVO_HZ", "M"]
@@ -280,7 +281,7 @@ def _regular_inertia(pm, link_diameter: float) -> np.ndarray:
     """The payload's inertia (kg·mm²), plus that of a solid sphere of its mass and the link
     diameter when it is not positive definite (a point mass, which MuJoCo refuses)."""
     J = np.asarray(pm.inertia, dtype=float)
-    if np.linalg.eigvalsh(J)[0] <= 1e-12 * max(1.0, float(np.abs(J).max())):
+    if np.linalg.eigvalsh(J)[0] <= TOL.symmetric_rel * max(1.0, float(np.abs(J).max())):
         J = J + 0.4 * float(pm.mass) * (0.5 * link_diameter) ** 2 * np.eye(3)
     return J
 

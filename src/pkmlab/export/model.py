@@ -45,6 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ParameterError
+from ..tolerances import TOL
 
 __all__ = ["MechanismModel", "MassModel", "Body", "TreeJoint", "Closure", "build_model",
            "DENSITY", "LINK_DIAMETER_SHARE"]
@@ -366,7 +367,7 @@ def segments(model: MechanismModel, body: Body) -> list[tuple[np.ndarray, np.nda
     pts = [np.asarray(x, float) for x in body.points]
     if not pts:
         return []
-    tol = 1e-9 * max(1.0, float(model.mech.scale))
+    tol = TOL.same_point_rel * max(1.0, float(model.mech.scale))
     far = [x for x in pts[1:] if np.linalg.norm(x - pts[0]) > tol]
     uniq: list[np.ndarray] = []
     for x in far:

@@ -15,6 +15,7 @@ import tempfile
 
 import numpy as np
 
+from ..tolerances import TOL
 from .mjcf import _masses, _platform_disc
 from .model import MassModel, build_model
 
@@ -60,7 +61,7 @@ def _solids(mech, pose=None, mass: MassModel | None = None):
             continue
         for k, (a, b, r) in enumerate(gs):
             L = float(np.linalg.norm(b - a))
-            if L < 1e-9:
+            if L < TOL.direction_norm:
                 continue
             s = bd.Solid.make_cylinder(r, L, bd.Plane(origin=tuple(map(float, a)),
                                                       z_dir=tuple((b - a) / L)))

@@ -31,6 +31,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from ..tolerances import TOL
 from .mjcf import M, _masses, _platform_disc, _regular_inertia
 from .model import MassModel, build_model
 
@@ -88,7 +89,7 @@ def urdf_text(mech, pose=None, mass: MassModel | None = None) -> str:
             for a, c, r in gs:
                 L = np.linalg.norm(c - a)
                 mid = body.R.T @ (0.5 * (a + c) - body.pos) * M
-                if L < 1e-9:
+                if L < TOL.direction_norm:
                     shape = f"<sphere{_a(radius=_r(r * M))}/>"
                     rot = np.eye(3)
                 else:

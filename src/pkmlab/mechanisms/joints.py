@@ -54,6 +54,7 @@ from typing import Any, ClassVar, NamedTuple
 import numpy as np
 
 from ..errors import ParameterError
+from ..tolerances import TOL
 
 __all__ = ["Joint", "Link", "Leg", "LegTemplate", "JointArrays", "Parameters", "ParamField",
            "JointsMixin", "build_legs", "joint_segments", "hinge_axis", "chain_errors",
@@ -143,9 +144,10 @@ def hinge_axis(d: np.ndarray, hint: np.ndarray) -> np.ndarray:
     a = np.cross(hint, d)
     n = np.linalg.norm(a, axis=-1, keepdims=True)
     alt = np.cross(np.array([1.0, 0.0, 0.0]), d)
-    alt = np.where(np.linalg.norm(alt, axis=-1, keepdims=True) > 1e-9, alt,
+    alt = np.where(np.linalg.norm(alt, axis=-1, keepdims=True) > TOL.direction_norm, alt,
                    np.cross(np.array([0.0, 1.0, 0.0]), d))
-    return unit(np.where(n > 1e-9 * np.linalg.norm(d, axis=-1, keepdims=True), a, alt))
+    return unit(np.where(n > TOL.direction_norm * np.linalg.norm(d, axis=-1, keepdims=True), a,
+                         alt))
 
 
 _Z = np.array([0.0, 0.0, 1.0])

@@ -348,7 +348,8 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
     bad_j = ~j_ok
     for k in np.flatnonzero(bad_j):
         if j_finite[k]:
-            issues[k].append(f"singular Jacobian (κ = inf: σmin <= 1e-12·σmax with L = "
+            issues[k].append(f"singular Jacobian (κ = inf: σmin <= {TOL.singular_rtol:g}·σmax "
+                             f"with L = "
                              f"{L:.4g} mm), no forces")
         else:
             issues[k].append("Jacobian not finite (no solution or a link at a singularity), "

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..poses import POSE_SIZE
+from ..tolerances import TOL
 
 __all__ = ["Motion", "euler_rates_to_twist", "make_motion", "sinusoid_motion", "differentiate",
            "POSE_COLUMNS"]
@@ -97,7 +98,7 @@ def differentiate(t, x, window: float, polyorder: int, field: str = "smoothing"
     t = np.asarray(t, dtype=float)
     dt = np.diff(t)
     step = float(np.mean(dt))
-    if np.max(np.abs(dt - step)) > 1e-6 * step:
+    if np.max(np.abs(dt - step)) > TOL.uniform_time_rel * step:
         raise ParameterError(f"{field}", "uniformly sampled time for differentiation "
                              "(or derivative columns <coord>_dot, <coord>_ddot)",
                              f"steps from {dt.min():g} s to {dt.max():g} s")

@@ -36,6 +36,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..poses import as_frames
+from ..tolerances import TOL
 
 __all__ = ["MassProperties", "combine", "leg_end_masses", "leg_rod_masses", "GRAVITY"]
 
@@ -65,10 +66,10 @@ class MassProperties:
         if J.shape != (3, 3) or not np.all(np.isfinite(J)):
             raise ParameterError("inertia", "[Ixx, Iyy, Izz] or a 3×3 tensor in kg·mm²",
                                  self.inertia)
-        if np.max(np.abs(J - J.T)) > 1e-9 * max(1.0, np.max(np.abs(J))):
+        if np.max(np.abs(J - J.T)) > TOL.symmetric_rel * max(1.0, np.max(np.abs(J))):
             raise ParameterError("inertia", "a symmetric tensor", J.tolist())
         ev = np.linalg.eigvalsh(J)
-        tol = 1e-9 * max(1.0, float(np.max(np.abs(ev))))
+        tol = TOL.symmetric_rel * max(1.0, float(np.max(np.abs(ev))))
         if ev[0] < -tol:
             raise ParameterError("inertia", "a positive semi-definite tensor (principal "
                                  "moments >= 0)", ev.tolist())
@@ -117,7 +118,7 @@ def leg_rod_masses(mech, mass_each: float) -> MassProperties:
     """The six legs as uniform slender rods of ``mass_each`` kg from fixed base joints
     (module docstring): inertial mass ``m/3`` and weight ``m/2`` at each platform joint."""
     start, _ = mech.leg_segments(*_two_poses(mech))
-    if not np.allclose(start[0], start[1], rtol=0, atol=1e-9 * mech.scale):
+    if not np.allclose(start[0], start[1], rtol=0, atol=TOL.same_point_rel * mech.scale):
         raise ParameterError("evaluate.payload.legs.model", "'ends' for family "
                              f"{mech.family!r} ('rod' needs legs whose base joint does not "
                              "move, such as ups6)", "rod")

@@ -281,7 +281,7 @@ class MotionsPlan:
             elif s.file is not None:
                 rec = self.recorded[s.name].poses
                 moving = [k for j, k in enumerate(mo.POSE_COLUMNS) if k not in mob.coordinates
-                          and np.ptp(rec[:, j]) > 1e-9]
+                          and np.ptp(rec[:, j]) > 1e-9]   # algorithm constant: CSV rounding
             if moving:
                 raise ParameterError(f"evaluate.motions[{i}]", "a motion of the mechanism's "
                                      f"free coordinates ({', '.join(mob.coordinates)}) only",

@@ -15,6 +15,7 @@ import numpy as np
 from ..dexterity.metrics import condition_number, resolve_length
 from ..errors import ParameterError
 from ..poses import as_frames
+from ..tolerances import TOL
 
 __all__ = ["ActuatorWindow", "Constraints", "JointLimits", "check", "segment_distances",
            "joint_angles"]
@@ -92,7 +93,7 @@ class JointLimits:
             if v is not None:
                 a = np.asarray(v, dtype=float)
                 n = np.linalg.norm(a, axis=-1) if a.shape == (6, 3) else None
-                if n is None or not np.all(np.isfinite(a)) or np.any(n < 1e-12):
+                if n is None or not np.all(np.isfinite(a)) or np.any(n < TOL.direction_norm):
                     raise ParameterError(f"joint_limits.{name}",
                                          "six non-zero direction vectors, shape (6, 3)", v)
                 object.__setattr__(self, name, a / n[:, None])
@@ -226,6 +227,7 @@ def segment_distances(start: np.ndarray, end: np.ndarray, leg=None) -> np.ndarra
     b = np.einsum("...i,...i", d1, d2)
     den = a * e - b * b
     with np.errstate(invalid="ignore", divide="ignore"):
+        # algorithm constant: segments this close to parallel take s = 0 (any s is closest)
         s = np.where(den > 1e-12 * a * e, np.clip((b * f - c * e) / den, 0, 1), 0.0)
         t = (b * s + f) / e
         # Clamp t and recompute s where t leaves [0, 1] (closest points of two segments).

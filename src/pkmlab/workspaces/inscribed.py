@@ -44,6 +44,9 @@ __all__ = ["InscribedBox", "InscribedCylinder", "inscribed_box", "inscribed_cyli
 
 _POLY = 16
 
+#: algorithm constant: the trust region (and a step) below which the search stops (mm, rad)
+_RHO_MIN = 1e-3
+
 
 STATUSES = ("ok", "not converged", "failed", "empty")
 
@@ -311,7 +314,7 @@ def _scp(result, x0, points_of, jac_of, objective, lower_bounds, iters=30):
         if d.value is None or status not in ("optimal", "optimal_inaccurate"):
             problem = f"convex sub-problem not solved: {status}"
             rho *= 0.5
-            if rho < 1e-3:
+            if rho < _RHO_MIN:
                 break
             continue
         step = rho * np.asarray(d.value)
@@ -322,12 +325,12 @@ def _scp(result, x0, points_of, jac_of, objective, lower_bounds, iters=30):
         else:
             problem = "no step along the sub-problem's solution keeps the stroke"
             rho *= 0.5
-            if rho < 1e-3:
+            if rho < _RHO_MIN:
                 break
             continue
         x = x + step
         accepted += 1
-        if float(np.max(np.abs(step))) < 1e-3:
+        if float(np.max(np.abs(step))) < _RHO_MIN:
             converged = True
             break
     else:

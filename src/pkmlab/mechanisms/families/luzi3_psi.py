@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...poses import as_frames, frames_to_poses
+from ...tolerances import TOL
 from ..results import NO_STROKE
 
 __all__ = ["four_bar_theta", "pose_to_psi", "psi_to_pose", "reduced_dpa", "ReducedDPAResult"]
@@ -181,6 +182,7 @@ def reduced_dpa(mech, q, *, grid: int = 9, tol: float = 1e-9, max_iter: int = 60
                 dx[j] = h
                 Jm[:, :, j] = (_reduced_residual(mech, x + dx, q, branch, literal_eq10)
                                - _reduced_residual(mech, x - dx, q, branch, literal_eq10)) / (2 * h)
+            # algorithm constant: a non-zero determinant
             good = np.all(np.isfinite(Jm), axis=(1, 2)) & (np.abs(np.linalg.det(Jm)) > 1e-300)
             x, f, Jm = x[good], f[good], Jm[good]
             step = -np.linalg.solve(Jm, f[..., None])[..., 0]
@@ -207,14 +209,14 @@ def reduced_dpa(mech, q, *, grid: int = 9, tol: float = 1e-9, max_iter: int = 60
             k = np.array(keep)
             dp = np.max(np.abs(p[k] - p[i]), axis=1)
             dr = np.max(np.abs(R[k] - R[i]), axis=(1, 2))
-            if np.any((dp < 1e-6 * mech.scale) & (dr < 1e-6)):
+            if np.any((dp < TOL.mode_duplicate_rel * mech.scale) & (dr < TOL.mode_duplicate_rel)):
                 continue
         keep.append(int(i))
     psi, res, branch, pose, p, R = (a[keep] for a in (psi, res, branch, pose, p, R))
     ik = mech.inverse((p, R), stroke=NO_STROKE)
     with np.errstate(invalid="ignore"):
         err = np.max(np.abs(ik.q - q), axis=1) if pose.size else np.zeros(0)
-    physical = np.isfinite(err) & (err < 1e-6)
+    physical = np.isfinite(err) & (err < TOL.working_mode_mm)
     rank = np.lexsort((mech._pose_distance(p, R) if pose.size else np.zeros(0), ~physical))
     return ReducedDPAResult(psi=psi[rank], branch=branch[rank], residual=res[rank],
                             pose=pose[rank], physical=physical[rank], ik_error=err[rank])

@@ -53,6 +53,7 @@ from ...errors import ParameterError
 from ...poses import as_frames
 from ...quantities import AngleWindow, Branches, Directions, LinkLengths
 from ...specbase import PairedCircles, _Common
+from ...tolerances import TOL
 from ..base import NO_STROKE, Mechanism, as_points, as_positive, as_vector3
 from ..joints import DEFAULT_FIELDS, ParamField, kind_arrays, kind_template, platform_joints
 from ..kernels import ik as _kernels
@@ -189,7 +190,7 @@ def _unit_rows(value, field: str) -> np.ndarray:
     if arr.shape != (6, 3) or not np.all(np.isfinite(arr)):
         raise ParameterError(field, "an array of shape (6, 3) of directions", arr.shape)
     n = np.linalg.norm(arr, axis=1)
-    if np.any(n < 1e-9):
+    if np.any(n < TOL.direction_norm):
         raise ParameterError(field, "non-zero directions", arr.tolist())
     out = unit_rows(arr)
     out.setflags(write=False)
@@ -299,7 +300,7 @@ class RSS6(Mechanism):
         n = _unit_rows(self.servo_axes, "servo_axes")
         u = _unit_rows(self.zero_directions, "zero_directions")
         u = without_component(u, n)                               # Gram-Schmidt
-        if np.any(np.linalg.norm(u, axis=1) < 1e-6):
+        if np.any(np.linalg.norm(u, axis=1) < TOL.perpendicular_rel):
             raise ParameterError("zero_directions", "directions not parallel to the servo axes",
                                  self.zero_directions)
         u = unit_rows(u)

@@ -63,6 +63,7 @@ from numba.extending import register_jitable
 
 from ...errors import ParameterError
 from ...poses import euler_to_matrix
+from ...tolerances import TOL
 from .. import joints
 from ..base import NO_STROKE, Mechanism, as_points, as_stroke, as_vector3
 from ..kernels import ik as _kernels
@@ -189,7 +190,7 @@ def _directions(value, field: str, need: np.ndarray) -> np.ndarray:
     if arr.shape != (6, 3) or not np.all(np.isfinite(arr)):
         raise ParameterError(field, "an array of shape (6, 3) of directions", arr.shape)
     n = np.linalg.norm(arr, axis=1)
-    bad = need & (n < 1e-9)
+    bad = need & (n < TOL.direction_norm)
     if np.any(bad):
         i = int(np.argmax(bad))
         raise ParameterError(f"legs[{i + 1}].{field}", "a non-zero direction", arr[i].tolist())
@@ -280,8 +281,8 @@ class SixLeg(Mechanism):
         u = _directions(self.zero_directions, "zero_direction", crank)
         u = without_component(u, self.axes)                                  # Gram-Schmidt
         nu = np.linalg.norm(u, axis=1)
-        if np.any(crank & (nu < 1e-6)):
-            i = int(np.argmax(crank & (nu < 1e-6)))
+        if np.any(crank & (nu < TOL.perpendicular_rel)):
+            i = int(np.argmax(crank & (nu < TOL.perpendicular_rel)))
             raise ParameterError(f"legs[{i + 1}].zero_direction", "a direction not parallel "
                                  "to the servo axis", self.zero_directions[i])
         set_(self, "zero_directions", np.where(crank[:, None], unit_rows(u), 0.0))

@@ -26,6 +26,7 @@ import math
 import numpy as np
 
 from ...errors import ParameterError
+from ...tolerances import TOL
 from ..legs.layout import build_paired
 from .psu6 import PSU6, _radii
 from .rss6 import RSS6
@@ -49,7 +50,8 @@ def rail_axes(base_points: np.ndarray, inclination: float, heading: str,
     if heading == "parallel":
         sx = np.sign(B[:, 0])
         if pair_angles is not None:
-            sx = np.where(np.abs(B[:, 0]) < 1e-9, np.sign(np.cos(pair_angles)), sx)
+            sx = np.where(np.abs(B[:, 0]) < TOL.direction_norm, np.sign(np.cos(pair_angles)),
+                          sx)
         sx = np.where(sx == 0, 1.0, sx)
         h = np.stack([sx, np.zeros(6), np.zeros(6)], axis=1)
     else:
@@ -57,7 +59,7 @@ def rail_axes(base_points: np.ndarray, inclination: float, heading: str,
         h = np.stack([np.cos(ang), np.sin(ang), np.zeros(6)], axis=1)
         h = h if heading == "outward" else -h
     e = math.cos(inclination) * h + math.sin(inclination) * np.array([0.0, 0.0, 1.0])
-    e[np.abs(e) < 1e-15] = 0.0
+    e[np.abs(e) < 1e-15] = 0.0        # algorithm constant: clear round-off of cos/sin
     return e / np.linalg.norm(e, axis=1, keepdims=True)
 
 

@@ -98,6 +98,7 @@ def equal_leg_base_angle(base_radii, platform_radii, platform_rotation, base_pai
 
     grid = np.linspace(-np.pi, np.pi, 1441)
     vals = gap(grid)
+    # algorithm constant: roots to round-off
     roots = [bracketed_root(gap, grid[i], grid[i + 1], xtol=1e-14)
              for i in range(len(grid) - 1) if vals[i] == 0 or vals[i] * vals[i + 1] < 0]
     if not roots:

@@ -147,6 +147,7 @@ def _corners(C0, H0):
     signs = np.array(np.meshgrid(*[(-1.0, 1.0)] * 3, indexing="ij")).reshape(3, -1).T
     V = np.unique(np.round((C0[:, None, :] + signs[None] * H0[:, None, :]).reshape(-1, 3),
                            12), axis=0)
+    # algorithm constant: the vertices were rounded to 12 decimals just above
     return V[~np.any(np.all(np.abs(V[:, None, :] - C0[None]) < 1e-12, axis=2), axis=1)]
 
 
