@@ -56,7 +56,8 @@ import numpy as np
 from ..errors import ParameterError
 
 __all__ = ["Joint", "Link", "Leg", "LegTemplate", "JointArrays", "Parameters", "ParamField",
-           "JointsMixin", "build_legs", "joint_segments", "hinge_axis", "chain_errors",
+           "JointsMixin", "build_legs", "joint_segments", "link_segments_of",
+           "base_joint_axes_of", "chain_points", "hinge_axis", "chain_errors",
            "kind_template", "kind_arrays", "platform_joints", "KIND_CHAINS"]
 
 JOINT_TYPES = ("R", "P", "U", "S")
@@ -249,8 +250,11 @@ def build_legs(mech, pose=None) -> tuple[Leg, ...]:
 
 def joint_segments(mech, p: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``leg_segments`` from the joints: each leg's ``segment`` joint centres ``(N, L, 3)``."""
-    centre = mech._joint_arrays(p, R, axes=False).centre
-    seg = np.array([t.segment for t in mech._leg_templates()])
+    return _segments(mech._joint_arrays(p, R, axes=False).centre, mech._leg_templates())
+
+
+def _segments(centre, templates) -> tuple[np.ndarray, np.ndarray]:
+    seg = np.array([t.segment for t in templates])
     out = []
     for k in (0, 1):
         if np.all(seg[:, k] == seg[0, k]):
@@ -259,6 +263,63 @@ def joint_segments(mech, p: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.n
             x = np.choose(seg[:, k][None, :, None], centre)
         out.append(x if x.flags.writeable else x.copy())
     return tuple(out)
+
+
+def link_segments_of(mech, p: np.ndarray, R: np.ndarray):
+    """``link_segments`` from the joints: each leg's links of positive length on the base
+    side of its ``segment`` (a crank: pivot → crank end), legs in order, then every leg's
+    ``segment``; ``(start, end)`` each ``(N, S, 3)`` and ``leg (S,)``. Links on the platform
+    side of the segment (luzi3's shared upper links) are not interference segments."""
+    centre = mech._joint_arrays(p, R, axes=False).centre
+    templates = mech._leg_templates()
+    start, end = _segments(centre, templates)
+    extra = [(i, k) for i, t in enumerate(templates) for k in range(t.segment[0])
+             if t.lengths[k] > 0.0]
+    if not extra:
+        return start, end, np.arange(start.shape[1])
+    shape = (len(p), 3)
+    a = [np.broadcast_to(centre[k][:, i], shape) for i, k in extra]
+    b = [np.broadcast_to(templates[i].zero, shape) if templates[i].types[k + 1] == "P"
+         else np.broadcast_to(centre[k + 1][:, i], shape) for i, k in extra]   # P: its zero
+    leg = np.array([i for i, _ in extra] + list(range(start.shape[1])))
+    return (np.concatenate([np.stack(a, axis=1), start], axis=1),
+            np.concatenate([np.stack(b, axis=1), end], axis=1), leg)
+
+
+def base_joint_axes_of(mech, p: np.ndarray, R: np.ndarray, axes) -> np.ndarray:
+    """``base_joint_axes`` from the joints: the mounting axis (given at the nominal pose) of a
+    leg's ``segment`` base-side joint is fixed in the body that carries it; when that body is
+    turned by the leg's actuated R joint (a crank), the axis turns with it about the R axis
+    by ``q − q_nominal`` (Rodrigues); otherwise it is fixed to the base."""
+    axes = np.asarray(axes, dtype=float)
+    out = np.array(np.broadcast_to(axes, (len(p), *axes.shape)))
+    templates = mech._leg_templates()
+    turned = np.array([i for i, t in enumerate(templates)
+                       if t.segment[0] > 0 and t.actuated == t.segment[0] - 1
+                       and t.types[t.actuated] == "R"], dtype=int)
+    if not len(turned):
+        return out
+    act = np.array([templates[i].actuated for i in turned])
+    now = mech._joint_arrays(p, R)
+    q0 = mech._joint_arrays(*mech._frames(mech.nominal_pose)).q[0]
+    n = now.axes[:, turned, act, 0]                                      # (N, T, 3)
+    d = (now.q[:, turned] - q0[turned])[..., None]
+    a = out[:, turned]
+    out[:, turned] = (a * np.cos(d) + np.cross(n, a) * np.sin(d)
+                      + n * np.sum(n * a, axis=-1, keepdims=True) * (1.0 - np.cos(d)))
+    return out
+
+
+def chain_points(leg: Leg) -> np.ndarray:
+    """``(K, 3)`` the points a leg's chain passes through, base to platform: each joint's
+    ``location``, a P joint's ``zero`` then its ``location`` (its travel is part of the
+    chain). Consecutive points are joined by a link or a P joint's travel."""
+    pts = []
+    for j in leg.joints:
+        if j.type == "P":
+            pts.append(j.zero)
+        pts.append(j.location)
+    return np.array(pts, dtype=float)
 
 
 def coordinate(joint: Joint, following: Joint) -> float:
