@@ -112,7 +112,7 @@ def test_joint_markers_by_type_actuated_apart_and_outlines(name):
         want = sum(j.type == kind and not j.actuated for j in joints)
         have = [t for t in traces if t.name == label]
         assert (len(have[0].x) if have else 0) == want, kind
-    act = _trace(traces, "actuated joints")
+    act = _trace(traces, "actuators (actuated joints)")
     assert len(act.x) == m.n_actuators
     assert list(act.marker.symbol) == [{"S": "circle", "U": "diamond", "R": "square",
                                         "P": "cross"}[leg.actuated.type] for leg in m.legs()]

@@ -176,7 +176,8 @@ def mechanism_traces(mech, name: str = "", colour: str = "#333333", visible=True
     js = [j for j in d.joints if j.actuated]
     P = np.array([j.point for j in js])
     traces.append(go.Scatter3d(
-        x=P[:, 0], y=P[:, 1], z=P[:, 2], mode="markers", name=f"{label}actuated joints",
+        x=P[:, 0], y=P[:, 1], z=P[:, 2], mode="markers",
+        name=f"{label}actuators (actuated joints)",
         marker=dict(size=6, color=ACTUATOR, symbol=[JOINT_STYLE[j.type][0] for j in js],
                     line=dict(width=1, color="#000000")),
         hovertext=[j.text for j in js], hovertemplate="%{hovertext}<extra></extra>", **kw))
