@@ -253,7 +253,7 @@ def joint_segments(mech, p: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.n
     return _segments(mech._joint_arrays(p, R, axes=False).centre, mech._leg_templates())
 
 
-def _segments(centre, templates) -> tuple[np.ndarray, np.ndarray]:
+def _segments(centre, templates, copy: bool = True) -> tuple[np.ndarray, np.ndarray]:
     seg = np.array([t.segment for t in templates])
     out = []
     for k in (0, 1):
@@ -261,7 +261,7 @@ def _segments(centre, templates) -> tuple[np.ndarray, np.ndarray]:
             x = centre[seg[0, k]]
         else:                                   # legs of different kinds (sixleg)
             x = np.choose(seg[:, k][None, :, None], centre)
-        out.append(x if x.flags.writeable else x.copy())
+        out.append(x.copy() if copy and not x.flags.writeable else x)
     return tuple(out)
 
 
@@ -272,18 +272,28 @@ def link_segments_of(mech, p: np.ndarray, R: np.ndarray):
     side of the segment (luzi3's shared upper links) are not interference segments."""
     centre = mech._joint_arrays(p, R, axes=False).centre
     templates = mech._leg_templates()
-    start, end = _segments(centre, templates)
+    start, end = _segments(centre, templates, copy=False)
     extra = [(i, k) for i, t in enumerate(templates) for k in range(t.segment[0])
              if t.lengths[k] > 0.0]
     if not extra:
-        return start, end, np.arange(start.shape[1])
-    shape = (len(p), 3)
-    a = [np.broadcast_to(centre[k][:, i], shape) for i, k in extra]
-    b = [np.broadcast_to(templates[i].zero, shape) if templates[i].types[k + 1] == "P"
-         else np.broadcast_to(centre[k + 1][:, i], shape) for i, k in extra]   # P: its zero
-    leg = np.array([i for i, _ in extra] + list(range(start.shape[1])))
-    return (np.concatenate([np.stack(a, axis=1), start], axis=1),
-            np.concatenate([np.stack(b, axis=1), end], axis=1), leg)
+        return (*(x if x.flags.writeable else x.copy() for x in (start, end)),
+                np.arange(start.shape[1]))
+    idx = [i for i, _ in extra]
+    ks = {k for _, k in extra}
+    if len(ks) == 1 and all(templates[i].types[k + 1] != "P" for i, k in extra):
+        k = ks.pop()                            # one link a leg at the same place (cranks)
+        every = idx == list(range(start.shape[1]))
+        a, b = (centre[k], centre[k + 1]) if every else (centre[k][:, idx],
+                                                          centre[k + 1][:, idx])
+    else:
+        shape = (len(p), 3)
+        a = np.stack([np.broadcast_to(centre[k][:, i], shape) for i, k in extra], axis=1)
+        b = np.stack([np.broadcast_to(templates[i].zero, shape)          # P: its zero
+                      if templates[i].types[k + 1] == "P"
+                      else np.broadcast_to(centre[k + 1][:, i], shape) for i, k in extra],
+                     axis=1)
+    leg = np.array(idx + list(range(start.shape[1])))
+    return np.concatenate([a, start], axis=1), np.concatenate([b, end], axis=1), leg
 
 
 def base_joint_axes_of(mech, p: np.ndarray, R: np.ndarray, axes) -> np.ndarray:
@@ -299,11 +309,14 @@ def base_joint_axes_of(mech, p: np.ndarray, R: np.ndarray, axes) -> np.ndarray:
                        and t.types[t.actuated] == "R"], dtype=int)
     if not len(turned):
         return out
-    act = np.array([templates[i].actuated for i in turned])
-    now = mech._joint_arrays(p, R)
-    q0 = mech._joint_arrays(*mech._frames(mech.nominal_pose)).q[0]
-    n = now.axes[:, turned, act, 0]                                      # (N, T, 3)
-    d = (now.q[:, turned] - q0[turned])[..., None]
+    legs0 = mech.legs()                         # the nominal pose
+    q = mech.inverse((p, R), stroke=(-np.inf, np.inf)).q
+    d = (q[:, turned] - np.array([legs0[i].value for i in turned]))[..., None]
+    if all(legs0[i].actuated.parent == "base" for i in turned):   # axes fixed in the base
+        n = np.array([legs0[i].actuated.axes[0] for i in turned])[None]
+    else:
+        act = np.array([templates[i].actuated for i in turned])
+        n = mech._joint_arrays(p, R).axes[:, turned, act, 0]                # (N, T, 3)
     a = out[:, turned]
     out[:, turned] = (a * np.cos(d) + np.cross(n, a) * np.sin(d)
                       + n * np.sum(n * a, axis=-1, keepdims=True) * (1.0 - np.cos(d)))

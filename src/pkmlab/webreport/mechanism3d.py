@@ -170,7 +170,7 @@ def mechanism_traces(mech, name: str = "", colour: str = "#333333", visible=True
             P = np.array([j.point for j in js])
             traces.append(go.Scatter3d(
                 x=P[:, 0], y=P[:, 1], z=P[:, 2], mode="markers", name=f"{label}{part}",
-                marker=dict(size=3.5, color=JOINT, symbol=symbol),
+                marker=dict(size=4.5, color=JOINT, symbol=symbol),
                 hovertext=[j.text for j in js], hovertemplate="%{hovertext}<extra></extra>",
                 **kw))
     js = [j for j in d.joints if j.actuated]
