@@ -194,3 +194,25 @@ def test_lower_mobility_and_overlay_scenes():
     assert _has_segment(_pieces(_trace(fig.data, "b: legs (joint chains)")),
                         RSS6.base_points[0],
                         RSS6.crank_ends(RSS6.inverse(RSS6.nominal_pose).q)[0, 0])
+
+
+def test_sixleg_crank_interference_fails_on_the_crank_as_rss6():
+    """tests/test_rss6_loads.py's machine (servo 1's crank turned towards its partner: a 20 mm
+    link diameter fails on the crank only, rods 26 mm apart) as a ``sixleg``: it fails too."""
+    import math
+
+    from pkmlab.mechanisms import RSS6 as RSS6Family
+    from pkmlab.workspaces.constraints import Constraints, check, segment_distances
+
+    b = RSS6Family.from_circles(crank_plane="tangential", crank_length=40.0, rod_length=160.0,
+                                base_pair_separation=math.radians(20.0))
+    u = b.zero_directions.copy()
+    u[0] = -u[0]
+    r = RSS6Family(b.base_points, b.platform_points, np.cross(u, [0.0, 0.0, 1.0]), u,
+                   b.crank_length, b.rod_length, b.stroke)
+    s = SixLeg.from_mechanism(r)
+    pn, Rn = as_frames(r.nominal_pose)
+    assert segment_distances(*s.leg_segments(pn, Rn))[0].min() > 25.0      # the rods
+    for m in (r, s):
+        assert not check(m, pn, Rn, Constraints(link_diameter=20.0))[0]
+        assert check(m, pn, Rn, Constraints(link_diameter=15.0))[0]
