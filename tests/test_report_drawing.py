@@ -216,3 +216,16 @@ def test_sixleg_crank_interference_fails_on_the_crank_as_rss6():
     for m in (r, s):
         assert not check(m, pn, Rn, Constraints(link_diameter=20.0))[0]
         assert check(m, pn, Rn, Constraints(link_diameter=15.0))[0]
+
+
+@pytest.mark.parametrize("name", ["instructables-servo-6rss", "hopkins-williams-6psu"])
+def test_actuated_hover_gives_the_value_in_degrees_or_mm(name):
+    """A servo's angle in degrees, a slider's position in mm (the IK's value at a random
+    valid pose, to the two decimals shown)."""
+    m = MECHANISMS[name]
+    x = testing.random_valid_poses(m, 1, seed=8)[0]
+    q = m.inverse(x).q[0]
+    act = _trace(mechanism_traces(m, pose=x), "actuators (actuated joints)")
+    for text, n, v in zip(act.hovertext, m.actuator_names, q, strict=True):
+        shown = f"{np.degrees(v):.2f}°" if m.actuator_unit == "rad" else f"{v:.2f} mm"
+        assert abs(v) > 1e-2 and f"{n} = {shown}" in text, text

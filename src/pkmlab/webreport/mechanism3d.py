@@ -78,12 +78,18 @@ def outline(points: np.ndarray) -> np.ndarray:
     return np.vstack([P, P[:1]])
 
 
+def _num(v: float, digits: int) -> str:
+    """``v`` to ``digits`` decimals, never ``-0.0``."""
+    text = f"{v:.{digits}f}"
+    return text.lstrip("-") if float(text) == 0.0 else text
+
+
 def _value_text(mech, name: str, q: float) -> str:
     lo, hi = mech.stroke
     if mech.actuator_unit == "rad":
-        return (f"{name} = {math.degrees(q):.2f}° (window {math.degrees(lo):g} … "
+        return (f"{name} = {_num(math.degrees(q), 2)}° (window {math.degrees(lo):g} … "
                 f"{math.degrees(hi):g}°)")
-    return f"{name} = {q:.2f} mm (window {lo:g} … {hi:g} mm)"
+    return f"{name} = {_num(q, 2)} mm (window {lo:g} … {hi:g} mm)"
 
 
 def drawing(mech, pose=None) -> Drawing:
@@ -100,7 +106,7 @@ def drawing(mech, pose=None) -> Drawing:
         fixed.append(first.zero if first.type == "P" else first.location)
         for j in leg.joints:
             at = 0.5 * (j.zero + j.location) if j.type == "P" else j.location
-            where = "({:.1f}, {:.1f}, {:.1f}) mm".format(*j.location)
+            where = "(" + ", ".join(_num(v, 1) for v in j.location) + ") mm"
             text = f"{j.name}: {j.type} joint at {where}"
             if j.actuated:
                 text = f"{text}<br>actuated: {_value_text(mech, leg.name, leg.value)}"
