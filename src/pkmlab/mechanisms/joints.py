@@ -23,8 +23,10 @@ base frame (mm) at that pose. Conventions:
 * link ``k`` of a leg joins joint ``k`` and joint ``k + 1``: its ``length`` is the fixed
   distance from joint ``k``'s location to joint ``k + 1``'s location (its ``zero`` when it is
   a P joint);
-* ``segment``: the joints whose centres bound the leg's moving link as ``leg_segments`` draws
-  it and checks it for interference.
+* ``segment``: the joints whose centres bound the leg's moving link as ``leg_segments`` gives
+  it (interference, joint cones, singularity checks; ``link_segments`` adds the positive-length
+  links on its base side, the cranks: :func:`link_segments_of`). The report draws the whole
+  chain (:func:`chain_points`, :mod:`pkmlab.webreport.mechanism3d`).
 
 A family provides ``_joint_arrays(p, R, axes=True)`` (:class:`JointArrays`: all the legs'
 joint centres and, with ``axes``, axes over N poses, vectorised) and ``_leg_templates()`` (one
