@@ -37,10 +37,10 @@ method whose name starts with ``_``):
   (:func:`pkmlab.testing.check_parameters`);
 * ``leg_segments(p, R)`` — each leg's moving link, for interference and drawing, read from
   the joints (each leg's ``segment``); ``link_segments(p, R)`` — every moving link with the
-  leg it belongs to (default: the ``leg_segments``; 6-RSS: cranks and rods, from the joints),
-  for interference; ``base_joint_axes(p, R, axes)``
-  — the mounting axes of the base-side passive joints at each pose (default: fixed; 6-RSS:
-  turned with the crank that carries the joint), for joint cones;
+  leg it belongs to (from the joints: the ``leg_segments`` and the cranks), for interference;
+  ``base_joint_axes(p, R, axes)`` — the mounting axes of the base-side passive joints at each
+  pose (from the joints: fixed, or turned with the crank that carries the joint), for joint
+  cones;
 * workspace hooks: ``position_bounds(R)``, and for families with exact column intervals
   ``column_method``, ``column_leg``, ``column_params()``, ``leg_offsets(R)`` and
   ``column_intervals(xs, ys, R, mode)`` (and ``column_radial`` when the leg intervals are
@@ -94,7 +94,7 @@ from ..errors import ParameterError
 from ..poses import POSE_SIZE, as_frames, log_so3
 from ..runtime.threads import threads_for
 from ..tolerances import TOL
-from .joints import JointsMixin
+from .joints import JointsMixin, base_joint_axes_of, link_segments_of
 from .kernels import columns as column_kernels
 from .kernels import ik as _kernels
 from .kernels import tiles as _tiles
@@ -259,15 +259,17 @@ class Mechanism(JointsMixin):
     def link_segments(self, p: np.ndarray, R: np.ndarray):
         """``(start, end, leg)``: end points ``(N, S, 3)`` of every moving link and the leg
         ``(S,)`` each belongs to; links of one leg share joints, so interference is checked
-        between links of different legs only. Default: the ``leg_segments``."""
-        start, end = self.leg_segments(p, R)
-        return start, end, np.arange(start.shape[1])
+        between links of different legs only. Read from the joints
+        (:func:`.joints.link_segments_of`): the ``leg_segments`` and, before them, every
+        leg's links of positive length on the base side of its segment (cranks)."""
+        return link_segments_of(self, p, R)
 
     def base_joint_axes(self, p: np.ndarray, R: np.ndarray, axes: np.ndarray) -> np.ndarray:
         """``(N, L, 3)`` base-frame mounting axes of the base-side passive joints at the poses,
-        given ``axes (L, 3)`` at the nominal pose. Default: the joints are fixed to the base."""
-        axes = np.asarray(axes, dtype=float)
-        return np.broadcast_to(axes, (len(p), *axes.shape))
+        given ``axes (L, 3)`` at the nominal pose, read from the joints
+        (:func:`.joints.base_joint_axes_of`): fixed to the base, or turned with the crank
+        that carries the joint."""
+        return base_joint_axes_of(self, p, R, axes)
 
     def _gparams(self) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError

@@ -23,8 +23,10 @@ base frame (mm) at that pose. Conventions:
 * link ``k`` of a leg joins joint ``k`` and joint ``k + 1``: its ``length`` is the fixed
   distance from joint ``k``'s location to joint ``k + 1``'s location (its ``zero`` when it is
   a P joint);
-* ``segment``: the joints whose centres bound the leg's moving link as ``leg_segments`` draws
-  it and checks it for interference.
+* ``segment``: the joints whose centres bound the leg's moving link as ``leg_segments`` gives
+  it (interference, joint cones, singularity checks; ``link_segments`` adds the positive-length
+  links on its base side, the cranks: :func:`link_segments_of`). The report draws the whole
+  chain (:func:`chain_points`, :mod:`pkmlab.webreport.mechanism3d`).
 
 A family provides ``_joint_arrays(p, R, axes=True)`` (:class:`JointArrays`: all the legs'
 joint centres and, with ``axes``, axes over N poses, vectorised) and ``_leg_templates()`` (one
@@ -57,7 +59,8 @@ from ..errors import ParameterError
 from ..tolerances import TOL
 
 __all__ = ["Joint", "Link", "Leg", "LegTemplate", "JointArrays", "Parameters", "ParamField",
-           "JointsMixin", "build_legs", "joint_segments", "hinge_axis", "chain_errors",
+           "JointsMixin", "build_legs", "joint_segments", "link_segments_of",
+           "base_joint_axes_of", "chain_points", "hinge_axis", "chain_errors",
            "kind_template", "kind_arrays", "platform_joints", "KIND_CHAINS"]
 
 JOINT_TYPES = ("R", "P", "U", "S")
@@ -251,16 +254,89 @@ def build_legs(mech, pose=None) -> tuple[Leg, ...]:
 
 def joint_segments(mech, p: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``leg_segments`` from the joints: each leg's ``segment`` joint centres ``(N, L, 3)``."""
-    centre = mech._joint_arrays(p, R, axes=False).centre
-    seg = np.array([t.segment for t in mech._leg_templates()])
+    return _segments(mech._joint_arrays(p, R, axes=False).centre, mech._leg_templates())
+
+
+def _segments(centre, templates, copy: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    seg = np.array([t.segment for t in templates])
     out = []
     for k in (0, 1):
         if np.all(seg[:, k] == seg[0, k]):
             x = centre[seg[0, k]]
         else:                                   # legs of different kinds (sixleg)
             x = np.choose(seg[:, k][None, :, None], centre)
-        out.append(x if x.flags.writeable else x.copy())
+        out.append(x.copy() if copy and not x.flags.writeable else x)
     return tuple(out)
+
+
+def link_segments_of(mech, p: np.ndarray, R: np.ndarray):
+    """``link_segments`` from the joints: each leg's links of positive length on the base
+    side of its ``segment`` (a crank: pivot → crank end), legs in order, then every leg's
+    ``segment``; ``(start, end)`` each ``(N, S, 3)`` and ``leg (S,)``. Links on the platform
+    side of the segment (luzi3's shared upper links) are not interference segments."""
+    centre = mech._joint_arrays(p, R, axes=False).centre
+    templates = mech._leg_templates()
+    start, end = _segments(centre, templates, copy=False)
+    extra = [(i, k) for i, t in enumerate(templates) for k in range(t.segment[0])
+             if t.lengths[k] > 0.0]
+    if not extra:
+        return (*(x if x.flags.writeable else x.copy() for x in (start, end)),
+                np.arange(start.shape[1]))
+    idx = [i for i, _ in extra]
+    ks = {k for _, k in extra}
+    if len(ks) == 1 and all(templates[i].types[k + 1] != "P" for i, k in extra):
+        k = ks.pop()                            # one link a leg at the same place (cranks)
+        every = idx == list(range(start.shape[1]))
+        a, b = (centre[k], centre[k + 1]) if every else (centre[k][:, idx],
+                                                          centre[k + 1][:, idx])
+    else:
+        shape = (len(p), 3)
+        a = np.stack([np.broadcast_to(centre[k][:, i], shape) for i, k in extra], axis=1)
+        b = np.stack([np.broadcast_to(templates[i].zero, shape)          # P: its zero
+                      if templates[i].types[k + 1] == "P"
+                      else np.broadcast_to(centre[k + 1][:, i], shape) for i, k in extra],
+                     axis=1)
+    leg = np.array(idx + list(range(start.shape[1])))
+    return np.concatenate([a, start], axis=1), np.concatenate([b, end], axis=1), leg
+
+
+def base_joint_axes_of(mech, p: np.ndarray, R: np.ndarray, axes) -> np.ndarray:
+    """``base_joint_axes`` from the joints: the mounting axis (given at the nominal pose) of a
+    leg's ``segment`` base-side joint is fixed in the body that carries it; when that body is
+    turned by the leg's actuated R joint (a crank), the axis turns with it about the R axis
+    by ``q − q_nominal`` (Rodrigues); otherwise it is fixed to the base."""
+    axes = np.asarray(axes, dtype=float)
+    out = np.array(np.broadcast_to(axes, (len(p), *axes.shape)))
+    templates = mech._leg_templates()
+    turned = np.array([i for i, t in enumerate(templates)
+                       if t.segment[0] > 0 and t.actuated == t.segment[0] - 1
+                       and t.types[t.actuated] == "R"], dtype=int)
+    if not len(turned):
+        return out
+    legs0 = mech.legs()                         # the nominal pose
+    q = mech.inverse((p, R), stroke=(-np.inf, np.inf)).q
+    d = (q[:, turned] - np.array([legs0[i].value for i in turned]))[..., None]
+    if all(legs0[i].actuated.parent == "base" for i in turned):   # axes fixed in the base
+        n = np.array([legs0[i].actuated.axes[0] for i in turned])[None]
+    else:
+        act = np.array([templates[i].actuated for i in turned])
+        n = mech._joint_arrays(p, R).axes[:, turned, act, 0]                # (N, T, 3)
+    a = out[:, turned]
+    out[:, turned] = (a * np.cos(d) + np.cross(n, a) * np.sin(d)
+                      + n * np.sum(n * a, axis=-1, keepdims=True) * (1.0 - np.cos(d)))
+    return out
+
+
+def chain_points(leg: Leg) -> np.ndarray:
+    """``(K, 3)`` the points a leg's chain passes through, base to platform: each joint's
+    ``location``, a P joint's ``zero`` then its ``location`` (its travel is part of the
+    chain). Consecutive points are joined by a link or a P joint's travel."""
+    pts = []
+    for j in leg.joints:
+        if j.type == "P":
+            pts.append(j.zero)
+        pts.append(j.location)
+    return np.array(pts, dtype=float)
 
 
 def coordinate(joint: Joint, following: Joint) -> float:

@@ -1,6 +1,7 @@
 """The report's interactive charts, built with plotly (rendered offline by the embedded
 plotly.js): the Pareto scatter matrix and parallel coordinates, and 3-D scenes of workspace
-hulls with the mechanism drawn at its nominal pose.
+hulls with the mechanism drawn at its nominal pose from its declared joints
+(:mod:`.mechanism3d`).
 
 Every point of the Pareto charts carries its candidate's ``seq`` as ``customdata``: the page
 opens that candidate's card when it is clicked.
@@ -9,6 +10,8 @@ opens that candidate's card when it is clicked.
 from __future__ import annotations
 
 import numpy as np
+
+from .mechanism3d import mechanism_traces
 
 __all__ = ["pareto_matrix", "pareto_parcoords", "mechanism_traces", "hull_trace",
            "design_scene", "overlay_scene", "PALETTE"]
@@ -112,88 +115,6 @@ def pareto_parcoords(axes: list[dict], rows: list[dict]):
         line=dict(color=colour, colorscale=[[0, "#9ecae1"], [1, "#d62728"]], cmin=0, cmax=1)))
     fig.update_layout(**_layout(height=380, margin=dict(l=150, r=150, t=80, b=30)))
     return fig
-
-
-def _loop(P: np.ndarray) -> np.ndarray:
-    """Points in angular order about their centroid, closed."""
-    c = P.mean(axis=0)
-    order = np.argsort(np.arctan2(P[:, 1] - c[1], P[:, 0] - c[0]))
-    P = P[order]
-    return np.vstack([P, P[:1]])
-
-
-def _segments(starts: np.ndarray, ends: np.ndarray):
-    """Line segments as one polyline broken by ``None``."""
-    xs, ys, zs = [], [], []
-    for a, b in zip(starts, ends):
-        xs += [float(a[0]), float(b[0]), None]
-        ys += [float(a[1]), float(b[1]), None]
-        zs += [float(a[2]), float(b[2]), None]
-    return xs, ys, zs
-
-
-def mechanism_traces(mech, name: str = "", colour: str = "#333333", visible=True,
-                     grouped: bool = False) -> list:
-    """The mechanism at its nominal pose: base, platform, legs, actuators (plotly traces).
-
-    ``grouped``: one legend entry for the whole mechanism (``name: mechanism``), which shows
-    or hides it at once; otherwise one entry per part."""
-    import plotly.graph_objects as go
-
-    from ..poses import as_frames
-
-    pose = mech.nominal_pose
-    p, R = as_frames(pose[None, :])
-    q = mech.inverse((p, R)).q[0]
-    starts, ends = (a[0] for a in mech.leg_segments(p, R))
-    label = f"{name}: " if name else ""
-    kw: dict = dict(visible=visible)
-    if grouped:
-        kw["legendgroup"] = f"mech-{name}"
-    traces = []
-    base = _loop(np.asarray(mech.base_points))
-    traces.append(go.Scatter3d(x=base[:, 0], y=base[:, 1], z=base[:, 2], mode="lines",
-                               line=dict(color="#7f7f7f", width=6), name=f"{label}base",
-                               hoverinfo="name", **kw))
-    W = p[0] + np.asarray(mech.tool_points) @ R[0].T
-    plat = _loop(W)
-    traces.append(go.Scatter3d(x=plat[:, 0], y=plat[:, 1], z=plat[:, 2], mode="lines",
-                               line=dict(color=colour, width=8),
-                               name=f"{label}platform (nominal pose)", hoverinfo="name",
-                               **kw))
-    if mech.family == "psu6":       # vertical rails: the sliders' travel
-        lo, hi = mech.stroke
-        b = np.asarray(mech.base_points)
-        x, y, z = _segments(b + [0, 0, lo], b + [0, 0, hi])
-        traces.append(go.Scatter3d(x=x, y=y, z=z, mode="lines",
-                                   line=dict(color="#bbbbbb", width=4),
-                                   name=f"{label}actuator rails", hoverinfo="name", **kw))
-    if mech.family == "luzi3":      # the upper links joining each chain's two legs
-        x, y, z = _segments(ends[0::2], ends[1::2])
-        traces.append(go.Scatter3d(x=x, y=y, z=z, mode="lines",
-                                   line=dict(color=colour, width=6),
-                                   name=f"{label}upper links", hoverinfo="name", **kw))
-    x, y, z = _segments(starts, ends)
-    traces.append(go.Scatter3d(x=x, y=y, z=z, mode="lines", line=dict(color="#E69F00", width=5),
-                               name=f"{label}legs", hoverinfo="name", **kw))
-    names = mech.actuator_names
-    hover = [f"{n} = {v:.2f} mm (stroke {mech.stroke[0]:g} … {mech.stroke[1]:g})"
-             for n, v in zip(names, q)]
-    traces.append(go.Scatter3d(x=starts[:, 0], y=starts[:, 1], z=starts[:, 2],
-                               mode="markers", marker=dict(size=4, color="#D55E00"),
-                               name=f"{label}actuators", hovertext=hover,
-                               hovertemplate="%{hovertext}<extra></extra>", **kw))
-    traces.append(go.Scatter3d(x=[float(p[0, 0])], y=[float(p[0, 1])], z=[float(p[0, 2])],
-                               mode="markers", marker=dict(size=5, color="#000000",
-                                                           symbol="diamond"),
-                               name=f"{label}tool point", hovertemplate=(
-                                   "tool point (%{x:.1f}, %{y:.1f}, %{z:.1f}) mm"
-                                   "<extra></extra>"), **kw))
-    if grouped:
-        for i, t in enumerate(traces):
-            t.update(showlegend=i == 0, name=f"{label}mechanism (nominal pose)" if i == 0
-                     else t.name)
-    return traces
 
 
 def hull_trace(vertices: np.ndarray, faces: np.ndarray, intensity=None, *, label: str = "",

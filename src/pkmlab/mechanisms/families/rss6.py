@@ -34,8 +34,8 @@ Workspace: exact column method (``column_method = "crank"``): on a column the fe
 of a leg is a union of intervals whose ends are roots of a quartic (the real solution appears)
 and of two quadratics (the servo-window edges), see :mod:`._crank`; the set-valued column
 drivers of :mod:`._set_columns` intersect / unite them. :meth:`RSS6.position_bounds` bounds the
-search box. Interference covers the cranks too (:meth:`RSS6.link_segments`), and the
-crank-end ball joints' cones turn with the cranks (:meth:`RSS6.base_joint_axes`).
+search box. Interference covers the cranks too (``link_segments``, read from the joints), and
+the crank-end ball joints' cones turn with the cranks (``base_joint_axes``, from the joints).
 """
 
 from __future__ import annotations
@@ -50,7 +50,6 @@ from numba.extending import register_jitable
 from pydantic import Field
 
 from ...errors import ParameterError
-from ...poses import as_frames
 from ...quantities import AngleWindow, Branches, Directions, LinkLengths
 from ...specbase import PairedCircles, _Common
 from ...tolerances import TOL
@@ -523,24 +522,3 @@ class RSS6(Mechanism):
                                    (self.crank_length[i], self.rod_length[i]),
                                    reference=self.zero_directions[i])
                      for i, n in enumerate(self.actuator_names))
-
-    def link_segments(self, p, R):
-        """Cranks (pivot → crank end, segments 0-5) and rods (crank end → platform joint,
-        6-11), with their legs ``[0..5, 0..5]``: interference covers crank/crank, crank/rod
-        and rod/rod of different legs (read from the joints)."""
-        c = self._joint_arrays(p, R, axes=False).centre
-        leg = np.arange(6)
-        return np.concatenate([np.broadcast_to(c[0], c[1].shape), c[1]], axis=1), \
-            np.concatenate([c[1], c[2]], axis=1), np.concatenate([leg, leg])
-
-    def base_joint_axes(self, p, R, axes):
-        """The crank-end ball joints ride on the cranks: their mounting axes, given at the
-        nominal pose, turn with each crank about its servo axis by ``α − α_nominal``."""
-        q = self.inverse((p, R), stroke=NO_STROKE).q                      # (N, 6)
-        pn, Rn = as_frames(self.nominal_pose)
-        d = q - self.inverse((pn, Rn), stroke=NO_STROKE).q                  # (N, 6)
-        n = self.servo_axes
-        a = np.broadcast_to(np.asarray(axes, dtype=float), (len(p), 6, 3))
-        c, s = np.cos(d)[..., None], np.sin(d)[..., None]
-        return (a * c + np.cross(n, a) * s
-                + n * np.sum(n * a, axis=-1, keepdims=True) * (1.0 - c))   # Rodrigues

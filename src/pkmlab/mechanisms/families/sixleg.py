@@ -189,8 +189,7 @@ def _directions(value, field: str, need: np.ndarray) -> np.ndarray:
     arr = np.asarray(value, dtype=float)
     if arr.shape != (6, 3) or not np.all(np.isfinite(arr)):
         raise ParameterError(field, "an array of shape (6, 3) of directions", arr.shape)
-    n = np.linalg.norm(arr, axis=1)
-    bad = need & (n < TOL.direction_norm)
+    bad = need & (np.linalg.norm(arr, axis=1) < TOL.direction_norm)
     if np.any(bad):
         i = int(np.argmax(bad))
         raise ParameterError(f"legs[{i + 1}].{field}", "a non-zero direction", arr[i].tolist())
@@ -280,9 +279,9 @@ class SixLeg(Mechanism):
         set_(self, "axes", _directions(self.axes, "axis", slider | crank))
         u = _directions(self.zero_directions, "zero_direction", crank)
         u = without_component(u, self.axes)                                  # Gram-Schmidt
-        nu = np.linalg.norm(u, axis=1)
-        if np.any(crank & (nu < TOL.perpendicular_rel)):
-            i = int(np.argmax(crank & (nu < TOL.perpendicular_rel)))
+        flat = crank & (np.linalg.norm(u, axis=1) < TOL.perpendicular_rel)
+        if np.any(flat):
+            i = int(np.argmax(flat))
             raise ParameterError(f"legs[{i + 1}].zero_direction", "a direction not parallel "
                                  "to the servo axis", self.zero_directions[i])
         set_(self, "zero_directions", np.where(crank[:, None], unit_rows(u), 0.0))
