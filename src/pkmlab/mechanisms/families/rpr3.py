@@ -271,6 +271,47 @@ class Rpr3(Mechanism):
         A = np.concatenate([s[..., :2], np.cross(r, s)[..., 2:] / self.scale], axis=-1)
         return np.linalg.det(A) / self.scale ** 2
 
+    # ---- planar workspace hooks (:mod:`pkmlab.workspaces.planar`) ----------------------------
+    def position_box(self, phi_lo: float, phi_hi: float) -> tuple[float, float, float, float]:
+        """A box holding every stroke-feasible position: leg i's tool point lies within
+        ``ρ_max + |u_i|`` of its base pivot, whatever φ."""
+        r = self.stroke[1] + np.linalg.norm(self.tool_points[:, :2], axis=1)
+        a = self.base_points[:, :2]
+        return (float(np.max(a[:, 0] - r)), float(np.min(a[:, 0] + r)),
+                float(np.max(a[:, 1] - r)), float(np.min(a[:, 1] + r)))
+
+    def planar_cell_margins(self, xy, phi, delta, alpha):
+        """Stroke margins ``min(ρ_i - ρmin, ρmax - ρ_i)`` at the cell centres and their bound
+        over the cell: a leg length is 1-Lipschitz in the position and moves by at most
+        ``|u_i|·α`` when the platform turns by α (the chord of its pivot's arc)."""
+        X = np.zeros((len(xy), 6))
+        X[:, :2], X[:, 5] = xy, phi
+        q = self.inverse(X, stroke=(-np.inf, np.inf)).q
+        lo, hi = self.stroke
+        m = np.minimum(q - lo, hi - q)
+        u = np.linalg.norm(self.tool_points[:, :2], axis=1)
+        eps = np.asarray(delta)[:, None] + np.asarray(alpha)[:, None] * u[None, :]
+        return m, eps
+
+    def annuli(self, phi: float):
+        """At orientation φ, the stroke-feasible positions are ``∩_i {p : ρmin <= |p - c_i|
+        <= ρmax}`` with ``c_i = a_i - R(φ)·u_i``."""
+        c, s = math.cos(phi), math.sin(phi)
+        u = self.tool_points[:, :2]
+        Ru = np.stack([c * u[:, 0] - s * u[:, 1], s * u[:, 0] + c * u[:, 1]], axis=1)
+        lo, hi = self.stroke
+        return self.base_points[:, :2] - Ru, np.full(3, lo), np.full(3, hi)
+
+    def singular_fields(self, poses) -> dict:
+        """Fields whose zero level is a singularity locus, for drawing: type II, ``det A``."""
+        return {"type II (parallel)": self.parallel_determinant(poses)}
+
+    def singular_points(self, phi: float) -> dict:
+        """Type I loci at orientation φ: the positions where a platform pivot lies on its base
+        pivot (a leg length 0)."""
+        c, _, _ = self.annuli(phi)
+        return {"type I (serial)": c}
+
     # ---- joints ------------------------------------------------------------------------------
     def _joint_arrays(self, p, R, axes=True):
         W = platform_joints(self, p, R)
