@@ -282,17 +282,15 @@ def plot_planar(mech, results, path, *, fields=None, points=None, title=None, nc
     default the family's ``singular_fields``; ``points(phi) -> {label: (K, 2)}`` point loci,
     default ``singular_points``), the area estimate and bracket in each title. Writes ``path``
     (PNG); returns it."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     fields = fields or getattr(mech, "singular_fields", None)
     points = points or getattr(mech, "singular_points", None)
     n = len(results)
     nc = min(ncols, n)
     nr = (n + nc - 1) // nc
-    fig, axes = plt.subplots(nr, nc, figsize=(4.2 * nc, 4.0 * nr), squeeze=False)
+    fig = Figure(figsize=(4.2 * nc, 4.0 * nr))
+    axes = np.asarray(fig.subplots(nr, nc, squeeze=False))
     styles = ("-", "--", ":", "-.")
     colours = ("crimson", "royalblue", "darkorange", "seagreen")
     for ax, res in zip(axes.ravel(), results):
@@ -338,5 +336,4 @@ def plot_planar(mech, results, path, *, fields=None, points=None, title=None, nc
         fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
