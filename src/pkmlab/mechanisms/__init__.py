@@ -23,11 +23,12 @@ from .psu6 import PSU6
 from .rss6 import RSS6
 from .sixleg import SixLeg
 from .ups6 import UPS6
+from .families.fivebar import FiveBar  # noqa: E402  (issue 24; the lead re-registers)
 from .families.rpr3 import Rpr3  # noqa: E402  (issue 24; the lead re-registers at merge)
 
 #: family name → mechanism class (built-in families, then plugins once loaded)
 REGISTRY: dict[str, type[Mechanism]] = {cls.family: cls for cls in (PSU6, UPS6, Luzi3, RSS6,
-                                                                  SixLeg, Rpr3)}
+                                                                  SixLeg, Rpr3, FiveBar)}
 BUILTIN = frozenset(REGISTRY)
 
 #: entry point group of family plugins

@@ -43,7 +43,7 @@ import numpy as np
 from ..errors import ParameterError
 
 __all__ = ["PlanarWorkspace", "planar_workspace", "area_per_phi", "annuli_area",
-           "KINDS", "plot_planar"]
+           "KINDS", "plot_planar", "resolution_map", "areas_per_working_mode"]
 
 KINDS = ("constant", "reachable", "dexterous")
 #: largest (cells × orientation intervals) evaluated per refinement level of the bracket
@@ -237,6 +237,15 @@ def area_per_phi(mech, phis, resolution: float = 5.0, **kw) -> list[PlanarWorksp
     return [planar_workspace(mech, "constant", float(a), resolution, **kw) for a in phis]
 
 
+def areas_per_working_mode(mech, resolution: float = 5.0, **kw) -> dict:
+    """Constant-orientation workspaces of every working mode of a family that has several
+    (``working_modes()``, ``with_working_mode(mode)``: the five-bar): ``{mode: result}``."""
+    modes = mech.working_modes()
+    return {mode: planar_workspace(mech if mode == getattr(mech, "working_mode", None)
+                                   else mech.with_working_mode(mode), "constant", None,
+                                   resolution, **kw) for mode in modes}
+
+
 # ---- exact area of an intersection of annuli ---------------------------------------------------
 def annuli_area(centres, r_in, r_out) -> float:
     """Exact area (mm²) of ``∩_k {p : r_in[k] <= |p - c_k| <= r_out[k]}``, by Green's theorem
@@ -274,14 +283,47 @@ def annuli_area(centres, r_in, r_out) -> float:
     return float(total)
 
 
+# ---- resolution ---------------------------------------------------------------------------------
+def resolution_map(mech, res: PlanarWorkspace, step: float) -> dict:
+    """Positioning resolution over a workspace's feasible cells (at the middle of its φ
+    range): for actuator errors within ``±step`` each (mm or rad, the actuator unit), the
+    largest tool displacement ``max_s |J⁻¹_xy·s|·step`` over the corners ``s ∈ {±1}^L`` of
+    the error box (the largest of a convex function over a box is at a corner: exact), and
+    the largest per axis, ``step·Σ_j |J⁻¹_kj|``. Returns ``worst``, ``x``, ``y`` arrays
+    ``(nx, ny)`` in mm (NaN outside the workspace, inf at a singular pose)."""
+    if mech.n_actuators != mech.mobility.width:
+        raise ParameterError("mechanism", "as many actuators as free coordinates (a square "
+                             "Jacobian)", f"{mech.n_actuators} and {mech.mobility.width}")
+    idx = np.argwhere(res.occupancy)
+    at = 0.5 * (res.phi[0] + res.phi[1])
+    out = {k: np.full(res.occupancy.shape, np.nan) for k in ("worst", "x", "y")}
+    if not len(idx):
+        return out
+    J = mech.jacobian(_poses(mech, res.xs[idx[:, 0]], res.ys[idx[:, 1]], at))
+    L = J.shape[-1]
+    with np.errstate(all="ignore"):
+        det_ok = np.abs(np.linalg.det(J)) > 0
+        Jinv = np.full_like(J, np.inf)
+        Jinv[det_ok] = np.linalg.inv(J[det_ok])
+    S = np.array(np.meshgrid(*[[-1.0, 1.0]] * L, indexing="ij")).reshape(L, -1)   # (L, 2^L)
+    d = np.einsum("nkj,js->nks", Jinv[:, :2, :], S)
+    worst = step * np.sqrt(np.max(np.sum(d * d, axis=1), axis=1))
+    axis = step * np.sum(np.abs(Jinv[:, :2, :]), axis=2)
+    out["worst"][idx[:, 0], idx[:, 1]] = np.where(det_ok, worst, np.inf)
+    out["x"][idx[:, 0], idx[:, 1]] = np.where(det_ok, axis[:, 0], np.inf)
+    out["y"][idx[:, 0], idx[:, 1]] = np.where(det_ok, axis[:, 1], np.inf)
+    return out
+
+
 # ---- pictures -----------------------------------------------------------------------------------
 def plot_planar(mech, results, path, *, fields=None, points=None, title=None, ncols=3,
-                field_grid=None):
+                field_grid=None, values=None, value_label=""):
     """Slice plots of planar workspaces (one panel per result): feasible cells, the
     singularity loci drawn in (``fields(X) -> {label: values}`` whose zero level is the locus,
     default the family's ``singular_fields``; ``points(phi) -> {label: (K, 2)}`` point loci,
-    default ``singular_points``), the area estimate and bracket in each title. Writes ``path``
-    (PNG); returns it."""
+    default ``singular_points``), the area estimate and bracket in each title; ``values``, one
+    ``(nx, ny)`` array per result, colours the cells instead (a resolution map, labelled
+    ``value_label``, log scale). Writes ``path`` (PNG); returns it."""
     from matplotlib.figure import Figure
 
     fields = fields or getattr(mech, "singular_fields", None)
@@ -296,8 +338,18 @@ def plot_planar(mech, results, path, *, fields=None, points=None, title=None, nc
     for ax, res in zip(axes.ravel(), results):
         h = res.resolution
         ext = (res.xs[0] - h / 2, res.xs[-1] + h / 2, res.ys[0] - h / 2, res.ys[-1] + h / 2)
-        ax.imshow(res.occupancy.T, origin="lower", extent=ext, cmap="Greys", vmin=0, vmax=2.2,
-                  interpolation="nearest")
+        if values is None:
+            ax.imshow(res.occupancy.T, origin="lower", extent=ext, cmap="Greys", vmin=0,
+                      vmax=2.2, interpolation="nearest")
+        else:
+            from matplotlib.colors import LogNorm
+
+            v = np.asarray(values[results.index(res)], dtype=float)
+            fin = v[np.isfinite(v)]
+            norm = LogNorm(vmin=fin.min(), vmax=np.percentile(fin, 99)) if fin.size else None
+            im = ax.imshow(np.where(np.isfinite(v), v, np.nan).T, origin="lower", extent=ext,
+                           cmap="viridis", norm=norm, interpolation="nearest")
+            fig.colorbar(im, ax=ax, shrink=0.8, label=value_label)
         if fields is not None:
             xs = np.linspace(ext[0], ext[1], field_grid or 2 * len(res.xs))
             ys = np.linspace(ext[2], ext[3], field_grid or 2 * len(res.ys))
