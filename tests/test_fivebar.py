@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import MECH_DIR
 
 import pkmlab
 from pkmlab import testing
@@ -16,8 +17,6 @@ from pkmlab.mechanisms import REGISTRY
 from pkmlab.mechanisms.families.fivebar import FiveBar
 from pkmlab.mechanisms.solvers import multistart_modes
 from pkmlab.workspaces.planar import areas_per_working_mode, planar_workspace, resolution_map
-
-from conftest import MECH_DIR
 
 
 @pytest.fixture(scope="module")
@@ -105,7 +104,9 @@ def test_singularity_classification(mech):
     C1 = A1 + 250.0 * np.array([math.cos(th), math.sin(th)])
     A2 = mech.base_points[1, :2]
     # C2 on the circle |C2 - A2| = 250 at 600 mm from C1: bisect the angle
-    f = lambda t: np.hypot(*(A2 + 250 * np.array([math.cos(t), math.sin(t)]) - C1)) - 600.0
+    def f(t):
+        return np.hypot(*(A2 + 250 * np.array([math.cos(t), math.sin(t)]) - C1)) - 600.0
+
     a, b = -1.0, 1.5
     assert f(a) * f(b) < 0
     for _ in range(80):

@@ -7,14 +7,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import yaml
+from conftest import MECH_DIR, ROOT
 
 import pkmlab
 from pkmlab import dexterity as dx
 from pkmlab.errors import ParameterError
 from pkmlab.study import load_study
 from pkmlab.workspaces.planar import planar_workspace
-
-from conftest import MECH_DIR, ROOT
 
 
 def _study(tmp_path, mech_file="planar-3rpr.yaml", **block):

@@ -8,12 +8,11 @@ import math
 
 import numpy as np
 import pytest
+from conftest import MECH_DIR
 
 import pkmlab
 from pkmlab.workspaces import planar
 from pkmlab.workspaces.planar import annuli_area, area_per_phi, planar_workspace
-
-from conftest import MECH_DIR
 
 
 @pytest.fixture(scope="module")

@@ -83,6 +83,6 @@ def test_a_broken_plugin_is_reported_not_fatal(tmp_path):
     run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                          env=_env(tmp_path), timeout=600)
     assert run.returncode == 0, run.stderr
-    assert run.stdout.strip() == "['luzi3', 'psu6', 'rss6', 'sixleg', 'ups6'] " \
+    assert run.stdout.strip() == "['fivebar', 'luzi3', 'psu6', 'rpr3', 'rss6', 'sixleg', 'ups6'] " \
                                  "ModuleNotFoundError"
     assert "not loaded" in run.stderr

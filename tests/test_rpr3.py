@@ -118,7 +118,8 @@ def _joint_solve(m, rho, starts=400, seed=0):
 
 def test_sextic_against_multistart_loop_closure_of_the_joints(mech):
     """The published vector, 12 from random valid poses of the shipped layout and 12 near the
-    published vector (±3 on each leg): the same number of real modes and the same poses (1e-6 mm / rad) as 400-start Newton on the joints."""
+    published vector (±3 on each leg): the same number of real modes and the same poses
+    (1e-6 mm / rad) as 400-start Newton on the joints."""
     m0, rho0 = published()
     cases = [(m0, rho0)]
     rng = np.random.default_rng(3)

@@ -377,8 +377,8 @@ def plot_planar(mech, results, path, *, fields=None, points=None, title=None, nc
         ax.set_ylim(ext[2], ext[3])
         ax.set_xlabel("x (mm)")
         ax.set_ylabel("y (mm)")
-        phi = ("φ = %.1f°" % math.degrees(res.phi[0]) if res.kind == "constant" else
-               "φ ∈ [%.1f°, %.1f°]" % tuple(math.degrees(a) for a in res.phi))
+        lo_d, hi_d = (math.degrees(a) for a in res.phi)
+        phi = f"φ = {lo_d:.1f}°" if res.kind == "constant" else f"φ ∈ [{lo_d:.1f}°, {hi_d:.1f}°]"
         ax.set_title(f"{res.kind}, {phi}\nestimate {res.estimate / 100:.1f} cm², bracket "
                      f"[{res.lower / 100:.1f}, {res.upper / 100:.1f}]", fontsize=9)
         ax.legend(fontsize=6, loc="upper right")
