@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from .base import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult, Mechanism
 from .families.fivebar import FiveBar  # noqa: E402  (issue 24; the lead re-registers)
+from .families.prs3 import Prs3  # noqa: E402  (issue 24; the lead re-registers)
 from .families.rpr3 import Rpr3  # noqa: E402  (issue 24; the lead re-registers at merge)
 from .joints import Joint, Leg, Link, Parameters
 from .luzi3 import Luzi3
@@ -28,7 +29,8 @@ from .ups6 import UPS6
 
 #: family name → mechanism class (built-in families, then plugins once loaded)
 REGISTRY: dict[str, type[Mechanism]] = {cls.family: cls for cls in (PSU6, UPS6, Luzi3, RSS6,
-                                                                  SixLeg, Rpr3, FiveBar)}
+                                                                  SixLeg, Rpr3, FiveBar,
+                                                                  Prs3)}
 BUILTIN = frozenset(REGISTRY)
 
 #: entry point group of family plugins

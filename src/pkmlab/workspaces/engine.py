@@ -332,9 +332,10 @@ def _check_mobility(mech, kind, orientations) -> None:
     the other kinds and any orientation set, naming the field."""
     mob = mech.mobility
     what = f"family {mech.family!r} with {mob.name} mobility ({', '.join(mob.coordinates)})"
-    if "z" not in mob.coordinates:
-        raise ParameterError("mechanism", "a mechanism with z free (the x-y × z column grid); "
-                             "planar mechanisms: pkmlab.workspaces.planar", what)
+    if not {"x", "y", "z"} <= set(mob.coordinates):
+        raise ParameterError("mechanism", "a mechanism with x, y and z free (the x-y × z "
+                             "column grid); planar mechanisms: pkmlab.workspaces.planar, "
+                             "dependent coordinates (3-PRS): pkmlab.workspaces.tripod", what)
     if mob.rotations:
         return
     if kind != "constant":
