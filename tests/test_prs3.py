@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import MECH_DIR
 from scipy.optimize import brentq, fsolve
 
 import pkmlab
@@ -18,8 +19,6 @@ from pkmlab.mechanisms.families.prs3 import TRIPOD, Prs3, tripod_layout
 from pkmlab.mechanisms.mobility import Mobility
 from pkmlab.poses import euler_to_matrix
 from pkmlab.workspaces.tripod import plot_tripod, tripod_workspace
-
-from conftest import MECH_DIR
 
 
 @pytest.fixture(scope="module")
@@ -56,7 +55,7 @@ def test_parasitic_motions_against_scipy_and_their_properties(mech):
     F = _random_free(40, 0)
     par = mech.parasitic(F)
     for (z, a, b), mine in zip(F, par):
-        def eqs(u):
+        def eqs(u, z=z, a=a, b=b):
             R = euler_to_matrix(np.array([a, b, u[2]]))
             S = np.array([u[0], u[1], z]) + mech.platform_points @ R.T
             return np.sum(mech.hinge_axes * (S - mech.base_points), axis=1)
@@ -78,8 +77,9 @@ def test_ik_against_a_root_search_of_each_link(mech):
     for x, q in zip(X, ik.q):
         S = x[:3] + mech.platform_points @ euler_to_matrix(x[3:]).T
         for i in range(3):
-            f = lambda t: np.linalg.norm(S[i] - mech.base_points[i]       # noqa: E731
-                                         - t * mech.rail_axes[i]) - 250.0
+            def f(t, s=S[i], i=i):
+                return np.linalg.norm(s - mech.base_points[i] - t * mech.rail_axes[i]) - 250.0
+
             top = S[i][2] + 300.0                   # the slider above the joint (branch +1)
             ref = brentq(f, S[i][2], top, xtol=1e-13)
             assert q[i] == pytest.approx(ref, abs=1e-9)
