@@ -10,7 +10,7 @@ coordinates stay 0), declared as ``Mobility("planar-point", ("x", "y"))``.
   l2²)/(2·l1·D))``, ``D = |P - A_i|``, wrapped to (-π, π]; ``σ_i = ±1`` is arm i's elbow
   branch (``branch``). Status per actuator: ``no real solution`` outside the annulus
   ``|l1 - l2| <= D <= l1 + l2``, else the motor window. The angle is given as its
-  representative in ``[c - π, c + π)``, ``c`` the centre of the motor window (a window may
+  representative in ``(c - π, c + π]``, ``c`` the centre of the motor window (a window may
   cross ±180°, e.g. [-45°, 225°]).
 * **Working modes**: the four branch pairs (``working_modes``, ``with_working_mode``).
 * **Jacobian** ``(N, 2, 2)``: ``θ̇_i = (P - C_i)·v / (l1_i·(P - C_i)·e⊥_i)``, ``e⊥_i = (-sin θ_i,
@@ -42,7 +42,7 @@ from .. import _kernels
 from ..base import AssemblyModes, Mechanism, as_stroke
 from ..joints import JointArrays, LegTemplate, ParamField
 from ..mobility import Mobility
-from . import planar_fk
+from . import _fastmath, planar_fk
 
 __all__ = ["FiveBar", "FiveBarSpec", "POINT"]
 
@@ -58,12 +58,14 @@ def _fivebar_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmi
         dx, dy = px - g[2 * i], py - g[2 * i + 1]
         l1, l2, b = g[4 + i], g[6 + i], g[8 + i]
         d2 = dx * dx + dy * dy
-        d = math.sqrt(d2)
-        c = (l1 * l1 + d2 - l2 * l2) / (2.0 * l1 * d)
+        c = (l1 * l1 + d2 - l2 * l2) / (2.0 * l1 * math.sqrt(d2))
         ok = abs(c) <= 1.0
-        t = math.atan2(dy, dx) + b * math.acos(min(1.0, max(-1.0, c)))
-        # the representative nearest the motor window's centre g[10]: [c - π, c + π)
-        t = t - 2.0 * math.pi * math.floor((t - g[10] + math.pi) / (2.0 * math.pi))
+        c = min(1.0, max(-1.0, c))
+        s = b * math.sqrt(1.0 - c * c)
+        # the elbow's direction: A→P turned by the elbow angle (cos c, sin s), then measured
+        # from the motor window's centre g[10] (cos g[11], sin g[12]): one atan2, no wrap
+        vx, vy = dx * c - dy * s, dx * s + dy * c
+        t = g[10] + _fastmath.atan2(vy * g[11] - vx * g[12], vx * g[11] + vy * g[12])
         q[i * _kernels.ROW + j] = t if ok else math.nan
         st[i * _kernels.ROW + j] = (_kernels.stroke_status(t, qmin, qmax) if ok
                                     else _kernels.NO_SOLUTION)
@@ -167,8 +169,9 @@ class FiveBar(Mechanism):
         return float(np.abs(self.base_points).max() + np.max(self.proximal + self.distal))
 
     def _gparams(self):
+        c0 = 0.5 * (self.stroke[0] + self.stroke[1])
         return np.concatenate([self.base_points[:, :2].ravel(), self.proximal, self.distal,
-                               self.branch, [0.5 * (self.stroke[0] + self.stroke[1])]])
+                               self.branch, [c0, math.cos(c0), math.sin(c0)]])
 
     # ---- kinematics ---------------------------------------------------------------------------
     def _elbows(self, p, q):

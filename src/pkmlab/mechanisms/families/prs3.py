@@ -83,16 +83,15 @@ def _prs3_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, 
         a += g[_K + i] * (nx * wx + ny * wy)
         b += g[_K + i] * (ny * wx - nx * wy)
     rho = math.sqrt(a * a + b * b)
-    e = g[_H + 3]
-    c = e / rho
-    okc = abs(c) <= 1.0
-    base = math.atan2(b, a)
-    w = math.acos(min(1.0, max(-1.0, c)))
-    g1, g2 = base + w, base - w
-    g1 = g1 - 2.0 * math.pi * math.floor((g1 + math.pi) / (2.0 * math.pi))
-    g2 = g2 - 2.0 * math.pi * math.floor((g2 + math.pi) / (2.0 * math.pi))
-    gam = g1 if abs(g1) <= abs(g2) else g2
-    cg, sg = math.cos(gam), math.sin(gam)
+    ce = g[_H + 3] / rho
+    okc = abs(ce) <= 1.0
+    ce = min(1.0, max(-1.0, ce))
+    se = math.sqrt(1.0 - ce * ce)
+    # θz = atan2(b, a) ± acos(ce), the root nearer 0 (the larger cosine), as cos and sin
+    c1, s1 = (a * ce - b * se) / rho, (b * ce + a * se) / rho
+    c2, s2 = (a * ce + b * se) / rho, (b * ce - a * se) / rho
+    cg = c1 if c1 >= c2 else c2
+    sg = s1 if c1 >= c2 else s2
     x = 0.0
     y = 0.0
     for i in range(3):

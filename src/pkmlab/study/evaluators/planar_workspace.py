@@ -54,9 +54,9 @@ class PlanarWorkspace(Evaluator):
         metric("planar_area_exact", "cm²", "exact",
                "exact area where the set is an intersection of annuli (constant kind); null "
                "otherwise"),
-        metric("planar_gci", "", "sampled",
+        metric("gci_planar", "", "sampled",
                "mean 1/κ over the feasible sampled cells and orientations"),
-        metric("planar_worst_kappa", "", "sampled",
+        metric("sampled_planar_worst_kappa", "", "sampled",
                "largest κ over the feasible sampled cells and orientations"),
     )
 
@@ -90,8 +90,8 @@ class PlanarWorkspace(Evaluator):
             raise NumericalError("characteristic length", length.reason)
         idx = np.argwhere(res.occupancy)
         if not len(idx):
-            ctx.notes["planar_gci"] = ctx.notes["planar_worst_kappa"] = "empty workspace"
-            return {**out, "planar_gci": None, "planar_worst_kappa": None}
+            ctx.notes["gci_planar"] = ctx.notes["sampled_planar_worst_kappa"] = "empty workspace"
+            return {**out, "gci_planar": None, "sampled_planar_worst_kappa": None}
         lo, hi = res.phi
         phis = np.linspace(lo, hi, plan.samples) if hi > lo else np.array([lo])
         X = np.repeat(mech.nominal_pose[None], len(idx) * len(phis), axis=0)
@@ -100,10 +100,10 @@ class PlanarWorkspace(Evaluator):
         X[:, 5] = np.tile(phis, len(idx))
         ok = mech.inverse(X).valid
         kap = dx.condition_number(mech.jacobian(X[ok]), length)
-        out["planar_gci"] = float(np.mean(1.0 / kap))
-        out["planar_worst_kappa"] = finite(np.max(kap))
-        if out["planar_worst_kappa"] is None:
-            ctx.notes["planar_worst_kappa"] = "a sampled pose is singular"
+        out["gci_planar"] = float(np.mean(1.0 / kap))
+        out["sampled_planar_worst_kappa"] = finite(np.max(kap))
+        if out["sampled_planar_worst_kappa"] is None:
+            ctx.notes["sampled_planar_worst_kappa"] = "a sampled pose is singular"
         return out
 
 
