@@ -12,10 +12,9 @@ Run: .venv/bin/python benchmarks/bench_lowmob_planar.py   (exit 1 when a family 
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 from pathlib import Path
-
-import dataclasses
 
 import numba
 import numpy as np
