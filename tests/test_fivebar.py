@@ -196,3 +196,13 @@ def test_vectorisable_atan2_against_math_atan2():
     many(y, x, out)
     ref = np.arctan2(y, x)
     assert np.max(np.abs(out - ref)) <= 2 * np.spacing(math.pi)
+
+
+def test_dexterity_needs_no_characteristic_length(mech):
+    from pkmlab import dexterity as dx
+
+    L = dx.resolve_length(mech)
+    assert L.status == "not-applicable" and L.length is None
+    X = testing.random_valid_poses(mech, 20, seed=12, lin=100.0)
+    J = mech.jacobian(X)
+    np.testing.assert_allclose(dx.condition_number(J, L), np.linalg.cond(J), rtol=1e-12)

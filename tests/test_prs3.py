@@ -132,3 +132,23 @@ def test_the_3d_engine_refuses_the_tripod_naming_its_workspace_module(mech):
 
     with pytest.raises(ParameterError, match="pkmlab.workspaces.tripod"):
         pkmlab.workspace(mech, "constant", resolution=10.0)
+
+
+def test_dexterity_on_its_own_mobility(mech):
+    """Mixed translation (v_z) and rotation (ω_x, ω_y) columns: κ homogenised with Angeles'
+    length on the two rotation columns, equal to numpy.linalg.cond by hand."""
+    from pkmlab import dexterity as dx
+
+    L = dx.resolve_length(mech)
+    assert L.status == "angeles" and L.rotational == (1, 2)
+    X = testing.random_valid_poses(mech, 20, seed=11)
+    J = mech.jacobian(X)
+    Jh = J.copy()
+    Jh[:, :, 1:] /= L.length
+    np.testing.assert_allclose(dx.condition_number(J, L), np.linalg.cond(Jh), rtol=1e-10)
+    # Angeles' length minimises κ at the nominal pose: ±1 % of it does no better
+    Jn = mech.jacobian(mech.nominal_pose)[0]
+    for f in (0.99, 1.01):
+        Jf = Jn.copy()
+        Jf[:, 1:] /= f * L.length
+        assert np.linalg.cond(Jf) >= L.kappa - 1e-9
