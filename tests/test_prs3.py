@@ -152,3 +152,28 @@ def test_dexterity_on_its_own_mobility(mech):
         Jf = Jn.copy()
         Jf[:, 1:] /= f * L.length
         assert np.linalg.cond(Jf) >= L.kappa - 1e-9
+
+
+def test_a_type_ii_singularity_inside_the_stroke_is_classified(mech):
+    """det(J)·Π(L_i·d_i) (the actuation matrix; the constraint part stays regular) changes
+    sign between the nominal pose and a pose tilted 54° about x: bisection finds a valid pose
+    (tilted about 51°) that the flags call type II only."""
+    def det_a(F):
+        p, R = mech._frames(np.atleast_2d(F))
+        _, C, L = mech._rows(p, R)
+        assert np.linalg.det(C[:, :, [0, 1, 5]]).min() > 0        # no constraint singularity
+        return (np.linalg.det(mech.jacobian(np.atleast_2d(F)))
+                * np.prod(np.sum(L * mech.rail_axes, -1), axis=1))[0]
+
+    a = mech.nominal_pose[[2, 3, 4]]
+    b = np.array([-37.6638275, np.radians(54.24431016), np.radians(-0.96684155)])
+    fa = det_a(a)
+    assert fa * det_a(b) < 0 and mech.singularity(a).tolist() == [0]
+    for _ in range(80):
+        c = 0.5 * (a + b)
+        if np.sign(det_a(c)) == np.sign(fa):
+            a, fa = c, det_a(c)
+        else:
+            b = c
+    assert mech.inverse(c).valid[0] and mech.singularity(c).tolist() == [2]
+    assert 50.0 < np.degrees(c[1]) < 53.0
