@@ -67,21 +67,41 @@ _A, _D, _N, _B, _L, _S, _P, _K, _H = 0, 9, 18, 27, 36, 39, 42, 48, 51
 
 
 @register_jitable(inline="always")
+def _w(g, i, cb, sb, ca, sa):
+    """``w_i = Ry·Rx·b_i`` and its ``A_i``, ``B_i`` (module docstring)."""
+    bx, by, bz = g[_B + 3 * i], g[_B + 3 * i + 1], g[_B + 3 * i + 2]
+    wx = cb * bx + sb * sa * by + sb * ca * bz
+    wy = ca * by - sa * bz
+    wz = -sb * bx + cb * sa * by + cb * ca * bz
+    nx, ny = g[_N + 3 * i], g[_N + 3 * i + 1]
+    return wx, wy, wz, nx * wx + ny * wy, ny * wx - nx * wy
+
+
+@register_jitable(inline="always")
+def _leg(g, i, x, y, pz, cg, sg, wx, wy, wz, qmin, qmax, okc, q, st, j):
+    Dx = x + cg * wx - sg * wy - g[_A + 3 * i]
+    Dy = y + sg * wx + cg * wy - g[_A + 3 * i + 1]
+    Dz = pz + wz - g[_A + 3 * i + 2]
+    t = g[_D + 3 * i] * Dx + g[_D + 3 * i + 1] * Dy + g[_D + 3 * i + 2] * Dz
+    disc = g[_L + i] * g[_L + i] - (Dx * Dx + Dy * Dy + Dz * Dz) + t * t
+    ok = okc & (disc >= 0.0)
+    v = t + g[_S + i] * math.sqrt(max(disc, 0.0))
+    q[i * _kernels.ROW + j] = v if ok else math.nan
+    st[i * _kernels.ROW + j] = (_kernels.stroke_status(v, qmin, qmax) if ok
+                                else _kernels.NO_SOLUTION)
+
+
+@register_jitable(inline="always")
 def _prs3_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st,
               j):
     sb = -r20
     cb = math.sqrt(r21 * r21 + r22 * r22)
     sa, ca = r21 / cb, r22 / cb
-    # w_i = Ry·Rx·b_i; A_i, B_i (module docstring)
-    a = 0.0
-    b = 0.0
-    for i in range(3):
-        bx, by, bz = g[_B + 3 * i], g[_B + 3 * i + 1], g[_B + 3 * i + 2]
-        wx = cb * bx + sb * sa * by + sb * ca * bz
-        wy = ca * by - sa * bz
-        nx, ny = g[_N + 3 * i], g[_N + 3 * i + 1]
-        a += g[_K + i] * (nx * wx + ny * wy)
-        b += g[_K + i] * (ny * wx - nx * wy)
+    w0x, w0y, w0z, A0, B0 = _w(g, 0, cb, sb, ca, sa)
+    w1x, w1y, w1z, A1, B1 = _w(g, 1, cb, sb, ca, sa)
+    w2x, w2y, w2z, A2, B2 = _w(g, 2, cb, sb, ca, sa)
+    a = g[_K] * A0 + g[_K + 1] * A1 + g[_K + 2] * A2
+    b = g[_K] * B0 + g[_K + 1] * B1 + g[_K + 2] * B2
     rho = math.sqrt(a * a + b * b)
     ce = g[_H + 3] / rho
     okc = abs(ce) <= 1.0
@@ -92,31 +112,14 @@ def _prs3_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, 
     c2, s2 = (a * ce + b * se) / rho, (b * ce - a * se) / rho
     cg = c1 if c1 >= c2 else c2
     sg = s1 if c1 >= c2 else s2
-    x = 0.0
-    y = 0.0
-    for i in range(3):
-        bx, by, bz = g[_B + 3 * i], g[_B + 3 * i + 1], g[_B + 3 * i + 2]
-        wx = cb * bx + sb * sa * by + sb * ca * bz
-        wy = ca * by - sa * bz
-        nx, ny = g[_N + 3 * i], g[_N + 3 * i + 1]
-        rhs = g[_H + i] - cg * (nx * wx + ny * wy) - sg * (ny * wx - nx * wy)
-        x += g[_P + i] * rhs
-        y += g[_P + 3 + i] * rhs
-    for i in range(3):
-        bx, by, bz = g[_B + 3 * i], g[_B + 3 * i + 1], g[_B + 3 * i + 2]
-        wx = cb * bx + sb * sa * by + sb * ca * bz
-        wy = ca * by - sa * bz
-        wz = -sb * bx + cb * sa * by + cb * ca * bz
-        Dx = x + cg * wx - sg * wy - g[_A + 3 * i]
-        Dy = y + sg * wx + cg * wy - g[_A + 3 * i + 1]
-        Dz = pz + wz - g[_A + 3 * i + 2]
-        t = g[_D + 3 * i] * Dx + g[_D + 3 * i + 1] * Dy + g[_D + 3 * i + 2] * Dz
-        disc = g[_L + i] * g[_L + i] - (Dx * Dx + Dy * Dy + Dz * Dz) + t * t
-        ok = okc and disc >= 0.0
-        v = t + g[_S + i] * math.sqrt(max(disc, 0.0))
-        q[i * _kernels.ROW + j] = v if ok else math.nan
-        st[i * _kernels.ROW + j] = (_kernels.stroke_status(v, qmin, qmax) if ok
-                                    else _kernels.NO_SOLUTION)
+    r0 = g[_H] - cg * A0 - sg * B0
+    r1 = g[_H + 1] - cg * A1 - sg * B1
+    r2 = g[_H + 2] - cg * A2 - sg * B2
+    x = g[_P] * r0 + g[_P + 1] * r1 + g[_P + 2] * r2
+    y = g[_P + 3] * r0 + g[_P + 4] * r1 + g[_P + 5] * r2
+    _leg(g, 0, x, y, pz, cg, sg, w0x, w0y, w0z, qmin, qmax, okc, q, st, j)
+    _leg(g, 1, x, y, pz, cg, sg, w1x, w1y, w1z, qmin, qmax, okc, q, st, j)
+    _leg(g, 2, x, y, pz, cg, sg, w2x, w2y, w2z, qmin, qmax, okc, q, st, j)
 
 
 def tripod_layout(base_radius, platform_radius, rail_inclination=0.0,
