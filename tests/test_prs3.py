@@ -177,3 +177,19 @@ def test_a_type_ii_singularity_inside_the_stroke_is_classified(mech):
             b = c
     assert mech.inverse(c).valid[0] and mech.singularity(c).tolist() == [2]
     assert 50.0 < np.degrees(c[1]) < 53.0
+
+
+def test_cli_ik_reports_the_parasitic_motions(mech):
+    import json
+
+    from typer.testing import CliRunner
+
+    from pkmlab.cli import app
+
+    r = CliRunner().invoke(app, ["ik", str(MECH_DIR / "tripod-3prs.yaml"), "--pose",
+                                 "0,0,-20,10,5,0", "--json"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)["dependent"]
+    par = mech.parasitic([[-20.0, math.radians(10.0), math.radians(5.0)]])[0]
+    assert [d["x"], d["y"], math.radians(d["theta_z"])] == pytest.approx(par.tolist(),
+                                                                         abs=1e-12)
