@@ -63,13 +63,16 @@ def _moves(mech) -> np.ndarray:
 
 def random_valid_poses(mech, n: int, seed: int, lin: float = 25.0, ang_deg: float = 10.0):
     """``n`` poses near the nominal pose (±``lin`` mm, ±``ang_deg`` deg in the free
-    coordinates) whose inverse kinematics is valid; six coordinates each."""
+    coordinates) whose inverse kinematics is valid; six coordinates each (a mobility with
+    dependent coordinates: completed by ``mech.complete``)."""
     rng = np.random.default_rng(seed)
     out, total = [], 0
     for _ in range(200):
         X = mech.nominal_pose + _moves(mech) * np.concatenate(
             [rng.uniform(-lin, lin, (4 * n, 3)),
              np.radians(rng.uniform(-ang_deg, ang_deg, (4 * n, 3)))], axis=1)
+        if getattr(mech.mobility, "dependent", ()):
+            X = mech.complete(X)
         out.append(X[mech.inverse(X).valid])
         total += len(out[-1])
         if total >= n:

@@ -96,10 +96,19 @@ def ik(mech_file: MechArg,
             "actuators": _act_json(mech, mech.inverse(X).q[0]), "valid": rep["valid"],
             "reason": rep["reason"], "leg_status": rep["leg_status"], "kappa": rep["kappa"],
             "singular": rep["singular"], "characteristic_length": rep["characteristic_length"]}
+    dep = mech.mobility.dependent
+    if dep:                 # a 3-PRS: the dependent coordinates follow from the free ones
+        par = mech.parasitic(X[None])[0]
+        data["dependent"] = {c: float(np.degrees(v) if c.startswith("theta") else v)
+                             for c, v in zip(dep, par)}
     if as_json:
         _emit(data)
         return
     out.print(f"pose: {_pose_str(X, mech)}")
+    if dep:
+        out.print("dependent (parasitic, replacing the pose's): " + ", ".join(
+            f"{c}={v:.4f}{' deg' if c.startswith('theta') else ' mm'}"
+            for c, v in data["dependent"].items()))
     out.print(f"actuators ({_act_unit(mech)}): " + _act_str(mech, mech.inverse(X).q[0], 6))
     out.print(("[green]valid[/]" if rep["valid"] else "[red]invalid[/]") + ": "
               + escape("; ".join(legs)))

@@ -12,10 +12,24 @@ the others are fixed at the mechanism's nominal pose. So
 A coordinate that is free in the Euler pose maps to one column of the base-frame twist
 ``[v; ω]`` (``x, y, z`` to ``v``, ``theta_z`` to ``ω_z`` at any pose, and all three angles
 together to ``ω``): :attr:`Mobility.twist_columns` selects the columns of the full ``(L, 6)``
-velocity Jacobian that act on the free motion. A set with one or two of the tilt angles free
-and the rest dependent (a 3-PRS: ``z, theta_x, theta_y`` free, ``x, y, theta_z`` following from
-the inverse kinematics) is not a column selection; such families declare their own mobility
-(issue "lower-mobility families").
+velocity Jacobian that act on the free motion.
+
+**Dependent coordinates.** A mechanism may also declare coordinates that are not fixed but
+follow from the free ones (``Mobility.dependent``; a 3-PRS: ``z, theta_x, theta_y`` free,
+``x, y, theta_z`` dependent — the parasitic motions). Then:
+
+* the family completes poses itself: ``mech.complete(poses)`` gives six-coordinate poses with
+  the dependent coordinates computed from the free ones, and ``mech.parasitic(poses)`` gives
+  the dependent coordinates alone, ``(N, len(dependent))``; :meth:`Mobility.full` cannot (it
+  fills them from ``fixed``), so ``Mechanism._free_to_full`` is the family's;
+* the inverse kinematics reads the free coordinates only (a given pose's dependent coordinates
+  are replaced by their values);
+* the free twist columns are the base-frame twist components of the free coordinates' (3-PRS:
+  ``v_z, ω_x, ω_y``), and the Jacobian ``(L, width)`` is the derivative of the actuator values
+  along them with the dependent twist components following (the constraint solved for them):
+  what the protocol's finite-difference check measures, since the inverse kinematics depends on
+  the free coordinates alone;
+* a tilt angle may be free without ``theta_z`` when ``theta_z`` is dependent.
 """
 
 from __future__ import annotations
@@ -38,21 +52,29 @@ class Mobility:
     Attributes:
         name: ``"spatial"``, ``"translational"``, ``"planar"`` or a family's own.
         coordinates: the free coordinates, a subset of :data:`POSE` in its order.
+        dependent: coordinates that follow from the free ones (module docstring), in the
+            order of :data:`POSE`; the others are fixed at the nominal pose.
     """
 
     name: str
     coordinates: tuple[str, ...]
+    dependent: tuple[str, ...] = ()
 
     def __post_init__(self):
-        unknown = [c for c in self.coordinates if c not in POSE]
-        if unknown or len(set(self.coordinates)) != len(self.coordinates) \
-                or list(self.coordinates) != sorted(self.coordinates, key=POSE.index):
-            raise ValueError(f"coordinates must be distinct names of {POSE} in that order, "
-                             f"got {self.coordinates}")
+        for what, names in (("coordinates", self.coordinates), ("dependent", self.dependent)):
+            unknown = [c for c in names if c not in POSE]
+            if unknown or len(set(names)) != len(names) \
+                    or list(names) != sorted(names, key=POSE.index):
+                raise ValueError(f"{what} must be distinct names of {POSE} in that order, "
+                                 f"got {names}")
+        if set(self.coordinates) & set(self.dependent):
+            raise ValueError(f"a coordinate is free or dependent, not both: {self.coordinates}"
+                             f" and {self.dependent}")
         tilts = {"theta_x", "theta_y"} & set(self.coordinates)
-        if tilts and "theta_z" not in self.coordinates or len(tilts) == 1:
-            raise ValueError("a free tilt angle needs all three angles free (dependent "
-                             f"coordinates are a family's own mobility), got {self.coordinates}")
+        known = set(self.coordinates) | set(self.dependent)
+        if tilts and ("theta_z" not in known or len({"theta_x", "theta_y"} & known) == 1):
+            raise ValueError("a free tilt angle needs all three angles free or dependent, got "
+                             f"{self.coordinates} (dependent {self.dependent})")
 
     @property
     def width(self) -> int:

@@ -331,9 +331,13 @@ def _check_mobility(mech, kind, orientations) -> None:
     """A mechanism without a free rotation has constant-orientation workspaces only: refuse
     the other kinds and any orientation set, naming the field."""
     mob = mech.mobility
+    what = f"family {mech.family!r} with {mob.name} mobility ({', '.join(mob.coordinates)})"
+    if not {"x", "y", "z"} <= set(mob.coordinates):
+        raise ParameterError("mechanism", "a mechanism with x, y and z free (the x-y × z "
+                             "column grid); planar mechanisms: pkmlab.workspaces.planar, "
+                             "dependent coordinates (3-PRS): pkmlab.workspaces.tripod", what)
     if mob.rotations:
         return
-    what = f"family {mech.family!r} with {mob.name} mobility ({', '.join(mob.coordinates)})"
     if kind != "constant":
         raise ParameterError("kind", "'constant' for a mechanism without a free rotation "
                              "(its orientation is fixed)", f"{kind!r} ({what})")

@@ -6,14 +6,19 @@ are. The generic six-leg family's YAML model builds through the paired-circle ge
 other families, so it lives in :mod:`.sixleg_spec` and is given at registration.
 """
 
+from .fivebar import FiveBar
 from .luzi3 import Luzi3
+from .prs3 import Prs3
 from .psu6 import PSU6
+from .rpr3 import Rpr3
 from .rss6 import RSS6
 from .sixleg import SixLeg
 from .sixleg_spec import SixLegSpec
 from .ups6 import UPS6
 
-__all__ = ["BUILTIN_FAMILIES", "PSU6", "UPS6", "Luzi3", "RSS6", "SixLeg"]
+__all__ = ["BUILTIN_FAMILIES", "PSU6", "UPS6", "Luzi3", "RSS6", "SixLeg", "Rpr3", "FiveBar",
+           "Prs3"]
 
 #: ``(family class, YAML model given at registration or None)``, in registration order
-BUILTIN_FAMILIES = ((PSU6, None), (UPS6, None), (Luzi3, None), (RSS6, None), (SixLeg, SixLegSpec))
+BUILTIN_FAMILIES = ((PSU6, None), (UPS6, None), (Luzi3, None), (RSS6, None), (SixLeg, SixLegSpec),
+                    (Rpr3, None), (FiveBar, None), (Prs3, None))
