@@ -23,10 +23,12 @@ from .psu6 import PSU6
 from .rss6 import RSS6
 from .sixleg import SixLeg
 from .ups6 import UPS6
+from .families.delta3 import Delta3  # noqa: E402 (after base: the families import it)
+from .families.ldelta3 import LDelta3  # noqa: E402
 
 #: family name → mechanism class (built-in families, then plugins once loaded)
 REGISTRY: dict[str, type[Mechanism]] = {cls.family: cls for cls in (PSU6, UPS6, Luzi3, RSS6,
-                                                                  SixLeg)}
+                                                                  SixLeg, Delta3, LDelta3)}
 BUILTIN = frozenset(REGISTRY)
 
 #: entry point group of family plugins
