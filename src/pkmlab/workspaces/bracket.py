@@ -198,6 +198,9 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
         max_cells: largest number of (column × orientation cell) items of one step (an
             orientation split that would pass it halves the x-y cells instead).
     """
+    if getattr(mech, "position_bracket", None) is not None:     # delta3, ldelta3
+        return mech.position_bracket(kind, orientations, resolution, constraints,
+                                     target=target, budget_s=budget_s)
     require_spatial(mech, "volume brackets")
     t_call = time.perf_counter()
     mech, oset, cons = _request(mech, kind, orientations, resolution, constraints)

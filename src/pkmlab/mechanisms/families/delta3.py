@@ -53,6 +53,7 @@ from ...quantities import Angle, AngleWindow, PositiveLength
 from ...specbase import FamilySpec, _Model
 from .. import _kernels
 from .._crank import crank_leg_set, crank_params
+from .._crank_cells import crank_cell_terms
 from ..base import NO_STROKE, as_points, as_positive, as_vector3
 from ..joints import DEFAULT_FIELDS, ParamField, kind_arrays, kind_template, platform_joints
 from ..rss6 import _angle_window, _rss_leg
@@ -114,6 +115,50 @@ def delta_column_leg(x, y, wx, wy, wz, p, zlo, zhi, out_lo, out_hi):
             return 0
     return crank_leg_set(X, Y, wz, p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9],
                          p[10], p[11], p[12], p[13], p[14], zlo, zhi, out_lo, out_hi)
+
+
+@register_jitable
+def delta_margin(x, y, z, P):
+    """The smallest signed leg margin at ``(x, y, z)`` (:meth:`Delta3.leg_margins`, the numba
+    form of :func:`.._crank_cells.crank_cell_terms`' margin and the cone slab): ``P`` rows
+    ``w = R·t - B`` (3), ``u``, ``v``, ``n`` (3 each), ``a``, ``s``, ``b``, ``α_min``,
+    ``α_max``, 1 for a full window, the slab half-width, and the cosines and sines of
+    ``α_min`` and ``α_max``."""
+    out = np.inf
+    for i in range(P.shape[0]):
+        wx, wy, wz = x + P[i, 0], y + P[i, 1], z + P[i, 2]
+        X = wx * P[i, 3] + wy * P[i, 4] + wz * P[i, 5]
+        Y = wx * P[i, 6] + wy * P[i, 7] + wz * P[i, 8]
+        Z = wx * P[i, 9] + wy * P[i, 10] + wz * P[i, 11]
+        a, s, b, lo, hi = P[i, 12], P[i, 13], P[i, 14], P[i, 15], P[i, 16]
+        r = math.hypot(X, Y)
+        m1 = s - math.hypot(Z, r - a)
+        m2 = math.hypot(Z, r + a) - s
+        E = 2.0 * a * X
+        F = 2.0 * a * Y
+        G = wx * wx + wy * wy + wz * wz + a * a - s * s
+        h2 = E * E + F * F - G * G
+        real = m1 >= 0.0 and m2 >= 0.0 and h2 >= 0.0
+        D = min(m1, m2)
+        feasible = real
+        if P[i, 17] < 0.5:
+            for k in range(2):
+                ce = P[i, 19 + 2 * k]
+                se = P[i, 20 + 2 * k]
+                cx = a * (ce * P[i, 3] + se * P[i, 6])
+                cy = a * (ce * P[i, 4] + se * P[i, 7])
+                cz = a * (ce * P[i, 5] + se * P[i, 8])
+                sph = abs(math.sqrt((wx - cx) ** 2 + (wy - cy) ** 2 + (wz - cz) ** 2) - s)
+                side = -b * (X * se - Y * ce)
+                D = min(D, max(sph, side))
+            if real:
+                h = math.sqrt(h2)
+                th = math.atan2(F * G + b * E * h, E * G - b * F * h)
+                feasible = lo <= th <= hi
+        D = D if real else -min(m1, m2)
+        mu = D if feasible else -D
+        out = min(out, min(mu, P[i, 18] - abs(Z)))
+    return out
 
 
 class Delta3Generator(_Model):
@@ -295,6 +340,34 @@ class Delta3(DeltaFamily):
         W = self.leg_offsets(R)
         reach = (self.crank_length + self.rod_length)[:, None]
         return np.stack([(-W - reach).max(axis=1), (-W + reach).min(axis=1)], axis=1)
+
+    def leg_margins(self, p):
+        """Signed margins of the arms (:mod:`.delta_bracket`), ``(N, 3)``: the crank leg's
+        (:func:`.._crank_cells.crank_cell_terms`) and the cone slab's."""
+        p = np.asarray(p, dtype=float).reshape(-1, 3)
+        R = np.broadcast_to(self._rotation, (len(p), 3, 3))
+        _, _, mu, _ = crank_cell_terms(p, R, 0.0, 0.0, self.base_points, self.tool_points,
+                                       self.zero_directions, self.v_directions,
+                                       self.servo_axes, self.crank_length, self.rod_length,
+                                       self.branch, self.stroke, 0.0)
+        W = p[:, None, :] + self.tool_points @ self._rotation.T - self.base_points
+        slab = self.rod_length * math.sin(self.cone_limit) \
+            - np.abs(np.sum(W * self.servo_axes, axis=-1))
+        return np.minimum(mu, slab)
+
+    cube_margin = delta_margin
+
+    def margin_params(self) -> np.ndarray:
+        """``(3, 23)`` rows of :func:`delta_margin`."""
+        lo, hi = self.stroke
+        w = self.tool_points @ self._rotation.T - self.base_points
+        full = float(hi - lo >= 2 * math.pi * (1 - 1e-15))
+        return np.ascontiguousarray(np.column_stack([
+            w, self.zero_directions, self.v_directions, self.servo_axes, self.crank_length,
+            self.rod_length, self.branch, np.full(3, lo), np.full(3, hi), np.full(3, full),
+            self.rod_length * math.sin(self.cone_limit),
+            np.full(3, math.cos(lo)), np.full(3, math.sin(lo)), np.full(3, math.cos(hi)),
+            np.full(3, math.sin(hi))]))
 
     # ---- joints: R (motor, actuated), S at the elbow, the forearm, S at the platform ---------
     parameter_fields = (

@@ -129,6 +129,26 @@ def ldelta_column_leg(x, y, wx, wy, wz, p, zlo, zhi, out_lo, out_hi):
     return 1
 
 
+@register_jitable
+def ldelta_margin(x, y, z, P):
+    """The smallest signed leg margin at ``(x, y, z)`` (:meth:`LDelta3.leg_margins`, the
+    numba form): ``P`` rows ``w = R·t - B`` (3), ``e`` (3), ``l``, ``q_min``, ``q_max``,
+    ``l·sin(limit)``."""
+    out = np.inf
+    for i in range(P.shape[0]):
+        wx, wy, wz = x + P[i, 0], y + P[i, 1], z + P[i, 2]
+        ex, ey, ez, l, lo, hi = P[i, 3], P[i, 4], P[i, 5], P[i, 6], P[i, 7], P[i, 8]
+        c = wx * ex + wy * ey + wz * ez
+        ax, ay, az = wx - c * ex, wy - c * ey, wz - c * ez
+        reach = P[i, 9] - math.sqrt(ax * ax + ay * ay + az * az)
+        tx, ty, tz = wx - hi * ex, wy - hi * ey, wz - hi * ez
+        top = min(hi - c, math.sqrt(tx * tx + ty * ty + tz * tz) - l)
+        bx, by, bz = wx - lo * ex, wy - lo * ey, wz - lo * ez
+        bottom = max(c - lo, l - math.sqrt(bx * bx + by * by + bz * bz))
+        out = min(out, min(reach, min(top, bottom)))
+    return out
+
+
 class LDelta3Generator(_Model):
     tower_radius: PositiveLength = Field(description="distance of the towers' carriage-joint "
                                          "lines from the centre at the bed plane (mm)")
@@ -288,9 +308,40 @@ class LDelta3(DeltaFamily):
         b = ends.max(axis=0) + l - W
         return np.stack([a.max(axis=1), b.min(axis=1)], axis=1)
 
+    def leg_margins(self, p):
+        """Signed margins of the towers (:mod:`.delta_bracket`), ``(N, 3)``."""
+        W = np.asarray(p, dtype=float)[:, None, :] + self.tool_points @ self._rotation.T \
+            - self.base_points
+        e, l = self.rail_directions, self.rod_length
+        lo, hi = self.stroke
+        c = np.sum(W * e, axis=-1)
+        perp = np.linalg.norm(W - c[..., None] * e, axis=-1)
+        reach = l * math.sin(self.rod_angle_limit) - perp
+        top = np.minimum(hi - c, np.linalg.norm(W - hi * e, axis=-1) - l)
+        bottom = np.maximum(c - lo, l - np.linalg.norm(W - lo * e, axis=-1))
+        return np.minimum(reach, np.minimum(top, bottom))
+
+    cube_margin = ldelta_margin
+
+    def margin_params(self) -> np.ndarray:
+        """``(3, 10)`` rows of :func:`ldelta_margin`."""
+        lo, hi = self.stroke
+        w = self.tool_points @ self._rotation.T - self.base_points
+        return np.ascontiguousarray(np.column_stack([
+            w, self.rail_directions, self.rod_length, np.full(3, lo), np.full(3, hi),
+            self.rod_length * math.sin(self.rod_angle_limit)]))
+
+    def check_bracket(self) -> None:
+        tilt = np.arccos(np.clip(self.rail_directions[:, 2], -1.0, 1.0))
+        if np.any(~self.vertical & (tilt + self.rod_angle_limit >= math.pi / 2)):
+            raise ParameterError("rod_angle_limit", "below 90 deg minus the tower tilt for a "
+                                 "volume bracket of inclined towers (the rods then always go "
+                                 "down from the carriages: the working mode needs no margin)",
+                                 math.degrees(self.rod_angle_limit))
+
     # ---- joints: P (carriage, actuated), S at the carriage, the rod, S at the effector ------
     parameter_fields = (
-        ParamField("base_points", "tower_zero", "mm",
+        ParamField("base_points", "base", "mm",
                    "leg {i}'s carriage rod joint at actuator value 0 (base frame)"),
         DEFAULT_FIELDS[1],
         ParamField("rail_directions", "rail", "1", "leg {i}'s rail direction (up the tower)"),
