@@ -23,7 +23,7 @@ from typing import Annotated
 
 import typer
 
-from . import analysis, kinematics, optimum, study, workspace  # noqa: F401 - registers them
+from . import analysis, kinematics, optimum, printer, study, workspace  # noqa: F401 - registers them
 from .common import app
 
 __all__ = ["app", "main", "run_cli"]

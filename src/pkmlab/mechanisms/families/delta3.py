@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 from numba.extending import register_jitable
@@ -235,6 +235,13 @@ class Delta3(DeltaFamily):
 
     _ik_one = _delta3_one
     column_set_leg = delta_column_leg
+    #: named study variables (paths in the YAML model)
+    design_aliases: ClassVar[dict] = {
+        "base_radius": ("generator.base_radius", "length"),
+        "platform_radius": ("generator.platform_radius", "length"),
+        "upper_arm": ("upper_arm", "length"), "forearm": ("forearm", "length"),
+        "motor_min": ("stroke[0]", "angle"), "motor_max": ("stroke[1]", "angle"),
+        "cone_limit": ("cone_limit", "angle")}
 
     def __post_init__(self):
         set_ = object.__setattr__

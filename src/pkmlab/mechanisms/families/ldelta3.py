@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 from numba.extending import register_jitable
@@ -213,6 +213,13 @@ class LDelta3(DeltaFamily):
 
     _ik_one = _ldelta3_one
     column_set_leg = ldelta_column_leg
+    #: named study variables (paths in the YAML model)
+    design_aliases: ClassVar[dict] = {
+        "tower_radius": ("generator.tower_radius", "length"),
+        "effector_radius": ("generator.effector_radius", "length"),
+        "tilt": ("generator.tilt", "angle"), "rod_length": ("rod_length", "length"),
+        "stroke_min": ("stroke[0]", "length"), "stroke_max": ("stroke[1]", "length"),
+        "rod_angle_limit": ("rod_angle_limit", "angle")}
 
     def __post_init__(self):
         set_ = object.__setattr__
