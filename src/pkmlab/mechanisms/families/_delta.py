@@ -82,6 +82,8 @@ def trilaterate(c: np.ndarray, r: np.ndarray):
         a = (r[:, 0] ** 2 - r[:, 1] ** 2 + D ** 2) / (2 * D)
         b = (r[:, 0] ** 2 - r[:, 2] ** 2 + i ** 2 + J ** 2) / (2 * J) - i * a / J
         h2 = r[:, 0] ** 2 - a ** 2 - b ** 2
+        # a double point rounded a hair below zero (algorithm constant, relative to r²)
+        h2 = np.where((h2 < 0) & (h2 >= -1e-12 * r[:, 0] ** 2), 0.0, h2)
         h = np.sqrt(np.where(h2 >= 0, h2, np.nan))
     base = c[:, 0] + a[:, None] * ex + b[:, None] * ey
     x = np.stack([base + h[:, None] * ez, base - h[:, None] * ez], axis=1)
