@@ -58,7 +58,7 @@ def test_rotary_ik_is_the_elbow_out_root_of_the_rod_equation():
         for i in range(3):
             P = x[:3] + CLAVEL.platform_points[i]
 
-            def f(t):
+            def f(t, P=P, i=i):
                 return np.linalg.norm(P - CLAVEL.driven_points(np.array([[t, t, t]]))[0, i]) \
                     - CLAVEL.rod_length[i]
 

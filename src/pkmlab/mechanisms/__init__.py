@@ -16,6 +16,8 @@ listed in :data:`PLUGIN_ERRORS`, never fatal.
 from __future__ import annotations
 
 from .base import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult, Mechanism
+from .families.delta3 import Delta3
+from .families.ldelta3 import LDelta3
 from .joints import Joint, Leg, Link, Parameters
 from .luzi3 import Luzi3
 from .mobility import PLANAR, SPATIAL, TRANSLATIONAL, Mobility
@@ -23,8 +25,6 @@ from .psu6 import PSU6
 from .rss6 import RSS6
 from .sixleg import SixLeg
 from .ups6 import UPS6
-from .families.delta3 import Delta3  # noqa: E402 (after base: the families import it)
-from .families.ldelta3 import LDelta3  # noqa: E402
 
 #: family name → mechanism class (built-in families, then plugins once loaded)
 REGISTRY: dict[str, type[Mechanism]] = {cls.family: cls for cls in (PSU6, UPS6, Luzi3, RSS6,

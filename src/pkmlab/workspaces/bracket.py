@@ -95,6 +95,7 @@ from ..poses import as_frames, matrix_to_euler
 from . import cells as oc
 from .bracket_cells import cell_volume_bracket
 from .bracket_level import BATCH, Level
+from .bracket_octree import octree_volume_bracket
 from .bracket_result import VolumeBracket
 from .bracket_sets import connected, length, warm_up
 from .constraints import Constraints
@@ -198,8 +199,8 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
         max_cells: largest number of (column × orientation cell) items of one step (an
             orientation split that would pass it halves the x-y cells instead).
     """
-    if getattr(mech, "position_bracket", None) is not None:     # delta3, ldelta3
-        return mech.position_bracket(kind, orientations, resolution, constraints,
+    if getattr(mech, "cube_margin", None) is not None:      # delta3, ldelta3 (translational)
+        return octree_volume_bracket(mech, kind, orientations, resolution, constraints,
                                      target=target, budget_s=budget_s)
     require_spatial(mech, "volume brackets")
     t_call = time.perf_counter()

@@ -273,24 +273,14 @@ class DeltaFamily(Mechanism):
         kind = np.where(np.all(np.isfinite(q), axis=1), kind, "no solution")
         return Singularities(serial, parallel, kind.astype(object))
 
-    # ---- guaranteed volume bracket (:mod:`.delta_bracket`) ---------------------------------
+    # ---- guaranteed volume bracket (:mod:`pkmlab.workspaces.bracket_octree`) -------------
     def leg_margins(self, p: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
         """``(N, 3)`` signed margins of the legs at positions ``p (N, 3)`` (the platform's
-        orientation): see :mod:`.delta_bracket`."""
+        orientation): see :mod:`pkmlab.workspaces.bracket_octree`."""
         raise NotImplementedError
 
     def check_bracket(self) -> None:
         """Refuse, naming the field, a geometry the bracket's margins do not cover."""
-
-    def position_bracket(self, kind="constant", orientations=None, resolution=None,
-                         constraints=None, target=0.01, budget_s=30.0, **kw):
-        """The guaranteed volume bracket of the constant-orientation workspace
-        (:func:`.delta_bracket.delta_volume_bracket`; :func:`pkmlab.workspaces.bracket.
-        volume_bracket` dispatches here)."""
-        from .delta_bracket import delta_volume_bracket
-
-        return delta_volume_bracket(self, kind, orientations, resolution, constraints,
-                                    target, budget_s)
 
     # ---- exact columns -------------------------------------------------------------------
     column_method = "delta"

@@ -62,6 +62,9 @@ from ._delta import DeltaFamily
 
 __all__ = ["Delta3", "Delta3Spec"]
 
+_WINDOW = (-math.radians(60), math.radians(90))
+_ANGLES = tuple(math.radians(a) for a in (90.0, 210.0, 330.0))
+
 # g layout: B 0-8, tool points 9-17, 2a·u 18-26, 2a·v 27-35, a² - b² 36-38, degenerate
 # threshold 39-41, branch 42-44, motor axes n 45-53, b·sin(cone) 54-56
 
@@ -272,8 +275,7 @@ class Delta3(DeltaFamily):
 
     @classmethod
     def from_radii(cls, *, base_radius=200.0, platform_radius=50.0, upper_arm=350.0,
-                   forearm=800.0, stroke=(-math.radians(60), math.radians(90)),
-                   cone_limit=math.pi / 2, angles=np.radians([90.0, 210.0, 330.0]),
+                   forearm=800.0, stroke=_WINDOW, cone_limit=math.pi / 2, angles=_ANGLES,
                    tool_offset=(0.0, 0.0, 0.0), name: str = "", nominal=None) -> Delta3:
         """Pivots on the circle of radius ``base_radius`` at z = 0, platform joints on the
         circle of radius ``platform_radius``, both at ``angles`` (rad); motor axes tangent,
@@ -349,8 +351,8 @@ class Delta3(DeltaFamily):
         return np.stack([(-W - reach).max(axis=1), (-W + reach).min(axis=1)], axis=1)
 
     def leg_margins(self, p):
-        """Signed margins of the arms (:mod:`.delta_bracket`), ``(N, 3)``: the crank leg's
-        (:func:`.._crank_cells.crank_cell_terms`) and the cone slab's."""
+        """Signed margins of the arms (:mod:`pkmlab.workspaces.bracket_octree`), ``(N, 3)``:
+        the crank leg's (:func:`.._crank_cells.crank_cell_terms`) and the cone slab's."""
         p = np.asarray(p, dtype=float).reshape(-1, 3)
         R = np.broadcast_to(self._rotation, (len(p), 3, 3))
         _, _, mu, _ = crank_cell_terms(p, R, 0.0, 0.0, self.base_points, self.tool_points,

@@ -1,8 +1,9 @@
 """Does a delta robot's feasible set contain a vertical task cylinder? Decided by the signed
-leg margins of :mod:`.delta_bracket` on cubes covering the cylinder: a cube whose every leg
-margin exceeds its circumradius is inside the feasible set; a point of the cylinder whose
-inverse kinematics is invalid proves the cylinder is not contained; cubes neither proven nor
-refuted are halved, down to a depth limit (then the answer is "undecided", with the reason).
+leg margins (:mod:`pkmlab.workspaces.bracket_octree`) on cubes covering the cylinder: a cube
+whose every leg margin exceeds its circumradius is inside the feasible set; a point of the
+cylinder whose inverse kinematics is invalid proves the cylinder is not contained; cubes
+neither proven nor refuted are halved, down to a depth limit (then the answer is
+"undecided", with the reason).
 """
 
 from __future__ import annotations

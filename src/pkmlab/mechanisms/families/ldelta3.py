@@ -53,6 +53,8 @@ from ._delta import DeltaFamily
 
 __all__ = ["LDelta3", "LDelta3Spec"]
 
+_ANGLES = tuple(math.radians(a) for a in (210.0, 330.0, 90.0))     # Klipper's A, B, C
+
 # g layout: B 0-8, tool points 9-17, rails e 18-26, l² 27-29, (l sin limit)² 30-32
 
 
@@ -247,7 +249,7 @@ class LDelta3(DeltaFamily):
 
     @classmethod
     def from_towers(cls, *, tower_radius=215.0, effector_radius=40.0, rod_length=333.0,
-                    stroke=(0.0, 600.0), tilt=0.0, angles=np.radians([210.0, 330.0, 90.0]),
+                    stroke=(0.0, 600.0), tilt=0.0, angles=_ANGLES,
                     rod_angle_limit=math.pi / 2, tool_offset=(0.0, 0.0, 0.0), name: str = "",
                     nominal=None) -> LDelta3:
         """Towers at ``angles`` (rad) about z, their carriage-joint lines crossing the bed
@@ -316,7 +318,7 @@ class LDelta3(DeltaFamily):
         return np.stack([a.max(axis=1), b.min(axis=1)], axis=1)
 
     def leg_margins(self, p):
-        """Signed margins of the towers (:mod:`.delta_bracket`), ``(N, 3)``."""
+        """Signed margins of the towers (:mod:`pkmlab.workspaces.bracket_octree`), ``(N, 3)``."""
         W = np.asarray(p, dtype=float)[:, None, :] + self.tool_points @ self._rotation.T \
             - self.base_points
         e, l = self.rail_directions, self.rod_length

@@ -1,5 +1,6 @@
-"""A guaranteed volume bracket for the delta families (constant orientation: the platform
-only translates), on an octree of position cubes.
+"""A guaranteed volume bracket on an octree of position cubes, for translational families that
+give signed leg margins (``cube_margin``: the delta families ``delta3`` and ``ldelta3``,
+:mod:`pkmlab.mechanisms.families`); constant orientation (the platform only translates).
 
 Each family gives per leg a **signed margin** ``μ(p)`` (``leg_margins``): where the leg is
 feasible (its IK valid: real, in the working mode, in the window, within the joint limit),
@@ -34,21 +35,20 @@ from __future__ import annotations
 
 import math
 import time
-
 from functools import cache
 
 import numpy as np
 from numba import prange
 from numba import types as nt
 
-from ..._jit import cached_kernel
-from ...errors import ParameterError
-from ...threads import threads_for
-from ...workspaces.bracket_result import VolumeBracket
-from .. import _kernels
-from ..column_kernels import inlined
+from .._jit import cached_kernel
+from ..errors import ParameterError
+from ..mechanisms import _kernels
+from ..mechanisms.column_kernels import inlined
+from ..threads import threads_for
+from .bracket_result import VolumeBracket
 
-__all__ = ["delta_volume_bracket"]
+__all__ = ["octree_volume_bracket", "make_octree"]
 
 _SQRT3 = math.sqrt(3.0)
 
@@ -100,11 +100,12 @@ def make_octree(margin):
                          parallel=True)
 
 
-def delta_volume_bracket(mech, kind: str = "constant", orientations=None,
+def octree_volume_bracket(mech, kind: str = "constant", orientations=None,
                          resolution: float | None = None, constraints=None,
                          target: float = 0.01, budget_s: float = 30.0,
                          max_depth: int = 12) -> VolumeBracket:
-    """Bracket the constant-orientation workspace volume of a delta family (module notes).
+    """Bracket the constant-orientation workspace volume of a family with ``cube_margin``
+    (module notes).
 
     Args:
         mech: a ``delta3`` or ``ldelta3`` mechanism.
