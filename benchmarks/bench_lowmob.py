@@ -97,11 +97,11 @@ def _brute(m, xs, ys, zs):
     return out
 
 
-def bench_workspace() -> None:
+def bench_workspace(only=None) -> None:
     for name, m in _deltas().items():
-        if name == "ldelta3 inclined":
+        if name == "ldelta3 inclined" or (only and name not in only):
             continue
-        for h in ((4.0, 2.0) if name == "ldelta3" else (10.0, 5.0)):
+        for h in ((4.0, 2.0, 1.0) if name == "ldelta3" else (10.0, 5.0)):
             cons = Constraints(connected=False)
             t_ex, w = timed(lambda: workspace(m, "constant", resolution=h,   # noqa: B023
                                               constraints=cons), repeats=3)
@@ -136,4 +136,7 @@ if __name__ == "__main__":
     print(f"numba threads: {numba.get_num_threads()}")
     which = sys.argv[1:] or ["ik", "workspace", "bracket"]
     for part in which:
+        if part.startswith("workspace:"):            # workspace:ldelta3 runs one family
+            bench_workspace(part.split(":")[1:])
+            continue
         {"ik": bench_ik, "workspace": bench_workspace, "bracket": bench_bracket}[part]()

@@ -286,6 +286,9 @@ class DeltaFamily(Mechanism):
     column_method = "delta"
     #: the family's set leg ``leg(x, y, wx, wy, wz, p, zlo, zhi, out_lo, out_hi) -> n``
     column_set_leg = None
+    #: most pieces a column's set can have (``ldelta3``: 1, every leg's set is one interval),
+    #: so that the engine's arrays hold no empty slots
+    column_pieces = 8
 
     def column_params(self) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError
@@ -299,11 +302,12 @@ class DeltaFamily(Mechanism):
             raise ParameterError("orientations", "one orientation (a delta platform only "
                                  "translates)", f"{len(R)} rotations")
         xs, ys = _kernels.carray(xs), _kernels.carray(ys)
+        K = min(K, self.column_pieces)
         lo, hi = np.empty((len(xs), len(ys), K)), np.empty((len(xs), len(ys), K))
         count = np.empty((len(xs), len(ys)), dtype=np.int64)
         W = _kernels.carray(self.leg_offsets(R)[0])
-        make_columns(type(self).column_set_leg)(xs, ys, W, _kernels.carray(self.column_params()),
-                                                lo, hi, count)
+        make_columns(type(self).column_set_leg, K == 1)(
+            xs, ys, W, _kernels.carray(self.column_params()), lo, hi, count)
         if allowed is not None:
             off = ~np.asarray(allowed, dtype=bool).reshape(len(xs), len(ys), -1)[..., 0]
             lo[off], hi[off] = np.inf, -np.inf
@@ -314,12 +318,33 @@ _F1, _F2, _F3 = nt.float64[::1], nt.float64[:, ::1], nt.float64[:, :, ::1]
 
 
 @cache
-def make_columns(leg):
+def make_columns(leg, single: bool = False):
     """Parallel ``columns(xs (nx,), ys (ny,), W (L, 3), P (L, np), out_lo, out_hi (nx, ny,
     K), count (nx, ny) int64)``: the intersection over the ``L`` legs of the set leg ``leg``'s
     pieces on every column (one orientation; ``count`` is ``K + 1`` on overflow), built and
-    cached by :func:`pkmlab._jit.cached_kernel` like every family kernel."""
+    cached by :func:`pkmlab._jit.cached_kernel` like every family kernel. ``single``: every
+    leg's set is one interval (``K = 1``), intersected without the set machinery."""
     leg = inlined(leg)
+
+    def columns_single(xs, ys, W, P, out_lo, out_hi, count):
+        nx, ny, L = xs.shape[0], ys.shape[0], W.shape[0]
+        for ix in prange(nx):
+            llo = np.empty(PIECES)
+            lhi = np.empty(PIECES)
+            for iy in range(ny):
+                a = -np.inf
+                b = np.inf
+                for i in range(L):
+                    if leg(xs[ix], ys[iy], W[i, 0], W[i, 1], W[i, 2], P[i], a, b, llo,
+                           lhi) == 0:
+                        a = np.inf
+                        b = -np.inf
+                        break
+                    a = llo[0]
+                    b = lhi[0]
+                out_lo[ix, iy, 0] = a
+                out_hi[ix, iy, 0] = b
+                count[ix, iy] = 1 if a <= b else 0
 
     def columns(xs, ys, W, P, out_lo, out_hi, count):
         nx, ny, L, K = xs.shape[0], ys.shape[0], W.shape[0], out_lo.shape[2]
@@ -349,6 +374,6 @@ def make_columns(leg):
                     out_hi[ix, iy, k] = shi[k] if k < n else -np.inf
                 count[ix, iy] = K + 1 if over else n
 
-    return cached_kernel(columns, nt.void(_F1, _F1, _F2, _F2, _F3, _F3, nt.int64[:, ::1]),
-                         parallel=True)
+    return cached_kernel(columns_single if single else columns,
+                         nt.void(_F1, _F1, _F2, _F2, _F3, _F3, nt.int64[:, ::1]), parallel=True)
 

@@ -215,6 +215,7 @@ class LDelta3(DeltaFamily):
 
     _ik_one = _ldelta3_one
     column_set_leg = ldelta_column_leg
+    column_pieces = 1         # each tower's set is one interval, so is their intersection
     #: named study variables (paths in the YAML model)
     design_aliases: ClassVar[dict] = {
         "tower_radius": ("generator.tower_radius", "length"),
