@@ -7,6 +7,7 @@ shipped files.)"""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -241,3 +242,28 @@ def test_task_cylinder_proof_and_refutation():
     assert ok is False
     x = np.array([float(v) for v in why.split("(")[1].split(")")[0].split(",")])
     assert not CLAVEL.inverse(x).valid[0]
+
+
+def test_a_study_brackets_a_delta_and_still_refuses_the_tripod(tmp_path):
+    """The volume_bracket block serves a family with its own position bracket (the printer):
+    the study validates and the baseline's bracket holds its workspace volume."""
+    import yaml
+
+    from pkmlab.study import evaluators as ev_mod
+    from pkmlab.study.spec import load_study
+
+    data = {"study": "delta-bracket", "mechanism": {"file": str(
+        Path(__file__).resolve().parents[1] / "studies/mechanisms/klipper-example-ldelta3.yaml")},
+        "design": {"rod_length": {"low": "320 mm", "high": "340 mm"}},
+        "evaluate": {"workspace": {"kind": "constant", "resolution": "4 mm"},
+                     "volume_bracket": {"budget": 20, "target": 0.02}},
+        "objectives": [{"maximize": "workspace_volume_lower"}],
+        "optimizer": {"method": "sobol", "samples": 2}, "output": str(tmp_path / "out")}
+    path = tmp_path / "s.yaml"
+    path.write_text(yaml.safe_dump(data))
+    s = load_study(path)
+    rec = ev_mod.evaluate_design(s.space, None, s.evaluation, s.seed)
+    assert rec["status"] == "ok", rec
+    m = rec["metrics"]
+    assert m["workspace_volume_lower"] <= m["workspace_volume"] <= m["workspace_volume_upper"]
+    assert m["workspace_volume_bracket_width"] <= 2.0
