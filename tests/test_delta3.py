@@ -267,3 +267,31 @@ def test_a_study_brackets_a_delta_and_still_refuses_the_tripod(tmp_path):
     m = rec["metrics"]
     assert m["workspace_volume_lower"] <= m["workspace_volume"] <= m["workspace_volume_upper"]
     assert m["workspace_volume_bracket_width"] <= 2.0
+
+
+def test_printer_block_and_command(tmp_path):
+    """evaluate.printer is refused for a rotary delta, naming the block; `pkmlab printer`
+    prints the envelope and a firmware snippet, and refuses a rotary delta in one line."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from pkmlab.cli import app
+    from pkmlab.errors import ParameterError
+    from pkmlab.study.spec import load_study
+
+    root = Path(__file__).resolve().parents[1] / "studies" / "mechanisms"
+    data = {"study": "p", "mechanism": {"file": str(root / "clavel-delta3.yaml")},
+            "design": {"forearm": {"low": "700 mm", "high": "800 mm"}},
+            "evaluate": {"printer": {}}, "objectives": [{"maximize": "printable_volume"}],
+            "optimizer": {"method": "sobol", "samples": 2}, "output": str(tmp_path / "o")}
+    path = tmp_path / "s.yaml"
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(ParameterError, match=r"evaluate.printer .*printer needs linear actuators"):
+        load_study(path)
+    r = CliRunner().invoke(app, ["printer", str(root / "klipper-example-ldelta3.yaml"),
+                                 "--firmware", "reprap"])
+    assert r.exit_code == 0 and "M665 L333.000 R174.750 H297.050 B158.250" in r.output
+    r = CliRunner().invoke(app, ["printer", str(root / "klipper-example-ldelta3.yaml")])
+    assert r.exit_code == 0 and "printable cylinder: r = 158.250 mm" in r.output
+    r = CliRunner().invoke(app, ["printer", str(root / "clavel-delta3.yaml")])
+    assert r.exit_code == 2 and "mechanism: must be a linear delta" in r.output
