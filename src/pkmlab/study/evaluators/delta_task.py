@@ -33,9 +33,9 @@ class DeltaTask(Evaluator):
         metric("delta_task_contained", "", "guaranteed",
                "1 if the task cylinder is proven inside the feasible set, 0 if a position of "
                "it is proven outside (null with a note when the search stops undecided)"),
-        metric("delta_task_kappa_max", "", "sampled",
+        metric("sampled_delta_task_kappa_max", "", "sampled",
                "largest condition number of the 3 × 3 Jacobian over a grid of the cylinder"),
-        metric("delta_task_speed_max", "mm/s per unit/s", "sampled",
+        metric("sampled_delta_task_speed_max", "mm/s per unit/s", "sampled",
                "largest tool speed per unit actuator speed (the largest column norm of J⁻¹) "
                "over the same grid"),
     )
@@ -59,17 +59,18 @@ class DeltaTask(Evaluator):
         J = mech.jacobian(P)
         good = ik.valid & np.all(np.isfinite(J), axis=(1, 2))
         if not good.any():
-            for n in ("delta_task_kappa_max", "delta_task_speed_max"):
+            for n in ("sampled_delta_task_kappa_max", "sampled_delta_task_speed_max"):
                 out[n] = None
                 ctx.notes[n] = "no sample of the cylinder is feasible"
             return out
         s = np.linalg.svd(J[good], compute_uv=False)
         kappa = s[:, 0] / s[:, -1]
-        out["delta_task_kappa_max"] = float(np.max(kappa)) if good.all() else None
-        out["delta_task_speed_max"] = float(np.max(np.linalg.norm(np.linalg.inv(J[good]), axis=1)))
+        out["sampled_delta_task_kappa_max"] = float(np.max(kappa)) if good.all() else None
+        speed = np.linalg.norm(np.linalg.inv(J[good]), axis=1)
+        out["sampled_delta_task_speed_max"] = float(np.max(speed))
         if not good.all():
-            ctx.notes["delta_task_kappa_max"] = (f"{int((~good).sum())} of {len(P)} samples are "
-                                           "infeasible")
+            ctx.notes["sampled_delta_task_kappa_max"] = (
+                f"{int((~good).sum())} of {len(P)} samples are infeasible")
         return out
 
 

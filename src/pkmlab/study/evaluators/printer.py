@@ -41,11 +41,11 @@ class Printer(Evaluator):
         metric("printable_height", "mm", "exact",
                "its height (given, or of the largest-volume cylinder, to 1e-6 mm)"),
         metric("printable_volume", "cm³", "exact", "its volume π·r²·h"),
-        metric("printer_step_xy", "mm", "sampled",
+        metric("sampled_printer_step_xy", "mm", "sampled",
                "worst tool motion in x or y for one carriage step over a grid of the "
                "cylinder's mid-height disc"),
-        metric("printer_step_z", "mm", "sampled", "the same in z"),
-        metric("printer_speed_ratio", "", "sampled",
+        metric("sampled_printer_step_z", "mm", "sampled", "the same in z"),
+        metric("sampled_printer_speed_ratio", "", "sampled",
                "largest tower/XY speed ratio (carriage speed per unit XY tool speed) over "
                "the same grid; inf on a serial singularity (a rod at right angles to its "
                "tower)"),
@@ -61,7 +61,8 @@ class Printer(Evaluator):
         cyl = dp.printable_cylinder(mech, plan.bed, plan.height)
         out = {"printable_radius": cyl.radius, "printable_height": cyl.height,
                "printable_volume": cyl.volume_mm3 / 1e3}
-        names = ("printer_step_xy", "printer_step_z", "printer_speed_ratio")
+        names = ("sampled_printer_step_xy", "sampled_printer_step_z",
+                 "sampled_printer_speed_ratio")
         if cyl.radius <= 0:
             for n in names:
                 out[n] = None
@@ -72,9 +73,9 @@ class Printer(Evaluator):
         ratio = dp.speed_ratio_map(mech, zm, cyl.radius, n=plan.grid)["ratio"]
         disc = np.hypot(*np.meshgrid(res["x"], res["y"], indexing="ij")) <= cyl.radius
         worst = float(np.nanmax(np.where(disc, ratio, np.nan)))
-        out.update(printer_step_xy=float(max(res["worst"][:2])),
-                   printer_step_z=float(res["worst"][2]),
-                   printer_speed_ratio=worst if math.isfinite(worst) else math.inf)
+        out.update(sampled_printer_step_xy=float(max(res["worst"][:2])),
+                   sampled_printer_step_z=float(res["worst"][2]),
+                   sampled_printer_speed_ratio=worst if math.isfinite(worst) else math.inf)
         return out
 
 
