@@ -112,6 +112,8 @@ class DeltaFamily(Mechanism):
     """Base of the delta families: a translating platform on three rod legs (module notes)."""
 
     mobility = TRANSLATIONAL
+    #: forward kinematics and assembly modes are complete (closed form), not a search
+    closed_form_modes = True
 
     # ---- what a delta family provides --------------------------------------------------------
     def driven_points(self, q: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
