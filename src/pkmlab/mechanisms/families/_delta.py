@@ -50,7 +50,7 @@ from .._crank import PIECES
 from .._set_columns import intersect_sets
 from ..base import NO_STROKE, Mechanism
 from ..column_kernels import inlined
-from ..mobility import TRANSLATIONAL
+from ..mobility import POSE, TRANSLATIONAL
 from ..results import AssemblyModes, FKResult
 
 __all__ = ["trilaterate", "DeltaFamily", "Singularities", "make_columns"]
@@ -223,7 +223,7 @@ class DeltaFamily(Mechanism):
             return FKResult(pose=pose, converged=ok, residual=res, iterations=it,
                             status=status.astype(object))
         other = ok & work[np.arange(n), 1 - k]
-        nxt = np.full((n, 6), np.nan)
+        nxt = np.full((n, len(POSE)), np.nan)
         nxt[other] = frames_to_poses(x[other, 1 - k[other]],
                                      np.ascontiguousarray(R[other]))
         dmm = np.where(other, np.linalg.norm(x[:, 0] - x[:, 1], axis=1), np.inf)
@@ -241,7 +241,7 @@ class DeltaFamily(Mechanism):
         q = np.asarray(q, dtype=float).reshape(1, 3)
         x, h2, Rn = self._fk_candidates(q)
         if not (self._q_domain(q)[0] and h2[0] >= 0):
-            return AssemblyModes(np.zeros((0, 6)), np.zeros(0), np.zeros(0, bool),
+            return AssemblyModes(np.zeros((0, len(POSE))), np.zeros(0), np.zeros(0, bool),
                                  np.zeros(0), 0)
         p = x[0] if h2[0] > 0 else x[0, :1]
         R = np.ascontiguousarray(np.broadcast_to(Rn, (len(p), 3, 3)))
