@@ -257,10 +257,11 @@ MECH_WORDING = [
     ("luzi-3chain", {"strok": [1, 2], "stroke": None},
      "strok: must be a known key (did you mean 'stroke'? known keys: base_points, family, "),
     ("luzi-3chain", {"family": None},
-     "family: must be given (one of 'psu6', 'ups6', 'luzi3', 'rss6', 'sixleg', 'rpr3', "
-     "'fivebar', 'prs3'); got nothing"),
+     "family: must be given (one of 'psu6', 'ups6', 'luzi3', 'rss6', 'sixleg', 'delta3', "
+     "'ldelta3', 'rpr3', 'fivebar', 'prs3'); got nothing"),
     ("luzi-3chain", {"family": "luzi"}, "family: must be one of 'psu6', 'ups6', 'luzi3', 'rss6', "
-                                        "'sixleg', 'rpr3', 'fivebar', 'prs3'; got 'luzi'"),
+                                        "'sixleg', 'delta3', 'ldelta3', 'rpr3', 'fivebar', "
+                                        "'prs3'; got 'luzi'"),
     ("hopkins-williams-6psu", {"name": [1]}, "name: must be text; got [1]"),
     ("hopkins-williams-6psu", {"generator": {"pairing": "x"}},
      "generator.pairing: must be 'same' or 'crossed'; got 'x'"),

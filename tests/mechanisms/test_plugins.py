@@ -70,8 +70,8 @@ def test_without_the_plugin_its_family_is_unknown():
                           str(PLUGIN / "legs6-demo.yaml")], capture_output=True, text=True,
                          env=_env(), timeout=600)
     assert run.returncode != 0
-    assert ("must be one of 'psu6', 'ups6', 'luzi3', 'rss6', 'sixleg', 'rpr3', 'fivebar', "
-            "'prs3'; got 'legs6'") in run.stderr
+    assert ("must be one of 'psu6', 'ups6', 'luzi3', 'rss6', 'sixleg', 'delta3', 'ldelta3', "
+            "'rpr3', 'fivebar', 'prs3'; got 'legs6'") in run.stderr
 
 
 def test_a_broken_plugin_is_reported_not_fatal(tmp_path):
@@ -84,6 +84,6 @@ def test_a_broken_plugin_is_reported_not_fatal(tmp_path):
     run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                          env=_env(tmp_path), timeout=600)
     assert run.returncode == 0, run.stderr
-    assert run.stdout.strip() == ("['fivebar', 'luzi3', 'prs3', 'psu6', 'rpr3', 'rss6', "
-                                  "'sixleg', 'ups6'] ModuleNotFoundError")
+    assert run.stdout.strip() == ("['delta3', 'fivebar', 'ldelta3', 'luzi3', 'prs3', 'psu6', "
+                                  "'rpr3', 'rss6', 'sixleg', 'ups6'] ModuleNotFoundError")
     assert "not loaded" in run.stderr

@@ -23,7 +23,15 @@ from typing import Annotated
 
 import typer
 
-from . import analysis, export, kinematics, optimum, study, workspace  # noqa: F401 - registers
+from . import (  # noqa: F401 - registers the commands
+    analysis,
+    export,
+    kinematics,
+    optimum,
+    printer,
+    study,
+    workspace,
+)
 from .common import app
 
 __all__ = ["app", "main", "run_cli"]

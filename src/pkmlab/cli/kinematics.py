@@ -166,6 +166,9 @@ def fk(mech_file: MechArg,
                   f"actuator values, {res.next_mode_mm[0]:.4g} mm and "
                   f"{res.next_mode_deg[0]:.4g}° away: {_pose_str(res.next_mode[0], mech)} "
                   "(--all lists every mode found)")
+    elif res.converged[0] and getattr(mech, "closed_form_modes", False):
+        out.print("every assembly mode found in closed form: no other one is in the working "
+                  "mode (--all lists them)")
     elif res.converged[0]:
         out.print(f"no other working-mode assembly mode reached from {res.mode_starts} starts "
                   "in the working region (a search, not a proof; --all searches wider)")

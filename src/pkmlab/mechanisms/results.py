@@ -24,6 +24,7 @@ LEG_STATUS = {
     _kernels.NO_SOLUTION: "no real solution",
     _kernels.INVALID_INPUT: "non-finite pose",
     _kernels.OTHER_MODE: "leg outside the working mode",
+    _kernels.JOINT_LIMIT: "passive joint beyond its limit",
 }
 
 

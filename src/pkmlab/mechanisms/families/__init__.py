@@ -6,7 +6,9 @@ are. The generic six-leg family's YAML model builds through the paired-circle ge
 other families, so it lives in :mod:`.sixleg_spec` and is given at registration.
 """
 
+from .delta3 import Delta3
 from .fivebar import FiveBar
+from .ldelta3 import LDelta3
 from .luzi3 import Luzi3
 from .prs3 import Prs3
 from .psu6 import PSU6
@@ -16,9 +18,9 @@ from .sixleg import SixLeg
 from .sixleg_spec import SixLegSpec
 from .ups6 import UPS6
 
-__all__ = ["BUILTIN_FAMILIES", "PSU6", "UPS6", "Luzi3", "RSS6", "SixLeg", "Rpr3", "FiveBar",
-           "Prs3"]
+__all__ = ["BUILTIN_FAMILIES", "PSU6", "UPS6", "Luzi3", "RSS6", "SixLeg", "Delta3", "LDelta3",
+           "Rpr3", "FiveBar", "Prs3"]
 
 #: ``(family class, YAML model given at registration or None)``, in registration order
 BUILTIN_FAMILIES = ((PSU6, None), (UPS6, None), (Luzi3, None), (RSS6, None), (SixLeg, SixLegSpec),
-                    (Rpr3, None), (FiveBar, None), (Prs3, None))
+                    (Delta3, None), (LDelta3, None), (Rpr3, None), (FiveBar, None), (Prs3, None))

@@ -97,6 +97,9 @@ __all__ = ["BLOCK", "ROW", "carray", "make_driver", "make_jacobian_driver",
 OK, BELOW_STROKE, ABOVE_STROKE, DEGENERATE, NO_SOLUTION, INVALID_INPUT = 0, 1, 2, 3, 4, 5
 # A leg on the other side of its base joint than at the nominal pose (another assembly mode).
 OTHER_MODE = 6
+#: A leg whose passive joint is beyond its declared limit (delta3's forearm ball-joint cone,
+#: ldelta3's rod angle): the actuator value is still reported.
+JOINT_LIMIT = 8
 #: Reason of a pose whose per-pose function wrote another number of legs than the family
 #: declares (``Mechanism.n_actuators``); the mechanism raises on it.
 LEG_FAULT = 7

@@ -10,7 +10,8 @@ block. It declares, beside its computation:
 * ``metrics`` — the :class:`~pkmlab.study.metrics.Metric` s it writes (name, unit, kind,
   meaning; declared with :func:`metric`);
 * ``requires`` — what the study must offer: ``"rotations"`` (a free orientation coordinate),
-  ``"spatial"`` (all six pose coordinates free), ``"rotary actuator"`` / ``"linear actuator"``
+  ``"spatial"`` (all six pose coordinates free), ``"bracket"`` (spatial, or a family with its
+  own position bracket: ``cube_margin``), ``"rotary actuator"`` / ``"linear actuator"``
   (the mechanism's actuators), or another evaluator's name (its block must be given);
   :func:`pkmlab.study.load_study` refuses a study that asks an evaluator what the mechanism or
   the study cannot offer, naming ``evaluate.<name>``;
@@ -52,7 +53,7 @@ PLUGIN_ERRORS: dict[str, str] = {}
 EVALUATORS: dict[str, Evaluator] = {}
 
 #: what an evaluator can require of the mechanism, checked in this order
-MECHANISM_NEEDS = ("rotations", "rotary actuator", "linear actuator", "spatial")
+MECHANISM_NEEDS = ("rotations", "rotary actuator", "linear actuator", "spatial", "bracket")
 
 #: ``Evaluator.absent``: nothing written back when the block is not given
 OMIT = object()
@@ -221,7 +222,9 @@ def load_evaluator_plugins() -> dict[str, Evaluator]:
 
 _NEED_TEXT = {"rotations": "rotations (a free orientation coordinate)",
               "spatial": "six free pose coordinates (x, y, z, theta_x, theta_y, theta_z)",
-              "rotary actuator": "rotary actuators", "linear actuator": "linear actuators"}
+              "rotary actuator": "rotary actuators", "linear actuator": "linear actuators",
+              "bracket": "six free pose coordinates (x, y, z, theta_x, theta_y, theta_z), or "
+                         "a family bracketing its positions (cube margins: delta3, ldelta3)"}
 
 
 def _offers(mech, need: str) -> bool:
@@ -229,12 +232,14 @@ def _offers(mech, need: str) -> bool:
         return bool(mech.mobility.rotations)
     if need == "spatial":
         return bool(mech.mobility.is_spatial)
+    if need == "bracket":
+        return bool(mech.mobility.is_spatial) or getattr(mech, "cube_margin", None) is not None
     rotary = mech.actuator_unit == "rad"
     return rotary if need == "rotary actuator" else not rotary
 
 
 def _has(mech, need: str) -> str:
-    if need in ("rotations", "spatial"):
+    if need in ("rotations", "spatial", "bracket"):
         mob = mech.mobility
         return f"{mob.name} mobility ({', '.join(mob.coordinates)})"
     return ("rotary actuators (rad)" if mech.actuator_unit == "rad"

@@ -27,7 +27,8 @@ class VolumeBracket(Evaluator):
     name = "volume_bracket"
     block = VolumeBracketSpec
     description = VolumeBracketSpec.__doc__
-    requires = frozenset({"spatial", "workspace"})   # the bracket: six coordinates
+    # six coordinates, or a family with its own position bracket (delta3, ldelta3)
+    requires = frozenset({"bracket", "workspace"})
     after = ("workspace",)
     metrics = (
         metric("workspace_volume_lower", "cm³", "guaranteed",

@@ -98,6 +98,7 @@ from ..orientations import OrientationSet
 from .cells import cell_volume_bracket
 from .legbounds import Legs
 from .level import BATCH, Level
+from .octree import octree_volume_bracket
 from .result import VolumeBracket
 from .sets import connected, length, warm_up
 
@@ -198,6 +199,9 @@ def volume_bracket(mech, kind: str = "constant", orientations: OrientationSet | 
         max_cells: largest number of (column × orientation cell) items of one step (an
             orientation split that would pass it halves the x-y cells instead).
     """
+    if getattr(mech, "cube_margin", None) is not None:      # delta3, ldelta3 (translational)
+        return octree_volume_bracket(mech, kind, orientations, resolution, constraints,
+                                     target=target, budget_s=budget_s)
     require_spatial(mech, "volume brackets")
     t_call = time.perf_counter()
     mech, oset, cons = _request(mech, kind, orientations, resolution, constraints)

@@ -1,0 +1,142 @@
+"""Lower-mobility families (issue 24): the delta robots against the six-DOF families.
+
+1. IK throughput per family on 10⁶ poses, as actuator values per second (poses/s × actuators),
+   against the six-DOF families' (psu6, ups6, rss6) in the same run: each delta must stay
+   within 2× of their mean per-actuator rate.
+2. The exact workspace (constant orientation, columns exact in z) against a plain NumPy brute
+   force on the same grid (the engine's x-y columns, z at the same spacing h), in the same
+   run; each delta must be >= 1000× faster, and every feasible voxel of the brute force must
+   lie in the exact set.
+3. The time to a 1 % guaranteed volume bracket (:mod:`pkmlab.workspaces.bracket_octree`).
+
+Run: .venv/bin/python benchmarks/bench_lowmob.py [ik|workspace|bracket ...]
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from pathlib import Path
+
+import numba
+import numpy as np
+from _timing import timed
+
+import pkmlab
+from pkmlab.mechanisms.families.ldelta3 import LDelta3
+from pkmlab.workspaces import Constraints, workspace
+from pkmlab.workspaces.bracket.columns import volume_bracket
+
+ROOT = Path(__file__).resolve().parents[1]
+MECH = ROOT / "studies" / "mechanisms"
+SIX = {"psu6": "hopkins-williams-6psu.yaml", "ups6": "gough-stewart-6ups.yaml",
+       "rss6": "instructables-servo-6rss.yaml"}
+DELTAS = {"delta3": "clavel-delta3.yaml", "ldelta3": "klipper-example-ldelta3.yaml"}
+N_IK = 1_000_000
+CONNECTED_OFF = Constraints(connected=False)      # the brute force keeps every component
+
+
+def _deltas():
+    out = {k: pkmlab.load_mechanism(MECH / f) for k, f in DELTAS.items()}
+    out["ldelta3 inclined"] = LDelta3.from_towers(tilt=math.radians(12),
+                                                 rod_angle_limit=math.radians(60))
+    return out
+
+
+def bench_ik() -> None:
+    rng = np.random.default_rng(0)
+    rates = {}
+    mechs = {k: pkmlab.load_mechanism(MECH / f) for k, f in SIX.items()} | _deltas()
+    for name, m in mechs.items():
+        ang = 15.0 if m.mobility.rotations else 0.0
+        X = m.nominal_pose + np.concatenate(
+            [rng.uniform(-40, 40, (N_IK, 3)), np.radians(rng.uniform(-ang, ang, (N_IK, 3)))],
+            axis=1)
+        t, ik = timed(lambda: m.inverse(X))                    # noqa: B023
+        rates[name] = N_IK * m.n_actuators / t
+        print(f"{name:17s} IK {N_IK / t / 1e6:6.1f} M poses/s  {rates[name] / 1e6:6.1f} M "
+              f"actuators/s  ({m.n_actuators} actuators, {ik.valid.mean():.0%} valid)")
+    six = np.mean([rates[k] for k in SIX])
+    for name in rates:
+        if name in SIX:
+            continue
+        ratio = rates[name] / six
+        print(f"{name:17s} per-actuator rate {ratio:.2f}× the six-DOF mean "
+              f"({six / 1e6:.1f} M/s): {'ok' if ratio >= 0.5 else 'SLOWER THAN 2x'}")
+
+
+def _brute(m, xs, ys, zs):
+    """Plain NumPy: the IK validity of every voxel centre (x slab by x slab), written here
+    from the families' formulas (vertical towers; rotary arms), not the kernels."""
+    out = np.zeros((len(xs), len(ys), len(zs)), dtype=bool)
+    Y, Z = np.meshgrid(ys, zs, indexing="ij")
+    for i, x in enumerate(xs):
+        p = np.stack([np.full(Y.shape, x), Y, Z], axis=-1)[..., None, :]      # (ny, nz, 1, 3)
+        W = p + m.tool_points - m.base_points                              # (ny, nz, 3, 3)
+        if m.family == "ldelta3":
+            lo, hi = m.stroke
+            h2 = m.rod_length ** 2 - W[..., 0] ** 2 - W[..., 1] ** 2
+            with np.errstate(invalid="ignore"):
+                q = W[..., 2] + np.sqrt(h2)
+            ok = (h2 >= 0) & (q >= lo) & (q <= hi) \
+                & (h2 >= (m.rod_length * math.cos(m.rod_angle_limit)) ** 2 - 1e-9)
+        else:
+            a, s, b = m.crank_length, m.rod_length, m.branch
+            x_ = np.sum(W * m.zero_directions, axis=-1)
+            y_ = np.sum(W * m.v_directions, axis=-1)
+            E, F = 2 * a * x_, 2 * a * y_
+            G = np.sum(W * W, axis=-1) + a * a - s * s
+            h2 = E * E + F * F - G * G
+            with np.errstate(invalid="ignore"):
+                h = np.sqrt(h2)
+                th = np.arctan2(F * G + b * E * h, E * G - b * F * h)
+            cone = np.abs(np.sum(W * m.servo_axes, axis=-1)) <= s * math.sin(m.cone_limit)
+            lo, hi = m.stroke
+            ok = (h2 >= 0) & (E * E + F * F > 1e-24 * a ** 4) & (th >= lo) & (th <= hi) & cone
+        out[i] = np.all(ok, axis=-1)
+    return out
+
+
+def bench_workspace(only=None) -> None:
+    for name, m in _deltas().items():
+        if name == "ldelta3 inclined" or (only and name not in only):
+            continue
+        for h in ((4.0, 2.0, 1.0) if name == "ldelta3" else (10.0, 5.0)):
+            t_ex, w = timed(lambda: workspace(m, "constant", resolution=h,   # noqa: B023
+                                              constraints=CONNECTED_OFF), repeats=3)
+            t_col = w.timings["columns_s"]
+            box = m.position_bounds(np.eye(3)[None])[0]
+            zs = np.arange(math.ceil(box[0, 2] / h), math.floor(box[1, 2] / h) + 1) * h
+            t = time.perf_counter()
+            occ = _brute(m, w.xs, w.ys, zs)
+            t_bf = time.perf_counter() - t
+            X, Y, Z = np.meshgrid(w.xs, w.ys, zs, indexing="ij")
+            inside = np.zeros_like(occ)
+            for k in range(w.lo.shape[-1]):
+                inside |= (Z >= w.lo[..., k:k + 1] - 1e-9) & (Z <= w.hi[..., k:k + 1] + 1e-9)
+            missed = int(np.sum(occ & ~inside))
+            print(f"{name:8s} h = {h:4.1f} mm: {len(w.xs)} × {len(w.ys)} columns, "
+                  f"{occ.size:,} voxels; exact {t_ex * 1e3:7.1f} ms (column kernel "
+                  f"{t_col * 1e3:6.1f} ms), NumPy brute force {t_bf:6.2f} s: "
+                  f"{t_bf / t_ex:6.0f}× (kernel {t_bf / t_col:6.0f}×); volume exact "
+                  f"{w.volume / 1e6:.4f} L, brute {occ.sum() * h ** 3 / 1e6:.4f} L; "
+                  f"feasible voxels outside the exact set: {missed}")
+
+
+def bench_bracket() -> None:
+    for name, m in _deltas().items():
+        b = volume_bracket(m, target=0.01, budget_s=300.0)
+        print(f"{name:17s} 1 % bracket [{b.lower / 1e6:.4f}, {b.upper / 1e6:.4f}] L "
+              f"({100 * b.relative_width:.2f} %), {b.stop_reason}, {b.seconds:.1f} s "
+              f"(set-up {b.setup_seconds:.1f} s), final cube {b.resolution:.3g} mm")
+
+
+if __name__ == "__main__":
+    print(f"numba threads: {numba.get_num_threads()}")
+    which = sys.argv[1:] or ["ik", "workspace", "bracket"]
+    for part in which:
+        if part.startswith("workspace:"):            # workspace:ldelta3 runs one family
+            bench_workspace(part.split(":")[1:])
+            continue
+        {"ik": bench_ik, "workspace": bench_workspace, "bracket": bench_bracket}[part]()
