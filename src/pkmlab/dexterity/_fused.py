@@ -26,7 +26,6 @@ import numpy as np
 from numba import prange
 from numba import types as nt
 
-from ..mechanisms.base import Mechanism
 from ..runtime.jit import cached_kernel
 from ..runtime.threads import threads_for
 from ._linalg import sweep_one
@@ -38,12 +37,11 @@ _TASK = 512
 
 
 def fused_available(mech) -> bool:
-    """True when :func:`fused_sweep` serves ``mech``: a spatial mechanism whose Jacobian is
-    the family's numba ``_jac_one`` without actuator values."""
-    cls = type(mech)
-    return (cls._jac_one is not None and not cls._jac_uses_q
-            and cls._jacobian is Mechanism._jacobian and mech.mobility.is_spatial
-            and mech.n_actuators == 6)
+    """True when :func:`fused_sweep` serves ``mech``: a spatial mechanism of six actuators
+    whose Jacobian is the family's numba per-pose function without actuator values
+    (:meth:`~pkmlab.mechanisms.base.Mechanism.jacobian_kernel`)."""
+    kernel = getattr(mech, "jacobian_kernel", None)      # a plugin need not derive from it
+    return mech.n_actuators == 6 and kernel is not None and kernel() is not None
 
 
 @cache
@@ -91,7 +89,7 @@ def fused_sweep(mech, P, R, feas, L, fmax):
     feas = np.require(feas, np.bool_, ("C", "A", "W"))
     fmax = np.require(np.broadcast_to(fmax, (6,)), np.float64, ("C", "A", "W"))
     kup, force, det = np.empty((k, U)), np.empty((k, U)), np.empty((k, U))
-    g = mech._ik_geometry
+    jac, g = mech.jacobian_kernel()
     with threads_for(U * k):
-        _kernel(type(mech)._jac_one, len(g))(P, R, feas, g, float(L), fmax, kup, force, det)
+        _kernel(jac, len(g))(P, R, feas, g, float(L), fmax, kup, force, det)
     return kup.T, force.T, det.T

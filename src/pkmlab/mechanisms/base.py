@@ -445,6 +445,17 @@ class Mechanism(JointsMixin):
         return (IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st),
                 self._free_columns(J))
 
+    def jacobian_kernel(self) -> tuple | None:
+        """``(jac, g)`` when :meth:`jacobian` is the family's numba per-pose Jacobian ``jac``
+        (``_jac_one``) with the geometry tuple ``g`` and no actuator values, over all six
+        twist components; else None. For numba loops that fuse it with their own per-pose work
+        (:mod:`pkmlab.dexterity._fused`)."""
+        cls = type(self)
+        if (cls._jac_one is None or cls._jac_uses_q or cls._jacobian is not Mechanism._jacobian
+                or not self.mobility.is_spatial):
+            return None
+        return cls._jac_one, self._ik_geometry
+
     def jacobian(self, poses) -> np.ndarray:
         """Analytic velocity Jacobian ``(N, L, width)``: ``q̇ = J · t``, ``t`` the free
         components of the twist ``[v; ω]`` (all six for a spatial mechanism).
