@@ -13,7 +13,7 @@ BROWSER := $(VENV)/.chromium
 export UV_PYTHON_DOWNLOADS := never
 export UV_PROJECT_ENVIRONMENT := $(VENV)
 
-.PHONY: demo test bench clean bytecode lock lock-check fresh-check
+.PHONY: demo test bench clean bytecode lock lock-check fresh-check kernels
 
 $(UV): tools/uv-requirements.txt
 	$(PYTHON) -m venv $(UVENV)
@@ -23,7 +23,14 @@ $(UV): tools/uv-requirements.txt
 # --locked: fails, naming the cause, if uv.lock does not match pyproject.toml
 $(STAMP): pyproject.toml uv.lock | $(UV)
 	$(UV) sync --locked --extra dev --python $(PYTHON)
+	@$(MAKE) --no-print-directory kernels
 	touch $(STAMP)
+
+# numba's disk cache of the demo study's kernels, filled once after installing (about 35 s of
+# CPU), so that the first `make demo` loads them instead of compiling them in every worker;
+# kernels are keyed by their source, so after an edit only what changed compiles again
+kernels:
+	@$(PY) -m pkmlab.study.warm || echo "note: the kernel cache was not warmed; the first run compiles"
 
 # the lock matches pyproject.toml (run by `make test`, so by CI)
 lock-check: | $(UV)

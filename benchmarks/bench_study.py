@@ -6,15 +6,29 @@ paper's motion) on 2 joblib workers, after one warm-up batch per worker (numba
 compilation), and prints the rate and the time 5,000 candidates take at that rate.
 ``--full`` evaluates all 5,000.
 Target on 2 cores: 5,000 candidates in ≤ 5 minutes.
+
+On a shared machine wall time measures the other users too. ``--cpu`` evaluates the same
+candidates in this process instead, one numba thread (as a study worker), and reports the CPU
+time per candidate (``time.process_time``) and the rate two idle cores would give.
+``--compare SRC`` runs ``--cpu`` alternately with the sources in ``SRC`` (a baseline checkout's
+``src``) and with this checkout's, twice each, in fresh processes with their own kernel caches,
+and reports the ratio in that one run (issue 28), with the load average and whether the two
+give identical metrics for every candidate.
+
+    python benchmarks/bench_study.py [--full | --cpu [N] | --compare SRC [N]]
 """
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
 import sys
 import time
 import warnings
 from pathlib import Path
 
+import numpy as np
 from scipy.stats import qmc
 
 from pkmlab.study import evaluate_design, load_study
@@ -23,7 +37,77 @@ from pkmlab.study.runners import JoblibRunner
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def _tasks(study, n):
+    space = study.space
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)        # n need not be a power of 2
+        u = qmc.Sobol(d=len(space.variables), scramble=True, seed=0).random(n + 16)
+    return [(i, (space, space.from_unit(r), study.evaluation, study.seed))
+            for i, r in enumerate(u)]
+
+
+def cpu_mode(n: int) -> dict:
+    """CPU seconds per candidate in this process (one numba thread), after 4 warm-ups."""
+    from pkmlab.runtime.threads import single_thread_worker
+
+    single_thread_worker()
+    study = load_study(ROOT / "studies/hopkins-6psu-redesign.yaml")
+    tasks = _tasks(study, n)
+    for _, args in tasks[:4]:
+        evaluate_design(*args)
+    cpu, metrics = [], []
+    for _, args in tasks[16:16 + n]:
+        c0 = time.process_time()
+        r = evaluate_design(*args)
+        cpu.append(time.process_time() - c0)
+        metrics.append({k: r[k] for k in sorted(r) if k not in ("seconds", "timings")})
+    return {"cpu": cpu, "metrics": json.dumps(metrics, sort_keys=True, default=str)}
+
+
+def compare(base_src: str, n: int) -> None:
+    here = str(ROOT / "src")
+    runs = {"before": [], "now": []}
+    out = {}
+    loads = [os.getloadavg()[0]]
+    for rep in range(3):                       # the first round only fills the kernel caches
+        for name, src in (("before", base_src), ("now", here)):
+            env = {**os.environ, "PYTHONPATH": src,
+                   "NUMBA_CACHE_DIR": f"/tmp/numba-bench-study-{name}-{os.getuid()}"}
+            proc = subprocess.run([sys.executable, __file__, "--cpu-json", str(n)], env=env,
+                                  capture_output=True, text=True, check=True)
+            res = json.loads(proc.stdout.splitlines()[-1])
+            if rep:
+                runs[name].append(np.median(res["cpu"]))
+                out[name] = res["metrics"]
+                loads.append(os.getloadavg()[0])
+    a, b = np.median(runs["before"]), np.median(runs["now"])
+    print(f"demo study, {n} candidates per run, one numba thread, CPU time per candidate "
+          f"(median; 2 runs each, alternating); load average {min(loads):.2f}-{max(loads):.2f}"
+          " (2 cores)")
+    print(f"  before ({base_src}): {1e3 * a:.0f} ms -> {2 / a:.1f} candidates/s on 2 idle cores")
+    print(f"  now    ({here}): {1e3 * b:.0f} ms -> {2 / b:.1f} candidates/s on 2 idle cores")
+    print(f"  ratio: {a / b:.2f}x; identical metrics for every candidate: "
+          f"{out['before'] == out['now']}")
+
+
 def main() -> None:
+    if "--cpu-json" in sys.argv:
+        print(json.dumps(cpu_mode(int(sys.argv[sys.argv.index("--cpu-json") + 1]))))
+        return
+    if "--compare" in sys.argv:
+        i = sys.argv.index("--compare")
+        n = int(sys.argv[i + 2]) if len(sys.argv) > i + 2 else 60
+        compare(sys.argv[i + 1], n)
+        return
+    if "--cpu" in sys.argv:
+        i = sys.argv.index("--cpu")
+        n = int(sys.argv[i + 1]) if len(sys.argv) > i + 1 else 100
+        cpu = np.array(cpu_mode(n)["cpu"])
+        print(f"demo study, {n} candidates in this process, one numba thread: "
+              f"{1e3 * np.median(cpu):.0f} ms CPU per candidate (median) -> "
+              f"{2 / np.median(cpu):.1f} candidates/s on 2 idle cores; load average "
+              f"{os.getloadavg()[0]:.2f}")
+        return
     n = 5000 if "--full" in sys.argv else 400
     study = load_study(ROOT / "studies/hopkins-6psu-redesign.yaml")
     space = study.space

@@ -87,7 +87,10 @@ for task in args["tasks"]:
         X = np.array(poses[f])
         R = euler_to_matrix(X[:, 3:]).reshape(-1, 3, 3)
         ik, J = m.inverse_and_jacobian((X[:, :3].copy(), R))
-        out[task] = {"fused": ik.q.tolist(), "fused_jac": J.tolist()}
+        from pkmlab.dexterity._fused import fused_sweep
+        sw = fused_sweep(m, X[:8, :3], R[:8], np.ones((8, 8), bool), 80.0, np.full(6, 150.0))
+        out[task] = {"fused": ik.q.tolist(), "fused_jac": J.tolist(),
+                     "sweep": [a.tolist() for a in sw]}
     elif kind == "ws":
         deg = args["box_deg"]
         oset = pkmlab.OrientationSet.box(np.radians([deg, deg, deg]), samples=args["samples"])
@@ -211,6 +214,17 @@ def check_jac(family, r, ik):
     Jref = jacobian_reference(family, X, ik["base"], ik["tool"], ik["length"])
     np.testing.assert_allclose(np.array(r["fused_jac"], dtype=float), Jref, rtol=1e-11,
                                atol=1e-11, err_msg=f"{family} Jacobian, fused path")
+    # the worst case's fused Jacobian + bounds kernel: the NumPy Jacobians of the 8 × 8
+    # (position, orientation) grid through the unfused bounds pass
+    from pkmlab.dexterity._linalg import sweep_bounds
+
+    G = np.concatenate([np.tile(X[:8, :3], (8, 1)), np.repeat(X[:8, 3:], 8, axis=0)], axis=1)
+    Jg = jacobian_reference(family, G, ik["base"], ik["tool"], ik["length"])
+    ref = [np.empty(64) for _ in range(3)]
+    sweep_bounds(np.ascontiguousarray(Jg), 80.0, np.full(6, 150.0), *ref)
+    for got, want in zip(r["sweep"], ref):
+        np.testing.assert_allclose(np.array(got, dtype=float), want.reshape(8, 8).T,
+                                   rtol=1e-9, err_msg=f"{family} fused worst-case sweep")
 
 
 def check_columns(family, r):
@@ -315,7 +329,7 @@ def test_kernels_compiled_by_different_processes_do_not_alias(tmp_path):
     # everything came from the cache: nothing compiled and saved in the third process
     assert "data saved" not in log, [s for s in log.splitlines() if "data saved" in s][:5]
     for name in ("drive_euler", "drive_frames", "columns_all", "columns_any", "leg_eval",
-                 "drive_kinematics"):
+                 "drive_kinematics", "fused_sweep_loop"):
         assert re.search(rf"data loaded from .*{name}", log), f"{name} not loaded from cache"
 
 

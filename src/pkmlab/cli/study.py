@@ -139,17 +139,21 @@ def _estimate_lines():
     as a ``pkmlab:`` line on stderr; the candidates' own log lines stay quiet."""
     import logging
 
-    logger = logging.getLogger("pkmlab.study.optimisers")
+    # and what the run compiles (pkmlab.study.run, pkmlab.runtime.jit: the first run only)
+    loggers = [logging.getLogger(n) for n in ("pkmlab.study.optimisers", "pkmlab.study.run",
+                                              "pkmlab.runtime.jit")]
     handler = logging.StreamHandler(sys.stderr)
     handler.setFormatter(logging.Formatter("pkmlab: %(message)s"))
-    old = logger.level
-    logger.addHandler(handler)
-    logger.setLevel(logging.INFO)
+    old = [lg.level for lg in loggers]
+    for lg in loggers:
+        lg.addHandler(handler)
+        lg.setLevel(logging.INFO)
     try:
         yield
     finally:
-        logger.removeHandler(handler)
-        logger.setLevel(old)
+        for lg, level in zip(loggers, old):
+            lg.removeHandler(handler)
+            lg.setLevel(level)
 
 
 @app.command()

@@ -259,18 +259,22 @@ def _sweep():
 @njit(cache=True, error_model="numpy", inline="always")
 def _sweep_pose(J, m, L, fmax, kup, force, det, A, B, G, T, piv):
     """One pose of :func:`sweep_bounds`, with the caller's scratch ``A, B, G, T, piv``."""
+    kup[m], force[m], det[m] = sweep_one(J[m], L, fmax, A, B, G, T, piv)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def sweep_one(Jm, L, fmax, A, B, G, T, piv):
+    """``(kup, force, det)`` of one ``Jm (6, 6)`` (:func:`sweep_bounds`), with scratch
+    ``A, B, G, T (6, 6)`` and ``piv (6,)`` int64."""
     finite = True
     for i in range(6):
         for k in range(6):
-            v = J[m, i, k]
+            v = Jm[i, k]
             if not math.isfinite(v):
                 finite = False
             A[i, k] = v
     if not finite:
-        kup[m] = np.inf
-        force[m] = np.nan
-        det[m] = np.nan
-        return
+        return np.inf, np.nan, np.nan
     d = 1.0
     zero = False
     for k in range(6):
@@ -297,11 +301,7 @@ def _sweep_pose(J, m, L, fmax, kup, force, det, A, B, G, T, piv):
             for c in range(k + 1, 6):
                 A[i, c] -= f * A[k, c]
     if zero:
-        kup[m] = np.inf
-        force[m] = 0.0
-        det[m] = 0.0
-        return
-    det[m] = d
+        return np.inf, 0.0, 0.0
     for i in range(6):                    # B = P·I, then forward and back substitution
         for c in range(6):
             B[i, c] = 1.0 if i == c else 0.0
@@ -330,19 +330,18 @@ def _sweep_pose(J, m, L, fmax, kup, force, det, A, B, G, T, piv):
             v = fmax[c] / math.sqrt(g)
             if v < fm:
                 fm = v
-    force[m] = fm
     for i in range(6):                    # J_h = J·diag(1, 1, 1, 1/L, 1/L, 1/L)
         for k in range(6):
-            A[i, k] = J[m, i, k] if k < 3 else J[m, i, k] / L
-    la = _gram_lambda_max(A, G, T)
+            A[i, k] = Jm[i, k] if k < 3 else Jm[i, k] / L
     for i in range(3, 6):                 # J_h⁻¹ = diag(1, 1, 1, L, L, L)·J⁻¹
         for c in range(6):
             B[i, c] *= L
+    la = _gram_lambda_max(A, G, T)
     for i in range(6):                    # λmax(B Bᵀ) = λmax(Bᵀ B): use Bᵀ as "A"
         for c in range(6):
             A[i, c] = B[c, i]
     lb = _gram_lambda_max(A, G, T)
-    kup[m] = math.sqrt(la * lb) if la > 0.0 and lb > 0.0 else np.inf
+    return (math.sqrt(la * lb) if la > 0.0 and lb > 0.0 else np.inf), fm, d
 
 
 #: ``kup / KAPPA_BRACKET`` of :func:`sweep_bounds` is a lower bound on κ (exact arithmetic).

@@ -71,6 +71,7 @@ import numpy as np
 
 from ..poses import POSE_SIZE, matrix_to_euler
 from ._boundary import column_ends
+from ._fused import fused_available, fused_sweep
 from ._linalg import KAPPA_BRACKET, KAPPA_ROUND, kappa_upper
 from .aggregate import _CHUNK, _ik_valid, _units, _voxels, orientation_batches
 from .force import _fmax, max_force_all_directions
@@ -86,6 +87,10 @@ __all__ = ["WorstCase", "worst_case", "MAX_POSES"]
 MAX_POSES = 50_000_000
 
 _EXACT_BATCH = 256
+#: use the fused Jacobian + bounds kernel (:mod:`._fused`) where the family has one; the
+#: unfused path (NumPy Jacobians, then :func:`sweep_bounds`) gives the same values bit for bit
+#: and is kept as the reference of the tests and benchmarks
+FUSED = True
 _ROUND = KAPPA_ROUND   # relative allowance for rounding in the κ bound of sweep_bounds
 _SINGULAR_BOUND = KAPPA_SINGULAR / KAPPA_BRACKET / (1 + _ROUND) ** 2   # may be singular
 
@@ -482,19 +487,23 @@ def _sweep(mech, unit_pos, Rs, feas, L, fmax) -> _Sweep:
     lower = -math.inf                                 # largest certified lower bound on κ
     f_min, f_arg = math.inf, None
     step = max(1, _CHUNK // max(U, 1))
+    fused = FUSED and fused_available(mech)
     for m0 in range(0, M if U else 0, step):
         Rm = Rs[m0:m0 + step]
         k = len(Rm)
-        J = mech.jacobian((np.tile(unit_pos, (k, 1)), np.repeat(Rm, U, axis=0)))
-        kup = np.empty(k * U)
-        force = np.empty(k * U)
-        det = np.empty(k * U)
-        sweep_bounds(np.ascontiguousarray(J), L, fmax, kup, force, det, mech.mobility)
-        kup, force, det = (a.reshape(k, U).T for a in (kup, force, det))
         fe = feas[:, m0:m0 + k]
-        kup = np.where(fe, kup, -np.inf)
-        force = np.where(fe, force, np.inf)
-        det = np.where(fe, det, 0.0)
+        if fused:       # Jacobian and bounds in one numba loop, infeasible poses skipped
+            kup, force, det = fused_sweep(mech, unit_pos, Rm, fe, L, fmax)
+        else:
+            J = mech.jacobian((np.tile(unit_pos, (k, 1)), np.repeat(Rm, U, axis=0)))
+            kup = np.empty(k * U)
+            force = np.empty(k * U)
+            det = np.empty(k * U)
+            sweep_bounds(np.ascontiguousarray(J), L, fmax, kup, force, det, mech.mobility)
+            kup, force, det = (a.reshape(k, U).T for a in (kup, force, det))
+            kup = np.where(fe, kup, -np.inf)
+            force = np.where(fe, force, np.inf)
+            det = np.where(fe, det, 0.0)
         up = kappa_upper(kup)
         fin = np.isfinite(up)
         if fin.any():

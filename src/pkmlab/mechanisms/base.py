@@ -447,6 +447,16 @@ class Mechanism(JointsMixin):
         return (IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st),
                 self._free_columns(J))
 
+    def jacobian_kernel(self) -> tuple | None:
+        """``(jac, g)``: the family's numba per-pose Jacobian ``_jac_one`` over all six twist
+        components and its geometry tuple, when :meth:`jacobian` is exactly that; else None
+        (fused loops, :mod:`pkmlab.dexterity._fused`)."""
+        cls = type(self)
+        if (cls._jac_one is None or cls._jac_uses_q or cls._jacobian is not Mechanism._jacobian
+                or not self.mobility.is_spatial):
+            return None
+        return cls._jac_one, self._ik_geometry
+
     def jacobian(self, poses) -> np.ndarray:
         """Analytic velocity Jacobian ``(N, L, width)``: ``q̇ = J · t``, ``t`` the free
         components of the twist ``[v; ω]`` (all six for a spatial mechanism).

@@ -21,7 +21,7 @@ Modules, one concept each:
   global backend are not touched).
 """
 
-from .check import TrajectoryReport, Violation, check_trajectory
+from .check import TrajectoryFit, TrajectoryReport, Violation, check_trajectory, trajectory_fit
 from .csvfile import CSV_COLUMNS, load_motion_csv
 from .motions import Motion, differentiate, sinusoid_motion
 from .paper import PAPER_AXES, lobe_profile, paper_motion, paper_motion_phases
@@ -40,5 +40,7 @@ __all__ = [
     "differentiate",
     "load_motion_csv",
     "check_trajectory",
+    "TrajectoryFit",
+    "trajectory_fit",
     "plot_actuators",
 ]

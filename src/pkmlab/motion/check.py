@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..dexterity.metrics import CharacteristicLength, condition_number, resolve_length
+from ..dexterity.sweep import singular
 from ..errors import ParameterError
 from ..mechanisms.base import LEG_STATUS, Mechanism
 from ..poses import POSE_SIZE, as_frames
@@ -32,7 +33,7 @@ from ._args import positive as _positive
 
 log = logging.getLogger(__name__)
 
-__all__ = ["Violation", "TrajectoryReport", "check_trajectory"]
+__all__ = ["Violation", "TrajectoryReport", "check_trajectory", "TrajectoryFit", "trajectory_fit"]
 
 
 @dataclass(frozen=True)
@@ -206,6 +207,95 @@ def _readonly(*arrays: np.ndarray) -> None:
         a.setflags(write=False)
 
 
+def _times_and_poses(mech: Mechanism, t, poses) -> tuple[np.ndarray, np.ndarray]:
+    """``(t (T,), poses (T, 6))`` checked: T >= 2 finite, strictly increasing times; poses
+    ``(T, 6)`` or ``(T, width)`` in a lower mobility's free coordinates (made ``(T, 6)``)."""
+    mob = mech.mobility
+    t = np.array(t, dtype=float)
+    if t.ndim != 1 or len(t) < 2:
+        raise ParameterError("t", "an array of shape (T,) with T >= 2 (s)", t.shape)
+    if not np.all(np.isfinite(t)):
+        k = int(np.flatnonzero(~np.isfinite(t))[0])
+        raise ParameterError(f"t[{k}]", "a finite time (s)", float(t[k]))
+    steps = np.diff(t)
+    if np.any(steps <= 0):
+        k = int(np.flatnonzero(steps <= 0)[0]) + 1
+        raise ParameterError(f"t[{k}]", f"strictly increasing time (> {t[k - 1]:g} s)",
+                             float(t[k]))
+    X = np.array(poses, dtype=float)
+    if X.ndim == 2 and X.shape == (len(t), mob.width) and not mob.is_spatial:
+        X = mob.full(X, mech.nominal_pose)
+    if X.shape != (len(t), POSE_SIZE):
+        raise ParameterError("poses", f"an array of shape ({len(t)}, 6) or ({len(t)}, "
+                             f"{mob.width}) matching t (mm, rad)", X.shape)
+    return t, X
+
+
+def _inverse(mech: Mechanism, X: np.ndarray, stroke_tolerance: float):
+    """The inverse kinematics with the stroke window widened by ``stroke_tolerance`` (mm)."""
+    tol = _positive(stroke_tolerance, "stroke_tolerance", "mm", allow_zero=True)
+    qlo, qhi = mech.stroke
+    return mech.inverse(X, stroke=(qlo - tol, qhi + tol))
+
+
+def _margins(q: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """Per actuator: the smallest ``q - lo`` and ``hi - q`` over the samples with a finite
+    value and their sample indices (NaN and -1 for an actuator that never has one)."""
+    n_act = q.shape[1]
+    margin_low = np.full(n_act, np.nan)
+    margin_high = np.full(n_act, np.nan)
+    idx_low = np.full(n_act, -1)
+    idx_high = np.full(n_act, -1)
+    for i in range(n_act):
+        fin = np.isfinite(q[:, i])
+        if fin.any():
+            dl = np.where(fin, q[:, i] - lo[i], np.inf)
+            dh = np.where(fin, hi[i] - q[:, i], np.inf)
+            idx_low[i], idx_high[i] = int(np.argmin(dl)), int(np.argmin(dh))
+            margin_low[i], margin_high[i] = dl[idx_low[i]], dh[idx_high[i]]
+    return margin_low, margin_high, idx_low, idx_high
+
+
+@dataclass(frozen=True)
+class TrajectoryFit:
+    """What a study reads from a trajectory: :class:`TrajectoryReport`'s ``fits``,
+    ``margin_low`` and ``margin_high`` (of a check without speed or force limits), from
+    :func:`trajectory_fit`."""
+
+    fits: bool
+    margin_low: np.ndarray
+    margin_high: np.ndarray
+
+
+def trajectory_fit(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
+                   stroke_tolerance: float = TOL.stroke_roundoff_mm,
+                   characteristic_length: float | CharacteristicLength | None = None
+                   ) -> TrajectoryFit:
+    """``fits``, ``margin_low`` and ``margin_high`` of :func:`check_trajectory` without speed
+    and force limits (the payload then changes none of them), computing only what they need.
+
+    ``fits`` there is "every sample ok": the inverse kinematics valid (within the stroke, with
+    ``stroke_tolerance``), the speed defined (both neighbours solved) and κ finite. Here the
+    Jacobians are formed only when every sample is solved, and κ is not computed: one LU per
+    sample bounds it (:func:`pkmlab.dexterity.sweep.singular`), and only a sample whose
+    certified bound reaches the singular threshold gets its exact κ. No static forces, speeds
+    or per-sample statuses. Same arguments as :func:`check_trajectory`.
+    """
+    t, X = _times_and_poses(mech, t, poses)
+    limits = np.asarray(mech.actuator_limits, dtype=float)
+    ik = _inverse(mech, X, stroke_tolerance)
+    q = np.array(ik.q, dtype=float)
+    low, high, _, _ = _margins(q, limits[:, 0], limits[:, 1])
+    fits = (bool(np.all(ik.valid)) and bool(np.all(np.isfinite(X)))
+            and bool(np.all(np.isfinite(np.gradient(q, t, axis=0)))))
+    if fits:
+        length = resolve_length(mech, characteristic_length)
+        with np.errstate(all="ignore"):
+            J = mech.jacobian(X)
+        fits = not bool(np.any(singular(J, length.length, mech.mobility)))
+    return TrajectoryFit(fits, low, high)
+
+
 def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
                      payload_mass_kg: float = 0.0, payload_com: Sequence[float] = (0.0, 0.0, 0.0),
                      gravity: Sequence[float] = (0.0, 0.0, -9810.0),
@@ -252,23 +342,7 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
         ParameterError: for malformed inputs (shapes, non-monotonic time, negative mass, ...).
     """
     mob, n_act = mech.mobility, mech.n_actuators
-    t = np.array(t, dtype=float)
-    if t.ndim != 1 or len(t) < 2:
-        raise ParameterError("t", "an array of shape (T,) with T >= 2 (s)", t.shape)
-    if not np.all(np.isfinite(t)):
-        k = int(np.flatnonzero(~np.isfinite(t))[0])
-        raise ParameterError(f"t[{k}]", "a finite time (s)", float(t[k]))
-    steps = np.diff(t)
-    if np.any(steps <= 0):
-        k = int(np.flatnonzero(steps <= 0)[0]) + 1
-        raise ParameterError(f"t[{k}]", f"strictly increasing time (> {t[k - 1]:g} s)",
-                             float(t[k]))
-    X = np.array(poses, dtype=float)
-    if X.ndim == 2 and X.shape == (len(t), mob.width) and not mob.is_spatial:
-        X = mob.full(X, mech.nominal_pose)
-    if X.shape != (len(t), POSE_SIZE):
-        raise ParameterError("poses", f"an array of shape ({len(t)}, 6) or ({len(t)}, "
-                             f"{mob.width}) matching t (mm, rad)", X.shape)
+    t, X = _times_and_poses(mech, t, poses)
     mass = _positive(payload_mass_kg, "payload_mass_kg", "kg", allow_zero=True)
     com = np.asarray(payload_com, dtype=float)
     if com.shape != (3,) or not np.all(np.isfinite(com)):
@@ -287,9 +361,7 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
     T = len(t)
 
     # --- kinematics --------------------------------------------------------------------------
-    tol = _positive(stroke_tolerance, "stroke_tolerance", "mm", allow_zero=True)
-    qlo, qhi = mech.stroke
-    ik = mech.inverse(X, stroke=(qlo - tol, qhi + tol))
+    ik = _inverse(mech, X, stroke_tolerance)
     q = np.array(ik.q, dtype=float)
     ik_valid = np.asarray(ik.valid, dtype=bool)
     ik_reason = ik.reason_text
@@ -385,17 +457,7 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
     ok = status == "ok"
 
     # --- stroke margins ------------------------------------------------------------------------
-    margin_low = np.full(n_act, np.nan)
-    margin_high = np.full(n_act, np.nan)
-    idx_low = np.full(n_act, -1)
-    idx_high = np.full(n_act, -1)
-    for i in range(n_act):
-        fin = np.isfinite(q[:, i])
-        if fin.any():
-            dl = np.where(fin, q[:, i] - lo[i], np.inf)
-            dh = np.where(fin, hi[i] - q[:, i], np.inf)
-            idx_low[i], idx_high[i] = int(np.argmin(dl)), int(np.argmin(dh))
-            margin_low[i], margin_high[i] = dl[idx_low[i]], dh[idx_high[i]]
+    margin_low, margin_high, idx_low, idx_high = _margins(q, lo, hi)
 
     fits = bool(ok.all())
     _readonly(t, X, q, qdot, force, wrench, condition, ik_valid, status, ok, margin_low,

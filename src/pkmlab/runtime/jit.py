@@ -67,6 +67,7 @@ import warnings
 
 import numba
 from numba import njit
+from numba.core import event as _event
 from numba.core.bytecode import FunctionIdentity
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.errors import NumbaIRAssumptionWarning
@@ -78,7 +79,7 @@ log = logging.getLogger(__name__)
 #: seconds after which a kernel compile is announced (the progress rule: no silent step > 2 s)
 COMPILE_NOTICE_S = 1.5
 
-__all__ = ["cached_kernel", "identity", "jitable", "CACHE_SAFE"]
+__all__ = ["cached_kernel", "identity", "jitable", "CACHE_SAFE", "CompileLog", "compile_log"]
 
 #: True when kernels can be cached safely (numba's uid counter is where it is expected).
 CACHE_SAFE = isinstance(getattr(FunctionIdentity, "_unique_ids", None), itertools.count)
@@ -199,15 +200,17 @@ def cached_kernel(fn, sig, *, roots=(), extra=(), **options):
     ident = identity(fn, *roots, extra=(fn.__name__, str(sig), sorted(options.items()),
                                         tuple(extra)))
     kernel = _renamed(fn, f"{fn.__name__}_{ident[:16]}")
-    # a compile (not a cache load) takes seconds: say so after COMPILE_NOTICE_S, once per kernel
-    notice = threading.Timer(COMPILE_NOTICE_S, log.info, ("compiling the numba kernel %s (first "
-                             "use after an install or an edit; cached for later runs)",
-                                                        fn.__name__))
+    # a compile takes seconds (a cache load, on a loaded machine, may too): say so after
+    # COMPILE_NOTICE_S, once per kernel, and afterwards which of the two it was
+    notice = threading.Timer(COMPILE_NOTICE_S, log.info, ("loading or compiling the numba "
+                             "kernel %s (compiled on first use after an install or an edit; "
+                             "cached for later runs)", fn.__name__))
     notice.daemon = True
     notice.start()
     t0 = time.perf_counter()
     try:
-        with _uid_namespace(ident) if CACHE_SAFE else contextlib.nullcontext():
+        with compile_log() as rec, \
+                _uid_namespace(ident) if CACHE_SAFE else contextlib.nullcontext():
             with warnings.catch_warnings():
                 # numba's "internal pedantic check" on closures of generated code: a page of
                 # text on every first compile, about numba's IR, not about the user's input
@@ -215,6 +218,62 @@ def cached_kernel(fn, sig, *, roots=(), extra=(), **options):
                 compiled = njit(sig, cache=CACHE_SAFE, **options)(kernel)
     finally:
         notice.cancel()
-    if time.perf_counter() - t0 > COMPILE_NOTICE_S:
-        log.info("compiled %s in %.1f s", fn.__name__, time.perf_counter() - t0)
+    dt = time.perf_counter() - t0
+    if rec.compiled:
+        log.log(logging.INFO if dt > COMPILE_NOTICE_S else logging.DEBUG,
+                "compiled %s in %.1f s", fn.__name__, dt)
+    elif dt > COMPILE_NOTICE_S:
+        log.info("loaded %s from the cache in %.1f s", fn.__name__, dt)
     return compiled
+
+
+class CompileLog(_event.Listener):
+    """numba compiles (not cache loads) seen while :func:`compile_log` is active: numba fires
+    its ``numba:compile`` event only after a cache miss. ``compiled`` holds ``(name, seconds)``
+    of each outermost compile, in order (a function compiled while another compiles counts
+    inside it); ``name`` is the function's name without the identity suffix of
+    :func:`cached_kernel`."""
+
+    def __init__(self):
+        self.compiled: list[tuple[str, float]] = []
+        self._stack: list[float] = []
+
+    def on_start(self, event):
+        self._stack.append(time.perf_counter())
+
+    def on_end(self, event):
+        t0 = self._stack.pop()
+        if self._stack:
+            return
+        fn = getattr(event.data.get("dispatcher"), "py_func", None)
+        name = getattr(fn, "__name__", "?")
+        head, _, tail = name.rpartition("_")
+        if head and len(tail) == 16 and all(c in "0123456789abcdef" for c in tail):
+            name = head
+        self.compiled.append((name, time.perf_counter() - t0))
+
+    @property
+    def seconds(self) -> float:
+        return sum(s for _, s in self.compiled)
+
+    def summary(self, top: int = 8) -> str:
+        """One line: how many functions were compiled, in how long, the slowest by name."""
+        if not self.compiled:
+            return "no numba kernel compiled (all loaded from the cache)"
+        by: dict[str, float] = {}
+        for n, s in self.compiled:
+            by[n] = by.get(n, 0.0) + s
+        names = sorted(by, key=by.get, reverse=True)
+        shown = ", ".join(f"{n} {by[n]:.1f} s" for n in names[:top])
+        more = f", and {len(names) - top} more" if len(names) > top else ""
+        return (f"compiled {len(self.compiled)} numba function(s) in {self.seconds:.1f} s "
+                f"({shown}{more})")
+
+
+@contextlib.contextmanager
+def compile_log():
+    """``with compile_log() as c:`` records in ``c`` (:class:`CompileLog`) every numba compile
+    made inside, in any thread of this process."""
+    rec = CompileLog()
+    with _event.install_listener("numba:compile", rec):
+        yield rec

@@ -7,7 +7,7 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from ...motion import check_trajectory, paper_motion
+from ...motion import paper_motion, trajectory_fit
 from .registry import Evaluator, finite, metric, register_evaluator
 
 
@@ -39,7 +39,8 @@ class Trajectory(Evaluator):
         plan = ctx.evaluation.trajectory
         motion = paper_motion(mech, segment_time=plan.segment_time)
         t, X = motion.t, motion.poses
-        rep = check_trajectory(mech, t, X, payload_mass_kg=plan.payload)
+        # check_trajectory's fits and margins only (no limits: the payload changes neither)
+        rep = trajectory_fit(mech, t, X)
         margins = np.concatenate([rep.margin_low, rep.margin_high])
         out = {"paper_motion_fits": float(rep.fits),
                "paper_motion_margin": finite(np.min(margins))
