@@ -7,6 +7,7 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
+from ...limits import MASS_MAX_KG, SEGMENT_TIME_S
 from ...motion import check_trajectory, paper_motion
 from .registry import Evaluator, finite, metric, register_evaluator
 
@@ -17,8 +18,10 @@ class TrajectorySpec(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
     paper_motion: Literal[True] = True
-    segment_time: float = Field(1.0, gt=0, allow_inf_nan=False, description="s per segment")
-    payload: float = Field(0.0, ge=0, allow_inf_nan=False, description="payload mass (kg)")
+    segment_time: float = Field(1.0, ge=SEGMENT_TIME_S[0], le=SEGMENT_TIME_S[1],
+                                allow_inf_nan=False, description="s per segment")
+    payload: float = Field(0.0, ge=0, le=MASS_MAX_KG, allow_inf_nan=False,
+                           description="payload mass (kg)")
 
 
 class Trajectory(Evaluator):
