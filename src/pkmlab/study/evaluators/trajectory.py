@@ -9,7 +9,12 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from ...limits import MASS_MAX_KG, SEGMENT_TIME_S
 from ...motion import check_trajectory, paper_motion
-from .registry import Evaluator, finite, metric, register_evaluator
+from ...motion import costs
+from ...motion.costs import paper_samples
+from .registry import Cost, Evaluator, finite, metric, register_evaluator
+
+#: sample rate of the paper motion checked (paper_motion's default)
+PAPER_RATE_HZ = 100.0
 
 
 class TrajectorySpec(BaseModel):
@@ -38,9 +43,18 @@ class Trajectory(Evaluator):
                "smallest stroke margin along that motion (negative: the overshoot)"),
     )
 
+    def cost(self, plan, evaluation, mech) -> list[Cost]:
+        """The paper motion at 100 Hz, checked sample by sample: time and memory scale with
+        ``segment_time`` (:func:`~pkmlab.motion.costs.paper_samples`)."""
+        n = paper_samples(plan.segment_time, PAPER_RATE_HZ)
+        return [Cost("evaluate.trajectory.segment_time", plan.segment_time, "s", 1.0,
+                     n * costs.TRAJECTORY_BYTES_PER_SAMPLE,
+                     n * costs.TRAJECTORY_SECONDS_PER_SAMPLE,
+                     f"{plan.segment_time:g} s ({n:.3g} samples at {PAPER_RATE_HZ:g} Hz)")]
+
     def compute(self, mech, ctx) -> dict:
         plan = ctx.evaluation.trajectory
-        motion = paper_motion(mech, segment_time=plan.segment_time)
+        motion = paper_motion(mech, segment_time=plan.segment_time, rate_hz=PAPER_RATE_HZ)
         t, X = motion.t, motion.poses
         rep = check_trajectory(mech, t, X, payload_mass_kg=plan.payload)
         margins = np.concatenate([rep.margin_low, rep.margin_high])
