@@ -83,3 +83,35 @@ def test_a_budget_refusal_mid_run_is_not_stored_as_a_design_result(tmp_path, mon
     rows = store.all()
     store.close()
     assert len(rows) == 5 and all(r["status"] == "ok" for r in rows)
+
+
+def test_a_task_at_101_samples_is_refused_within_a_tight_time_budget(capsys, tmp_path,
+                                                                     monkeypatch):
+    """``samples: 101`` on a ±10° Euler box is 1,030,301 orientations (over 7 min on the
+    6-UPS): it validates only when the time budget allows it, and the refusal names
+    ``evaluate.task.samples`` with a sample count that fits."""
+    task = {"shape": "box", "size": ["20 mm"] * 3, "box": ["10 deg"] * 3, "samples": 101}
+    p = small_study(tmp_path, evaluate={"task": task},
+                    objectives=[{"maximize": "task_margin"}])
+    code, _, err = cli(capsys, "validate", p, "--check-space", "0",
+                       env={"PKMLAB_TIME_LIMIT": "2min"}, monkeypatch=monkeypatch)
+    line = one_line(code, err, "evaluate.task.samples", "1030301 orientations", "try <=")
+    fit = int(line.split("try <= ")[1].split()[0].rstrip(";)"))
+    assert 10 <= fit < 101
+    task["samples"] = fit
+    p = small_study(tmp_path, evaluate={"task": task},
+                    objectives=[{"maximize": "task_margin"}])
+    code, _, err = cli(capsys, "validate", p, "--check-space", "0")
+    assert code == 0, err
+
+
+def test_dexterity_over_the_memory_budget_is_refused_before_it_allocates(capsys, tmp_path,
+                                                                         monkeypatch):
+    """The shipped 6-UPS at ±10° asked 37 GiB at 2.5 mm; here the same request at 10 mm
+    (2.2e5 voxels × 343 orientations, 2.6 GB of κ arrays) under a 1 GiB budget."""
+    from clihelp import GS
+
+    code, _, err = cli(capsys, "dexterity", GS, "--kind", "dexterous", "--box", "10,10,10",
+                       "--resolution", "10", "--out", tmp_path / "d",
+                       env={"PKMLAB_MEMORY_LIMIT": "1GiB"}, monkeypatch=monkeypatch)
+    one_line(code, err, "resolution", "voxel × orientation arrays", "fit in 1 GiB", "try >=")
