@@ -185,15 +185,24 @@ def _sixleg_set_leg(x, y, wx, wy, wz, p, zlo, zhi, out_lo, out_hi):
 
 
 def _directions(value, field: str, need: np.ndarray) -> np.ndarray:
+    """Unit rows of ``value (6, 3)`` where ``need`` (legs numbered from 0, as in the YAML
+    schema's errors); a row's scale does not matter, however large or small."""
     arr = np.asarray(value, dtype=float)
-    if arr.shape != (6, 3) or not np.all(np.isfinite(arr)):
+    if arr.shape != (6, 3):
         raise ParameterError(field, "an array of shape (6, 3) of directions", arr.shape)
-    n = np.linalg.norm(arr, axis=1)
-    bad = need & (n < 1e-9)
+    bad = need & ~np.all(np.isfinite(arr), axis=1)
     if np.any(bad):
         i = int(np.argmax(bad))
-        raise ParameterError(f"legs[{i + 1}].{field}", "a non-zero direction", arr[i].tolist())
-    return np.where(need[:, None], unit_rows(arr), 0.0)
+        raise ParameterError(f"legs[{i}].{field}", "a direction of finite numbers",
+                             arr[i].tolist())
+    scale = np.max(np.abs(arr), axis=1)
+    bad = need & ~(scale > 0)
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise ParameterError(f"legs[{i}].{field}", "a non-zero direction", arr[i].tolist())
+    # divided by the largest component first, so that no norm overflows or underflows
+    scaled = np.where(need[:, None], arr / np.where(scale > 0, scale, 1.0)[:, None], 0.0)
+    return np.where(need[:, None], unit_rows(np.where(need[:, None], scaled, 1.0)), 0.0)
 
 
 def _per_leg(value, field: str, need: np.ndarray, positive: bool = True) -> np.ndarray:
@@ -205,7 +214,7 @@ def _per_leg(value, field: str, need: np.ndarray, positive: bool = True) -> np.n
     bad = need & (arr <= 0) if positive else need & ~np.isin(arr, (-1.0, 1.0))
     if np.any(bad):
         i = int(np.argmax(bad))
-        raise ParameterError(f"legs[{i + 1}].{field}", "a length > 0 mm" if positive else
+        raise ParameterError(f"legs[{i}].{field}", "a length > 0 mm" if positive else
                              "-1 or +1", float(arr[i]))
     return np.where(need, arr, 0.0 if positive else -1.0)
 
@@ -282,7 +291,7 @@ class SixLeg(Mechanism):
         nu = np.linalg.norm(u, axis=1)
         if np.any(crank & (nu < 1e-6)):
             i = int(np.argmax(crank & (nu < 1e-6)))
-            raise ParameterError(f"legs[{i + 1}].zero_direction", "a direction not parallel "
+            raise ParameterError(f"legs[{i}].zero_direction", "a direction not parallel "
                                  "to the servo axis", self.zero_directions[i])
         set_(self, "zero_directions", np.where(crank[:, None], unit_rows(u), 0.0))
         set_(self, "crank_length", _per_leg(self.crank_length, "crank_length", crank))
