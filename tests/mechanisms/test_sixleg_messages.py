@@ -14,7 +14,7 @@ from pkmlab.errors import ParameterError
 
 def _slider_legs(axis, leg=2):
     data = generic_yaml(pkmlab.load_mechanism(GS))
-    for i, lg in enumerate(data["legs"]):
+    for lg in data["legs"]:
         lg["actuator"] = {"kind": "slider", "axis": [0, 0, 1], "link_length": "600 mm"}
     data["legs"][leg]["actuator"]["axis"] = axis
     data["stroke"] = ["-300 mm", "300 mm"]

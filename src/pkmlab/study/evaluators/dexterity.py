@@ -11,8 +11,8 @@ from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSche
 
 from ... import dexterity as dx
 from ... import limits
-from ...errors import NumericalError, ParameterError
 from ...dexterity.budget import WORST_BYTES_PER_SAMPLE, require_grid
+from ...errors import NumericalError, ParameterError
 from ...units import parse_length
 from .registry import Evaluator, finite, metric, register_evaluator
 

@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import ParameterError
+from ...motion import costs
 from ...motion.dynamics import inverse_dynamics
 from ...requirements.spec import MotionSpec, build_motions
-from ...motion import costs
 from .registry import Cost, Evaluator, metric, register_evaluator
 
 #: (linear actuators' metric, rotary actuators' metric, DynamicsResult.summary() key)

@@ -8,8 +8,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from ...limits import MASS_MAX_KG, SEGMENT_TIME_S
-from ...motion import check_trajectory, paper_motion
-from ...motion import costs
+from ...motion import check_trajectory, costs, paper_motion
 from ...motion.costs import paper_samples
 from .registry import Cost, Evaluator, finite, metric, register_evaluator
 
