@@ -15,11 +15,18 @@ from ..errors import ParameterError, Shown
 from ..limits import MEMORY_FRACTION
 
 __all__ = ["memory_limit", "format_bytes", "require", "coarser_resolution",
-           "readable_step", "BudgetError"]
+           "readable_step", "BudgetError", "PROCESS_BYTES", "OUTPUT_BYTES"]
 
 _UNITS = {"": 1, "b": 1, "k": 1e3, "kb": 1e3, "m": 1e6, "mb": 1e6, "g": 1e9, "gb": 1e9,
           "t": 1e12, "tb": 1e12, "kib": 2**10, "mib": 2**20, "gib": 2**30, "tib": 2**40}
 ENV = "PKMLAB_MEMORY_LIMIT"
+#: resident set of a command before its own arrays (interpreter, numpy, scipy, numba, plotly
+#: and the kernels loaded from the cache): measured 215-240 MB (benchmarks/memory_model.py);
+#: a first run after an install also compiles the kernels, up to 0.75 GB once
+PROCESS_BYTES = 240 * 2**20
+#: fixed cost of a command beside the arrays its budget checks (small work arrays, plots,
+#: meshes): a few MB (benchmarks/memory_model.py)
+OUTPUT_BYTES = 8 * 2**20
 
 
 class BudgetError(ParameterError):

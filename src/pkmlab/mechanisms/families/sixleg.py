@@ -185,24 +185,15 @@ def _sixleg_set_leg(x, y, wx, wy, wz, p, zlo, zhi, out_lo, out_hi):
 
 
 def _directions(value, field: str, need: np.ndarray) -> np.ndarray:
-    """Unit rows of ``value (6, 3)`` where ``need`` (legs numbered from 0, as in the YAML
-    schema's errors); a row's scale does not matter, however large or small."""
-    arr = np.asarray(value, dtype=float)
+    arr = np.asarray(value, dtype=float)        # legs numbered from 0, as in schema errors
     if arr.shape != (6, 3):
         raise ParameterError(field, "an array of shape (6, 3) of directions", arr.shape)
-    bad = need & ~np.all(np.isfinite(arr), axis=1)
+    scale = np.max(np.abs(arr), axis=1)          # NaN for a NaN row, inf for an inf one
+    bad = need & ~(np.isfinite(scale) & (scale > 0))
     if np.any(bad):
         i = int(np.argmax(bad))
-        raise ParameterError(f"legs[{i}].{field}", "a direction of finite numbers",
-                             arr[i].tolist())
-    scale = np.max(np.abs(arr), axis=1)
-    bad = need & ~(scale > 0)
-    if np.any(bad):
-        i = int(np.argmax(bad))
-        raise ParameterError(f"legs[{i}].{field}", "a non-zero direction", arr[i].tolist())
-    # divided by the largest component first, so that no norm overflows or underflows
-    scaled = np.where(need[:, None], arr / np.where(scale > 0, scale, 1.0)[:, None], 0.0)
-    return np.where(need[:, None], unit_rows(np.where(need[:, None], scaled, 1.0)), 0.0)
+        raise ParameterError(f"legs[{i}].{field}", "a finite non-zero direction", arr[i].tolist())
+    return np.where(need[:, None], unit_rows(arr / np.where(need, scale, 1.0)[:, None]), 0.0)
 
 
 def _per_leg(value, field: str, need: np.ndarray, positive: bool = True) -> np.ndarray:
