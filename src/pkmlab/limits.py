@@ -8,7 +8,7 @@ from __future__ import annotations
 
 __all__ = ["SEGMENT_TIME_S", "MEMORY_FRACTION", "TIME_LIMIT_S", "LENGTH_MAX_MM", "RESOLUTION_MM",
            "EULER_HALF_RANGE_DEG", "SAMPLES_PER_ANGLE", "GCI_SAMPLES", "CAPABILITY_MAX_DEG",
-           "CSV_MAX_BYTES", "CSV_MAX_ROWS", "MOTION_TIME_S"]
+           "CSV_MAX_BYTES", "CSV_MAX_ROWS", "MOTION_TIME_S", "MASS_MAX_KG", "INERTIA_MAX"]
 
 #: Duration of one leg of the paper's lobe motion (s): 1 ms .. 1 day.
 SEGMENT_TIME_S = (1e-3, 86400.0)
@@ -37,3 +37,7 @@ CSV_MAX_ROWS = 1_000_000
 #: Time stamps of recorded motions (s): magnitudes at most this (about 116 days), so that
 #: differences and rates stay finite.
 MOTION_TIME_S = 1.0e7
+#: Largest mass (kg) of a payload, platform or leg: 1000 t; beyond it forces overflow.
+MASS_MAX_KG = 1.0e6
+#: Largest magnitude of an inertia entry (kg·mm²): 1e9 kg·m².
+INERTIA_MAX = 1.0e15

@@ -44,6 +44,19 @@ def shown(text: str) -> Shown:
     return Shown(f"a {len(text)}-character text (not shown)" if text else "an empty cell")
 
 
+_NUMERIC = re.compile(r"[0-9eE.+\-]{1,32}|[+-]?(?i:nan|inf|infinity)")
+
+
+def shown_cell(text: str) -> Shown:
+    """A data cell as an error may show it: only when it is made of number characters
+    (digits, sign, point, exponent; nan, inf), else its length — a data cell is file
+    content, and a word there may be a secret (a token, a password)."""
+    text = text.strip()
+    if _NUMERIC.fullmatch(text):
+        return Shown(repr(text))
+    return Shown(f"a {len(text)}-character text (not shown)" if text else "an empty cell")
+
+
 @dataclass(frozen=True)
 class Table:
     """A numeric CSV table: the header names, the values ``(rows, columns)`` and each data
@@ -128,11 +141,11 @@ def read_table(path: str | Path, field: str, *, what: str = "a CSV file") -> Tab
                     v = float(cell)
                 except ValueError:
                     raise ParameterError(f"{field} column {shown(header[j])}",
-                                         "a finite number", shown(cell),
+                                         "a finite number", shown_cell(cell),
                                          where=f"{path}, line {line}") from None
                 if not math.isfinite(v):
                     raise ParameterError(f"{field} column {shown(header[j])}",
-                                         "a finite number", shown(cell),
+                                         "a finite number", shown_cell(cell),
                                          where=f"{path}, line {line}")
                 values[k - 1, j] = v
     except csv.Error:

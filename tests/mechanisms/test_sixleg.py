@@ -241,7 +241,7 @@ def test_yaml_errors_name_the_field():
     assert m.stroke == pytest.approx((math.radians(-80), 1.2)) and m.actuator_unit == "rad"
     legs = generic_yaml(LINEAR["gough-stewart-6ups"])
     legs["legs"][2]["actuator"] = {"kind": "slider", "axis": [0, 0, 0], "link_length": "9 mm"}
-    with pytest.raises(ParameterError, match=r"legs\[3\]\.axis"):
+    with pytest.raises(ParameterError, match=r"legs\[2\]\.axis"):    # numbered from 0
         pkmlab.load_mechanism(legs)
 
 

@@ -27,6 +27,7 @@ from .aggregate import (
     kappa_statistics,
     well_conditioned_volume,
 )
+from .budget import require_grid
 from .force import max_force_all_directions, max_moment_all_directions
 from .maps import METRICS, MetricMap, metric_map
 from .metrics import (
@@ -183,6 +184,7 @@ def dexterity_report(mech, request: dict, *, L: float | CharacteristicLength | N
     if not res.empty and res.mesh_problem is not None:    # no grid sample inside
         agg["no_samples"] = res.mesh_problem
     elif not res.empty:
+        require_grid(res)
         log.info("dexterity: κ over %d voxels × %d orientations", int(res.occupancy.sum()),
                  len(res.orientations.rotations()))
         g = kappa_grid(mech, res, length)

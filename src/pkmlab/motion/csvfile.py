@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError, Shown
-from ..limits import MOTION_TIME_S
+from ..limits import LENGTH_MAX_MM, MOTION_TIME_S
 from ..tables import read_table, shown
 from .motions import POSE_COLUMNS, Motion, differentiate, make_motion
 
@@ -92,18 +92,37 @@ def load_motion_csv(path: str | Path, name: str | None = None, window: float = 0
         k = int(bad[0]) + 1
         raise ParameterError(f"{field} column 't'", f"strictly increasing time (> {t[k - 1]:g}"
                              " s on the previous row)", float(t[k]), where=table.where(k))
-    poses = np.stack([table.column(c) for c in POSE_COLUMNS], axis=1) * _DEG
+    poses = np.stack([table.column(c) for c in POSE_COLUMNS], axis=1)
+    # lengths within LENGTH_MAX_MM and angles within as many degrees: beyond, the derivatives
+    # and the inverse dynamics overflow (a 1e305 mm cell used to give infinite accelerations)
+    far = np.abs(poses) > LENGTH_MAX_MM
+    if np.any(far):
+        k, j = (int(v) for v in np.argwhere(far)[0])
+        unit = "mm" if j < 3 else "deg"
+        raise ParameterError(f"{field} column {POSE_COLUMNS[j]!r}", f"values within "
+                             f"±{LENGTH_MAX_MM:g} {unit}", float(poses[k, j]),
+                             where=table.where(k))
+    poses = poses * _DEG
     name = name or Path(path).stem
     if not derivatives:
         return Motion(name, t.copy(), poses, None, None, "none")
     if have[_DDOT]:
         d1 = np.stack([table.column(c) for c in _DOT], axis=1) * _DEG
         d2 = np.stack([table.column(c) for c in _DDOT], axis=1) * _DEG
-        return make_motion(name, t, poses, d1, d2, "columns")
+        return _finite(make_motion(name, t, poses, d1, d2, "columns"), field, path)
     s1, s2, n = differentiate(t, poses, window, polyorder, field=f"{field} (smoothing)")
     how = f"savgol(window={n} samples = {n * float(np.mean(np.diff(t))):.4g} s, " \
           f"polyorder={polyorder})"
     if have[_DOT]:
         s1 = np.stack([table.column(c) for c in _DOT], axis=1) * _DEG
         how = "velocity columns; acceleration " + how
-    return make_motion(name, t, poses, s1, s2, how)
+    return _finite(make_motion(name, t, poses, s1, s2, how), field, path)
+
+
+def _finite(motion: Motion, field: str, path) -> Motion:
+    """``motion``, refused when its twist or acceleration overflowed."""
+    if not (np.all(np.isfinite(motion.twist)) and np.all(np.isfinite(motion.accel))):
+        raise ParameterError(field, "a motion whose velocities and accelerations are finite "
+                             "(smoother poses or smaller derivative columns)", "an overflow",
+                             where=str(path))
+    return motion

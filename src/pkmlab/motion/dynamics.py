@@ -58,7 +58,8 @@ class DynamicsResult:
         actuators).
         wrench ``(T, 6)`` [N; N·mm] the actuators exert on the platform.
         code ``(T,)`` int8: 0 ok, 1 no inverse kinematics within the stroke (``reasons``:
-        sample → the IK reason), 2 singular; :attr:`status` spells it out.
+        sample → the IK reason), 2 singular, 3 a force, speed or power that is not finite
+        (overflow); :attr:`status` spells it out.
         actuator_names, stroke (min, max) mm.
     """
 
@@ -83,6 +84,7 @@ class DynamicsResult:
     def status(self) -> np.ndarray:
         """``(T,)`` text: ``ok``, ``ik: <reason>`` or ``singular``."""
         out = np.where(self.code == 2, "singular", "ok").astype(object)
+        out[self.code == 3] = "non-finite force, speed or power (overflow)"
         for k, why in self.reasons.items():
             out[k] = f"ik: {why}"
         return out
@@ -317,6 +319,13 @@ def inverse_dynamics(mech, motion: Motion, body: MassProperties,
         code[idx] = 2
         f[idx] = np.nan
         pw[idx] = np.nan
+    # a force, speed or power that overflowed (extreme accelerations or masses) is flagged,
+    # never carried into the summaries as a silent NaN
+    over = (code == 0) & ~(np.all(np.isfinite(f), axis=1) & np.all(np.isfinite(qd), axis=1)
+                           & np.all(np.isfinite(pw), axis=1))
+    code[over] = 3
+    f[over] = np.nan
+    pw[over] = np.nan
     return DynamicsResult(motion.name, motion.t, q, qd, f, pw, w, code, reasons,
                           tuple(mech.actuator_names), tuple(mech.stroke),
                           mech.actuator_unit)

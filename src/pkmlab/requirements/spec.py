@@ -21,6 +21,7 @@ from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSche
 
 from ..config import read_yaml, validate_model
 from ..errors import ParameterError, Shown, format_value
+from ..limits import INERTIA_MAX, MASS_MAX_KG, SEGMENT_TIME_S
 from ..motion import motions as mo
 from ..motion.csvfile import load_motion_csv
 from ..motion.paper import paper_motion
@@ -51,7 +52,8 @@ __all__ = ["TaskSpec", "MotionSpec", "PayloadSpec", "ActuatorsSpec", "TaskPlan",
 _JSON = WithJsonSchema({"anyOf": [{"type": "number"}, {"type": "string"}]})
 
 
-def _quantity(units: dict, default: str, minimum: float | None = None, strict: bool = False):
+def _quantity(units: dict, default: str, minimum: float | None = None, strict: bool = False,
+              maximum: float | None = None):
     def parse(v: Any) -> float:
         try:
             x = parse_physical(v, "", units, default)
@@ -60,6 +62,10 @@ def _quantity(units: dict, default: str, minimum: float | None = None, strict: b
         if minimum is not None and (x <= minimum if strict else x < minimum):
             raise ValueError(f"must be a value {'>' if strict else '>='} {minimum:g} "
                              f"{default}; got {format_value(v)}")
+        if maximum is not None and not abs(x) <= maximum:
+            low = "" if minimum is None else f"{'>' if strict else '>='} {minimum:g} and "
+            raise ValueError(f"must be a value {low}of magnitude <= {maximum:g} {default}; "
+                             f"got {format_value(v)}")
         return x
     return Annotated[float, BeforeValidator(parse), _JSON]
 
@@ -75,16 +81,17 @@ def _nonneg_length(v: Any) -> float:
 
 
 NonNegLength = Annotated[float, BeforeValidator(_nonneg_length), _JSON]
-Mass = _quantity(MASS_UNITS, "kg", 0.0)
+Mass = _quantity(MASS_UNITS, "kg", 0.0, maximum=MASS_MAX_KG)
 PositiveForce = _quantity(FORCE_UNITS, "N", 0.0, strict=True)
 PositiveSpeed = _quantity(SPEED_UNITS, "mm/s", 0.0, strict=True)
 AngularSpeed = _quantity(ANGULAR_SPEED_UNITS, "rad/s", 0.0)
 Torque = _quantity(TORQUE_UNITS, "N*mm", 0.0)
-Inertia = _quantity(INERTIA_UNITS, "kg*mm^2")
+Inertia = _quantity(INERTIA_UNITS, "kg*mm^2", maximum=INERTIA_MAX)
 PositiveTime = _quantity(TIME_UNITS, "s", 0.0, strict=True)
 Frequency = _quantity(FREQUENCY_UNITS, "Hz", 0.0)
 PositiveFrequency = _quantity(FREQUENCY_UNITS, "Hz", 0.0, strict=True)
 Lead = _quantity(LEAD_UNITS, "mm/rev", 0.0, strict=True)
+SegmentTime = _quantity(TIME_UNITS, "s", SEGMENT_TIME_S[0], maximum=SEGMENT_TIME_S[1])
 PositiveLength = _quantity({"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}, "mm", 0.0,
                            strict=True)
 
@@ -228,7 +235,7 @@ class MotionSpec(_Model):
     smoothing: SmoothingSpec = Field(default_factory=SmoothingSpec)
     sinusoid: SinusoidSpec | None = None
     paper: bool = Field(False, description="Hopkins & Williams' ±2 in / ±30° motion")
-    segment_time: PositiveTime = Field(1.0, description="paper motion: s per cubic leg")
+    segment_time: SegmentTime = Field(1.0, description="paper motion: s per cubic leg")
     duration: PositiveTime = Field(2.0, description="sinusoid: s")
     rate: PositiveFrequency = Field(200.0, description="generators: samples per s")
 

@@ -15,11 +15,24 @@ from ..errors import ParameterError, Shown
 from ..limits import MEMORY_FRACTION
 
 __all__ = ["memory_limit", "format_bytes", "require", "coarser_resolution",
-           "readable_step"]
+           "readable_step", "BudgetError", "PROCESS_BYTES", "OUTPUT_BYTES"]
 
 _UNITS = {"": 1, "b": 1, "k": 1e3, "kb": 1e3, "m": 1e6, "mb": 1e6, "g": 1e9, "gb": 1e9,
           "t": 1e12, "tb": 1e12, "kib": 2**10, "mib": 2**20, "gib": 2**30, "tib": 2**40}
 ENV = "PKMLAB_MEMORY_LIMIT"
+#: resident set of a command before its own arrays (interpreter, numpy, scipy, numba, plotly
+#: and the kernels loaded from the cache): measured 215-240 MB (benchmarks/memory_model.py);
+#: a first run after an install also compiles the kernels, up to 0.75 GB once
+PROCESS_BYTES = 240 * 2**20
+#: fixed cost of a command beside the arrays its budget checks (small work arrays, plots,
+#: meshes): a few MB (benchmarks/memory_model.py)
+OUTPUT_BYTES = 8 * 2**20
+
+
+class BudgetError(ParameterError):
+    """A request does not fit the memory or time budget, or the budget's environment variable
+    is not readable: a property of the machine and its settings, never of a design (a study
+    run stops on it; it is never stored as a candidate's result)."""
 
 
 def _physical() -> int:
@@ -37,7 +50,7 @@ def memory_limit() -> int:
     m = re.fullmatch(r"([0-9]+(?:\.[0-9]*)?(?:[eE][+-]?[0-9]+)?)\s*([A-Za-z]*)", text)
     unit = m.group(2).lower() if m else None
     if m is None or unit not in _UNITS or not 0 < float(m.group(1)) * _UNITS[unit] < 2**62:
-        raise ParameterError(ENV, "a size in bytes or with a unit (e.g. 2GiB, 500MB)", text)
+        raise BudgetError(ENV, "a size in bytes or with a unit (e.g. 2GiB, 500MB)", text)
     return int(float(m.group(1)) * _UNITS[unit])
 
 
@@ -57,8 +70,8 @@ def require(field: str, need: float, what: str, got: str, hint: str = "") -> Non
     limit = memory_limit()
     if need > limit:
         hint = f" ({hint})" if hint else ""
-        raise ParameterError(field, f"{what} fit in {format_bytes(limit)}{hint}",
-                             Shown(f"{got} needing {format_bytes(need)}"))
+        raise BudgetError(field, f"{what} fit in {format_bytes(limit)}{hint}",
+                          Shown(f"{got} needing {format_bytes(need)}"))
 
 
 def coarser_resolution(h: float, need: float, exponent: float = 2.0) -> float:

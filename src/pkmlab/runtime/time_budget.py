@@ -24,9 +24,9 @@ import math
 import os
 import re
 
-from ..errors import ParameterError, Shown
+from ..errors import Shown
 from ..limits import TIME_LIMIT_S
-from .memory import readable_step
+from .memory import BudgetError, readable_step
 
 __all__ = ["time_limit", "format_seconds", "require_time", "workspace_seconds",
            "study_seconds", "coarser_for_time", "ENV", "NS_PER_COLUMN_LEG", "NS_PER_VOXEL_LEG"]
@@ -55,7 +55,7 @@ def time_limit() -> float:
     m = re.fullmatch(r"([0-9]+(?:\.[0-9]*)?(?:[eE][+-]?[0-9]+)?)\s*([A-Za-z]*)", text)
     unit = m.group(2).lower() if m else None
     if m is None or unit not in _UNITS or not 0 < float(m.group(1)) * _UNITS[unit] < 1e9:
-        raise ParameterError(ENV, "a duration in seconds or with a unit (e.g. 90s, 20min, "
+        raise BudgetError(ENV, "a duration in seconds or with a unit (e.g. 90s, 20min, "
                              "2h, 1d)", text)
     return float(m.group(1)) * _UNITS[unit]
 
@@ -96,9 +96,9 @@ def require_time(field: str, need: float, what: str, got: str, hint: str = "",
     limit = time_limit()
     if need > limit:
         hint = f"; {hint}" if hint else ""
-        raise ParameterError(field, f"{what} estimated to finish within "
-                             f"{format_seconds(limit)} ({ENV}{hint})",
-                             Shown(f"{got} estimated at {format_seconds(need)}"))
+        raise BudgetError(field, f"{what} estimated to finish within "
+                          f"{format_seconds(limit)} ({ENV}{hint})",
+                          Shown(f"{got} estimated at {format_seconds(need)}"))
     if need >= LOG_FROM_S:
         (logger or log).info("%s: %s estimated at %s (budget %s, %s)", field, got,
                              format_seconds(need), format_seconds(limit), ENV)

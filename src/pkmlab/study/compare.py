@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import dexterity as dx
+from ..escaping import markdown_text
 from ..motion import check_trajectory, paper_motion
 from ..workspaces import OrientationSet, workspace
 
@@ -139,13 +140,14 @@ def comparison_markdown(rows: list[dict], box_deg: float | None = None) -> str:
     req = rows[0]["request"] if rows else {}
     lines = [f"# Design comparison (dexterous set: {req.get('dexterous_set', '')}, grid "
              f"{req.get('resolution_mm', float('nan')):g} mm)", "",
-             "| | " + " | ".join(r["label"] for r in rows) + " |",
+             "| | " + " | ".join(markdown_text(r["label"]) for r in rows) + " |",
              "|---" * (len(rows) + 1) + "|"]
     for key, header, fmt in COLUMNS:
         lines.append(f"| {header} | " + " | ".join(
-            fmt.format(r[key]) if not isinstance(r[key], str) else r[key] for r in rows) + " |")
+            fmt.format(r[key]) if not isinstance(r[key], str) else markdown_text(r[key])
+            for r in rows) + " |")
     lines.append("| inscribed shapes / GCI / κ / force over | "
-                 + " | ".join(r["reference"] for r in rows) + " |")
+                 + " | ".join(markdown_text(r["reference"]) for r in rows) + " |")
     lines += ["", f"Inscribed shapes: {req.get('inscribed', '')}, the call of "
               "`pkmlab workspace --inscribed`. L: Angeles' characteristic length (status in "
               "brackets). GCI: every voxel × orientation sample. κ range and force: the grid's "

@@ -17,10 +17,11 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from ..errors import CandidateError, ParameterError
+from ..errors import CandidateError, ParameterError, Shown
 from ..runtime.jit import compile_log
+from ..runtime.memory import BudgetError
 from .definition import PENALTY, Study
-from .evaluators import evaluate_design
+from .evaluators import check_budget, evaluate_design
 from .folder import OutputLock, check_output, claim, clear_for_overwrite
 from .optimisers import OPTIMISERS, check_time
 from .store import Store, candidate_key
@@ -120,6 +121,9 @@ def run_study(study: Study, runner, *, resume: bool = False, overwrite: bool = F
         CandidateError: a candidate raised an undeclared exception (recorded first).
     """
     out = Path(study.output)
+    # the budgets (and their environment variables) are checked on the baseline before
+    # anything is written: a run that cannot fit is refused before it starts
+    check_budget(study.evaluation, study.space.decode(None))
     check_output(out, study.source, overwrite=overwrite)
     fp = study.fingerprint()
     if lock is None:
@@ -176,6 +180,9 @@ def _run(study: Study, runner, store: Store, fp: str, progress) -> None:
     space, ev, seed = study.space, study.evaluation, study.seed
 
     def commit(key, role, params, result):
+        if result["status"] == "budget":       # the environment's limit: stop, store nothing
+            m = result["metrics"]
+            raise BudgetError(m["field"], m["allowed"], Shown(m["got"]))
         store.put(key, role, params, result)
         if progress:
             progress(1)

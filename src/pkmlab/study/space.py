@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from pydantic import BaseModel
 
-from ..errors import ParameterError
+from ..errors import ParameterError, Shown
 from ..mechanisms import Mechanism
 
 __all__ = ["Variable", "Derived", "DesignSpace", "Expression", "parse_path", "get_path",
@@ -68,39 +68,90 @@ def with_path(node, parts: tuple, value):
 # ---- derived fields: a small, safe arithmetic language -----------------------------------
 
 _BINARY = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
-           ast.Div: operator.truediv, ast.Pow: operator.pow}
+           ast.Div: operator.truediv}
 _UNARY = {ast.USub: operator.neg, ast.UAdd: operator.pos}
-_FUNCTIONS = {"min": min, "max": max, "abs": abs, "sqrt": math.sqrt, "sin": math.sin,
-              "cos": math.cos, "tan": math.tan, "atan2": math.atan2}
-_ALLOWED = (ast.Expression, ast.BinOp, ast.UnaryOp, ast.Constant, ast.Call, ast.Load,
-            *_BINARY, *_UNARY)
+#: function name → (callable, fewest arguments, most arguments)
+_FUNCTIONS = {"min": (min, 2, 16), "max": (max, 2, 16), "abs": (abs, 1, 1),
+              "sqrt": (math.sqrt, 1, 1), "sin": (math.sin, 1, 1), "cos": (math.cos, 1, 1),
+              "tan": (math.tan, 1, 1), "atan2": (math.atan2, 2, 2)}
+_ALLOWED = (ast.Expression, ast.BinOp, ast.UnaryOp, ast.Constant, ast.Call, ast.Load, ast.Name,
+            ast.Pow, *_BINARY, *_UNARY)
 #: Constants an expression may use; values are internal units (mm, rad).
 CONSTANTS = {"pi": math.pi, "deg": math.pi / 180.0, "rad": 1.0, "mm": 1.0, "cm": 10.0,
              "m": 1000.0, "inch": 25.4}
+#: longest expression (characters), deepest nesting, largest constant exponent magnitude
+MAX_CHARS = 1000
+MAX_DEPTH = 32
+MAX_EXPONENT = 64.0
+_WHAT = ("an arithmetic expression (+ - * / **, numbers, design variables, "
+         + ", ".join(sorted(_FUNCTIONS)) + ")")
+
+
+def _depth(node, level: int = 0) -> int:
+    """Nesting depth of ``node``, stopping as soon as it exceeds :data:`MAX_DEPTH`."""
+    if level > MAX_DEPTH:
+        return level
+    return max([level] + [_depth(c, level + 1) for c in ast.iter_child_nodes(node)])
+
+
+def _constant(node) -> float | None:
+    """The value of a constant exponent (a number, a sign, a named constant), else None."""
+    if isinstance(node, ast.Constant) and isinstance(node.value, int | float):
+        return float(node.value)
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
+        v = _constant(node.operand)
+        return None if v is None else (-v if isinstance(node.op, ast.USub) else v)
+    if isinstance(node, ast.Name) and node.id in CONSTANTS:
+        return CONSTANTS[node.id]
+    return None
 
 
 @dataclass(frozen=True)
 class Expression:
     """An arithmetic expression of design variables, evaluated in internal units (mm, rad):
-    ``base_ratio * base_outer_radius``, ``platform_rotation + 10 * deg``."""
+    ``base_ratio * base_outer_radius``, ``platform_rotation + 10 * deg``.
+
+    Checked at load: at most :data:`MAX_CHARS` characters and :data:`MAX_DEPTH` levels of
+    nesting, known names only (number variables, constants; text variables refused), each
+    function called with its number of positional arguments, every exponent a constant of
+    magnitude at most :data:`MAX_EXPONENT`. Evaluated in floating point (never big integers):
+    a result that is not a finite real number makes the design invalid, with the reason."""
 
     text: str
     names: tuple[str, ...]
 
     @classmethod
-    def parse(cls, text: str, field: str, known: set[str]) -> Expression:
+    def parse(cls, text: str, field: str, known: set[str],
+              texts: frozenset[str] | set[str] = frozenset()) -> Expression:
+        """``known``: the number variables; ``texts``: the text variables (refused)."""
         if not isinstance(text, str | int | float) or isinstance(text, bool):
             raise ParameterError(field, "an arithmetic expression of design variables", text)
         text = str(text)
+        if len(text) > MAX_CHARS:
+            raise ParameterError(field, f"an expression of at most {MAX_CHARS} characters",
+                                 Shown(f"{len(text)} characters"))
         try:
             tree = ast.parse(text, mode="eval")
-        except SyntaxError:
-            raise ParameterError(field, "an arithmetic expression (+ - * / **, numbers, design "
-                                 "variables, " + ", ".join(sorted(_FUNCTIONS)) + ")",
-                                 text) from None
+        except (SyntaxError, ValueError):
+            raise ParameterError(field, _WHAT, text) from None
+        except (RecursionError, MemoryError):
+            raise ParameterError(field, f"an expression nested at most {MAX_DEPTH} deep",
+                                 Shown("deeper")) from None
+        if _depth(tree) > MAX_DEPTH:
+            raise ParameterError(field, f"an expression nested at most {MAX_DEPTH} deep",
+                                 Shown(f"more than {MAX_DEPTH} levels"))
         names = []
+        called = {id(n.func) for n in ast.walk(tree) if isinstance(n, ast.Call)}
         for node in ast.walk(tree):
             if isinstance(node, ast.Name):
+                if node.id in texts:
+                    raise ParameterError(field, "an expression of number variables (arithmetic "
+                                         "on a text variable is not defined)", node.id)
+                if node.id in _FUNCTIONS and id(node) not in called:
+                    raise ParameterError(field, f"a call of {node.id} with its arguments "
+                                         f"({node.id}(...))", text)
+                if id(node) in called and node.id not in _FUNCTIONS:
+                    raise ParameterError(field, f"calls of {sorted(_FUNCTIONS)} only", text)
                 if node.id not in known and node.id not in CONSTANTS \
                         and node.id not in _FUNCTIONS:
                     raise ParameterError(field, f"an expression of the design variables "
@@ -114,9 +165,24 @@ class Expression:
                                                                           int | float))):
                 raise ParameterError(field, "arithmetic only (+ - * / **, numbers, names, "
                                      "function calls)", text)
-            if isinstance(node, ast.Call) and not (isinstance(node.func, ast.Name)
-                                                   and node.func.id in _FUNCTIONS):
-                raise ParameterError(field, f"calls of {sorted(_FUNCTIONS)} only", text)
+            if isinstance(node, ast.Call):
+                if not (isinstance(node.func, ast.Name) and node.func.id in _FUNCTIONS):
+                    raise ParameterError(field, f"calls of {sorted(_FUNCTIONS)} only", text)
+                name = node.func.id
+                _, lo, hi = _FUNCTIONS[name]
+                if node.keywords:
+                    raise ParameterError(field, f"{name} called with positional arguments "
+                                         "only", text)
+                if not lo <= len(node.args) <= hi:
+                    n = (f"{lo} argument{'s' if lo > 1 else ''}" if lo == hi
+                         else f"at least {lo} arguments")
+                    raise ParameterError(field, f"a valid call ({name} takes {n})", text)
+            if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow):
+                e = _constant(node.right)
+                if e is None or not abs(e) <= MAX_EXPONENT:
+                    raise ParameterError(field, f"an expression whose exponents are constants "
+                                         f"of magnitude at most {MAX_EXPONENT:g}",
+                                         ast.get_source_segment(text, node.right) or text)
         return cls(text, tuple(dict.fromkeys(names)))
 
     def __call__(self, values: dict) -> float:
@@ -126,22 +192,28 @@ class Expression:
             if isinstance(node, ast.Expression):
                 return ev(node.body)
             if isinstance(node, ast.Constant):
-                return node.value
+                return float(node.value)
             if isinstance(node, ast.Name):
-                return env[node.id]
+                v = env[node.id]
+                if isinstance(v, bool) or not isinstance(v, int | float):
+                    raise ValueError(f"{node.id} is not a number")
+                return float(v)
             if isinstance(node, ast.BinOp):
+                if isinstance(node.op, ast.Pow):
+                    return math.pow(ev(node.left), ev(node.right))
                 return _BINARY[type(node.op)](ev(node.left), ev(node.right))
             if isinstance(node, ast.UnaryOp):
                 return _UNARY[type(node.op)](ev(node.operand))
-            return _FUNCTIONS[node.func.id](*[ev(a) for a in node.args])
+            return _FUNCTIONS[node.func.id][0](*[ev(a) for a in node.args])
 
         try:
-            out = float(ev(ast.parse(self.text, mode="eval")))
+            out = ev(ast.parse(self.text, mode="eval"))
         except (ZeroDivisionError, ValueError, OverflowError) as exc:
-            raise ParameterError(f"derived ({self.text})", "an expression defined for this "
-                                 "design", f"{type(exc).__name__}: {exc}") from None
-        if not math.isfinite(out):
-            raise ParameterError(f"derived ({self.text})", "a finite value", out)
+            raise ParameterError(f"derived ({self.text})", "an expression with a real value "
+                                 "defined for this design",
+                                 Shown(f"{type(exc).__name__}: {exc}")) from None
+        if not isinstance(out, float) or not math.isfinite(out):
+            raise ParameterError(f"derived ({self.text})", "a finite real value", out)
         return out
 
 

@@ -133,6 +133,11 @@ def _merge(base: dict, over: dict) -> dict:
     return out
 
 
+#: mechanism fields no design variable or derived field may set (a candidate would be
+#: evaluated as the baseline's family, and its exported YAML would not load)
+IDENTITY = ("family", "name")
+
+
 def _target(name: str, where: str, path: str | None, family: str, spec) -> tuple | None:
     alias = family_aliases(family).get(name)
     text = path or (alias[0] if alias else None)
@@ -140,6 +145,14 @@ def _target(name: str, where: str, path: str | None, family: str, spec) -> tuple
         return None
     try:
         parts = parse_path(text)
+    except KeyError:
+        parts = None
+    if parts and parts[0] in IDENTITY:
+        raise ParameterError(where, "a geometry field (the mechanism's family and name are "
+                             "fixed by the study: give another mechanism file instead)", text)
+    try:
+        if parts is None:
+            raise KeyError(text)
         leaf = get_path(spec, parts)
     except KeyError:
         raise ParameterError(where, "a field present in the mechanism spec (a generator "
@@ -218,6 +231,20 @@ def _variable(name: str, v: DesignVariableSpec, family: str, spec,
     return Variable(name, target, quantity, kind, lo, hi, levels=v.levels)
 
 
+def _check_actuator_choices(variables, evaluation: Evaluation, mech) -> None:
+    """Every catalogue entry a design variable chooses drives this mechanism's actuators
+    (a rotary servo on a linear-actuator family would fail every candidate that picks it)."""
+    rotary = mech.actuator_unit == "rad"
+    for v in variables:
+        for i, c in enumerate(v.choices if v.role == "actuator" else ()):
+            kind = evaluation.actuators.catalogue[c].kind
+            if (kind == "rotary") != rotary:
+                need = "rotary" if rotary else "linear"
+                raise ParameterError(f"design.{v.name}.choices[{i}]", f"a {need} actuator "
+                                     f"(family {mech.family!r} has {need} actuators)",
+                                     Shown(f"{c!r} ({kind})"))
+
+
 def _metric(name: Any, where: str, evaluation: Evaluation) -> str:
     if not isinstance(name, str) or name not in METRICS:
         raise ParameterError(where, f"one of {sorted(METRICS)}", name)
@@ -290,6 +317,7 @@ def study_from_mapping(data: Any, base: Path | None = None,
     variables = tuple(_variable(n, v, family, mech_spec, evaluation)
                       for n, v in spec.design.items())
     names = {v.name for v in variables}
+    _check_actuator_choices(variables, evaluation, baseline)
     derived = []
     for key, text in spec.derived.items():
         where = f"derived.{key}"
@@ -297,7 +325,13 @@ def study_from_mapping(data: Any, base: Path | None = None,
             raise ParameterError(where, "a field no design variable sets", key)
         target = _target(key, where, None if key in family_aliases(family) else key, family,
                          mech_spec)
-        derived.append(Derived(key, target, Expression.parse(text, where, names)))
+        leaf = get_path(mech_spec, target)
+        if isinstance(leaf, str | bool) or not isinstance(leaf, int | float | None):
+            raise ParameterError(where, "a number field (a derived field takes the value of an "
+                                 "arithmetic expression)", Shown(f"{key} = {leaf!r}"))
+        texts = {v.name for v in variables if v.quantity == "text"}
+        derived.append(Derived(key, target, Expression.parse(text, where, names - texts,
+                                                             texts)))
     written = [v.target for v in variables if v.target is not None] + \
         [d.target for d in derived]
     if len(set(written)) != len(written):

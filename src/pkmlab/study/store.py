@@ -14,7 +14,7 @@ import math
 import sqlite3
 from pathlib import Path
 
-from ..errors import ParameterError
+from ..errors import ParameterError, Shown
 
 __all__ = ["Store", "candidate_key"]
 
@@ -49,8 +49,11 @@ CHECKPOINT_EVERY = 50
 
 
 def diagnose(path: str | Path) -> str:
-    """What can be read from a damaged store: SQLite's integrity check and the number of
-    evaluation rows that still decode (one line)."""
+    """What can be read from a damaged store: SQLite's integrity check, the metadata entries
+    that are not JSON and the number of evaluation rows that still decode (one line)."""
+    if Path(path).is_file() and Path(path).stat().st_size == 0:
+        return ("the file is empty (0 bytes): no evaluation can be recovered; rerun the "
+                "study with --overwrite")
     try:
         conn = sqlite3.connect(f"file:{Path(path)}?mode=ro", uri=True)
     except sqlite3.Error as exc:
@@ -60,7 +63,15 @@ def diagnose(path: str | Path) -> str:
             check = conn.execute("PRAGMA integrity_check").fetchone()[0]
         except sqlite3.Error as exc:
             check = str(exc)
-        readable = 0
+        readable, bad_meta = 0, []
+        try:
+            for key, value in conn.execute("SELECT key, value FROM meta"):
+                try:
+                    json.loads(value)
+                except (ValueError, TypeError):
+                    bad_meta.append(str(key)[:40])
+        except sqlite3.Error:
+            pass
         try:
             for row in conn.execute(f"SELECT {_COLUMNS} FROM evaluations"):
                 try:
@@ -72,8 +83,9 @@ def diagnose(path: str | Path) -> str:
             pass
     finally:
         conn.close()
-    return (f"sqlite integrity_check: {check}; {readable} evaluations readable (copy them out "
-            "with the sqlite3 tool's .recover, or rerun the study with --overwrite)")
+    meta = (f"metadata not JSON: {', '.join(bad_meta[:5])}; " if bad_meta else "")
+    return (f"sqlite integrity_check: {check}; {meta}{readable} evaluations readable (copy "
+            "them out with the sqlite3 tool's .recover, or rerun the study with --overwrite)")
 
 
 def _damaged(path: Path, exc: Exception) -> Exception:
@@ -82,8 +94,8 @@ def _damaged(path: Path, exc: Exception) -> Exception:
     if getattr(exc, "sqlite_errorcode", None) == sqlite3.SQLITE_FULL:
         return OSError(errno.ENOSPC, "No space left on device (the results store cannot "
                        "grow; free space, then run --resume)", str(path))
-    return ParameterError("store", "a readable pkmlab results store",
-                          f"{path}: {exc}; {diagnose(path)}")
+    return ParameterError("store", f"a readable pkmlab results store ({diagnose(path)})",
+                          Shown(f"{path}: {exc}"))
 
 
 class Store:
@@ -99,6 +111,11 @@ class Store:
     def __init__(self, path: str | Path, *, read_only: bool = False):
         self.path = Path(path)
         self.read_only = read_only
+        if self.path.is_file() and self.path.stat().st_size == 0:
+            # SQLite would take an empty file for a new store: a resumed run would silently
+            # evaluate everything again
+            raise ParameterError("store", f"a readable pkmlab results store ("
+                                 f"{diagnose(self.path)})", Shown(f"{self.path}: empty"))
         try:
             if read_only:
                 self.conn = sqlite3.connect(f"file:{self.path}?mode=ro", uri=True)
@@ -129,7 +146,12 @@ class Store:
     # ---- metadata --------------------------------------------------------------------------
     def get_meta(self, key: str):
         row = self.conn.execute("SELECT value FROM meta WHERE key = ?", (key,)).fetchone()
-        return None if row is None else json.loads(row[0])
+        try:
+            return None if row is None else json.loads(row[0])
+        except (ValueError, TypeError):
+            raise ParameterError("store", f"a readable pkmlab results store "
+                                 f"({diagnose(self.path)})",
+                                 Shown(f"{self.path}: metadata {key!r} is not JSON")) from None
 
     def set_meta(self, key: str, value) -> None:
         self.conn.execute("INSERT OR REPLACE INTO meta VALUES (?, ?)", (key, _canon(value)))

@@ -9,6 +9,7 @@ import logging
 import time
 from pathlib import Path
 
+from ..escaping import plotly_text
 from . import data as D
 from .figures import overlay_scene
 from .page import figure_json, render_page
@@ -87,8 +88,8 @@ def compare_html(rows: list[dict], path: str | Path, *, box_deg: float | None = 
     for which, name in ((1, dex_name), (0, "level (constant orientation)")):
         step(f"{name} hulls")
         results = [r["results"][which] if r.get("results") else None for r in rows]
-        items = [{"label": lab, "mechanism": r.get("mechanism"), **_hull(res)}
-                 for lab, r, res in zip(labels, rows, results)]
+        items = [{"label": plotly_text(lab), "mechanism": r.get("mechanism"), **_hull(res)}
+                 for lab, r, res in zip(labels, rows, results)]   # legend: plotly markup
         empty = [lab for lab, res in zip(labels, results) if res is None or res.empty]
         fid = f"fig-overlay-{which}"
         figures[fid] = figure_json(overlay_scene(items, f"{name} workspaces"))

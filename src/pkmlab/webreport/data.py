@@ -11,6 +11,7 @@ import math
 from collections import Counter
 
 from ..errors import ParameterError
+from ..escaping import plotly_text
 from ..study.definition import Study
 from ..study.metrics import METRICS
 from ..study.run import BASELINE, feasible
@@ -80,14 +81,15 @@ def _hover(study: Study, row: dict, status: str) -> str:
         lines[0] += f" · Pareto rank {row['pareto_rank']}"
     if row.get("design"):
         lines[0] += f" · design {row['design']}"
-    for v in study.variables:
+    for v in study.variables:          # user strings are escaped for plotly's markup
         x = row["params"].get(v.name)
-        lines.append(f"{v.name} = {fmt(x)} {v.unit}".rstrip())
+        x = x if isinstance(x, int | float) or x is None else plotly_text(x)
+        lines.append(f"{plotly_text(v.name)} = {fmt(x)} {v.unit}".rstrip())
     for o in study.objectives:
         m = METRICS[o.metric]
         lines.append(f"{o.metric} = {fmt(row['metrics'].get(o.metric))} {m.unit}".rstrip())
     if row["reason"]:
-        lines.append(row["reason"][:120])
+        lines.append(plotly_text(row["reason"][:120]))
     return "<br>".join(lines)
 
 

@@ -39,7 +39,8 @@ from .result import WorkspaceResult
 
 log = logging.getLogger(__name__)
 
-__all__ = ["workspace", "orientation_convergence", "estimate_bytes", "check_request", "KINDS"]
+__all__ = ["workspace", "orientation_convergence", "estimate_bytes", "check_request", "KINDS",
+           "request_cost"]
 
 KINDS = ("constant", "reachable", "dexterous")
 _CHUNK = 200_000
@@ -129,13 +130,7 @@ def workspace(mech, kind: str = "constant", orientations: OrientationSet | None 
         raise ParameterError("method", f"'auto' or 'sampled' for family {mech.family!r} "
                              "(it has no column kernel)", method)
 
-    xs, ys, zb = _grid_xy(mech, R, mode, h)
-    nz = int(max(0.0, zb[1] - zb[0]) / h) + 1
-    need = estimate_bytes(len(xs), len(ys), nz, len(R), use_columns,
-                          use_columns and bool(cons.extra) and not mech.column_invariant)
-    secs = workspace_seconds(len(xs) * len(ys), len(R), len(mech.actuator_names), nz,
-                             not use_columns)
-    got = f"{h:g} mm ({len(xs)} × {len(ys)} columns, {len(R)} orientations)"
+    xs, ys, zb, nz, need, secs, got = _grid_cost(mech, R, mode, h, use_columns, cons)
     fit = max(coarser_resolution(h, need), coarser_for_time(h, secs, 2 if use_columns else 3))
     require("resolution", need, "a grid whose arrays", got, f"try >= {fit:g} mm")
     require_time("resolution", secs, "a grid whose evaluation is", got, f"try >= {fit:g} mm")
@@ -249,6 +244,37 @@ def orientation_convergence(mech, kind: str, orientations: OrientationSet,
             row["refined_volume_mm3"] = rr.volume
         rows.append(row)
     return rows
+
+
+def _grid_cost(mech, R, mode, h, use_columns, cons):
+    """The grid of a request and its cost model: ``(xs, ys, z bounds, nz, bytes, seconds,
+    description)``."""
+    xs, ys, zb = _grid_xy(mech, R, mode, h)
+    nz = int(max(0.0, zb[1] - zb[0]) / h) + 1
+    need = estimate_bytes(len(xs), len(ys), nz, len(R), use_columns,
+                          use_columns and bool(cons.extra) and not mech.column_invariant)
+    secs = workspace_seconds(len(xs) * len(ys), len(R), len(mech.actuator_names), nz,
+                             not use_columns)
+    return xs, ys, zb, nz, need, secs, \
+        f"{h:g} mm ({len(xs)} × {len(ys)} columns, {len(R)} orientations)"
+
+
+def request_cost(mech, kind: str = "constant", orientations: OrientationSet | None = None,
+                 resolution: float = 2.5, constraints: Constraints | None = None,
+                 method: str = "auto", refine: bool = False) -> tuple[float, float, str, float]:
+    """The cost model of :func:`workspace` with these arguments, without computing it:
+    ``(bytes, seconds, description, exponent)`` — memory and time scale as
+    ``resolution ** -exponent``."""
+    cons = (constraints or Constraints()).resolved(mech)
+    if cons.stroke is not True:
+        mech = dataclasses.replace(mech, stroke_window=cons.stroke)
+    oset = orientations or OrientationSet.fixed()
+    _, Rn = as_frames(mech.nominal_pose)
+    R = oset.centred(tuple(matrix_to_euler(Rn[0]))).rotations()
+    use_columns = mech.column_method is not None and method != "sampled"
+    mode = "any" if kind == "reachable" else "all"
+    *_, need, secs, got = _grid_cost(mech, R, mode, float(resolution), use_columns, cons)
+    return need, secs, got, 2.0 if use_columns else 3.0
 
 
 def _grid_xy(mech, R, mode, h):

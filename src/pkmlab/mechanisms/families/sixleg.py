@@ -186,14 +186,14 @@ def _sixleg_set_leg(x, y, wx, wy, wz, p, zlo, zhi, out_lo, out_hi):
 
 
 def _directions(value, field: str, need: np.ndarray) -> np.ndarray:
-    arr = np.asarray(value, dtype=float)
-    if arr.shape != (6, 3) or not np.all(np.isfinite(arr)):
+    arr = np.asarray(value, dtype=float)        # legs numbered from 0, as in schema errors
+    if arr.shape != (6, 3):
         raise ParameterError(field, "an array of shape (6, 3) of directions", arr.shape)
-    bad = need & (np.linalg.norm(arr, axis=1) < TOL.direction_norm)
-    if np.any(bad):
+    scale = np.max(np.abs(arr), axis=1)          # NaN for a NaN row, inf for an inf one
+    if np.any(bad := need & ~(np.isfinite(scale) & (scale > 0))):
         i = int(np.argmax(bad))
-        raise ParameterError(f"legs[{i + 1}].{field}", "a non-zero direction", arr[i].tolist())
-    return np.where(need[:, None], unit_rows(arr), 0.0)
+        raise ParameterError(f"legs[{i}].{field}", "a finite non-zero direction", arr[i].tolist())
+    return np.where(need[:, None], unit_rows(arr / np.where(need, scale, 1.0)[:, None]), 0.0)
 
 
 def _per_leg(value, field: str, need: np.ndarray, positive: bool = True) -> np.ndarray:
@@ -205,7 +205,7 @@ def _per_leg(value, field: str, need: np.ndarray, positive: bool = True) -> np.n
     bad = need & (arr <= 0) if positive else need & ~np.isin(arr, (-1.0, 1.0))
     if np.any(bad):
         i = int(np.argmax(bad))
-        raise ParameterError(f"legs[{i + 1}].{field}", "a length > 0 mm" if positive else
+        raise ParameterError(f"legs[{i}].{field}", "a length > 0 mm" if positive else
                              "-1 or +1", float(arr[i]))
     return np.where(need, arr, 0.0 if positive else -1.0)
 
@@ -282,7 +282,7 @@ class SixLeg(Mechanism):
         flat = crank & (np.linalg.norm(u, axis=1) < TOL.perpendicular_rel)
         if np.any(flat):
             i = int(np.argmax(flat))
-            raise ParameterError(f"legs[{i + 1}].zero_direction", "a direction not parallel "
+            raise ParameterError(f"legs[{i}].zero_direction", "a direction not parallel "
                                  "to the servo axis", self.zero_directions[i])
         set_(self, "zero_directions", np.where(crank[:, None], unit_rows(u), 0.0))
         set_(self, "crank_length", _per_leg(self.crank_length, "crank_length", crank))

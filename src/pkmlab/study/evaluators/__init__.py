@@ -11,6 +11,9 @@ silent NaN.
 
 Failure policy (:func:`evaluate_design`):
 
+* :class:`~pkmlab.runtime.memory.BudgetError` — the candidate does not fit the memory or
+  time budget (an environment limit): status ``budget``, which the study driver never
+  stores — it stops the run with that one line;
 * :class:`~pkmlab.errors.ParameterError` — the design is geometrically invalid: status
   ``invalid`` with the reason;
 * :class:`~pkmlab.errors.NumericalError` — a declared numerical failure: status ``failed``;
@@ -27,6 +30,7 @@ import time
 import traceback
 
 from ...errors import NumericalError, ParameterError
+from ...runtime.memory import BudgetError
 from ..metrics import metrics_of
 from .registry import (
     EVALUATORS,
@@ -35,7 +39,9 @@ from .registry import (
     PLUGIN_ERRORS,
     PLUGIN_GROUP,
     Context,
+    Cost,
     Evaluator,
+    check_budget,
     check_requirements,
     load_evaluator_plugins,
     metric,
@@ -56,7 +62,7 @@ from .orientation_capability import capability  # noqa: E402
 __all__ = ["EVALUATORS", "Evaluator", "Context", "register_evaluator", "unregister_evaluator",
            "metric", "check_requirements", "load_evaluator_plugins", "PLUGIN_GROUP",
            "PLUGIN_ERRORS", "MECHANISM_NEEDS", "OMIT", "evaluate_design",
-           "evaluate_mechanism", "capability", "BUILTINS"]
+           "evaluate_mechanism", "capability", "BUILTINS", "Cost", "check_budget"]
 
 load_evaluator_plugins()
 
@@ -96,6 +102,9 @@ def evaluate_design(space, design: dict | None, evaluation, seed: int) -> dict:
         metrics, notes = evaluate_mechanism(mech, evaluation, seed,
                                             space.evaluation_choices(design))
         status, reason = "ok", ""
+    except BudgetError as exc:     # the machine's budget, not the design: never stored
+        status, reason = "budget", str(exc)
+        metrics = {"field": exc.field, "allowed": exc.allowed, "got": str(exc.got)}
     except ParameterError as exc:
         status, reason = "invalid", str(exc)
     except NumericalError as exc:

@@ -11,6 +11,7 @@ from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSche
 
 from ... import dexterity as dx
 from ... import limits
+from ...dexterity.budget import WORST_BYTES_PER_SAMPLE, require_grid
 from ...errors import NumericalError, ParameterError
 from ...units import parse_length
 from .registry import Evaluator, finite, metric, register_evaluator
@@ -112,6 +113,7 @@ class Dexterity(Evaluator):
                 ctx.notes[n] = "workspace empty"
             out.update(dict.fromkeys(_OVER_WORKSPACE))
             return out
+        require_grid(res, "evaluate.workspace.resolution", WORST_BYTES_PER_SAMPLE)
         wc = dx.worst_case(res.mechanism, res, length, plan.force_limit)
         if wc.status != "ok":
             raise NumericalError("worst case over the workspace", wc.reason)

@@ -6,9 +6,10 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import ParameterError
+from ...motion import costs
 from ...motion.dynamics import inverse_dynamics
 from ...requirements.spec import MotionSpec, build_motions
-from .registry import Evaluator, metric, register_evaluator
+from .registry import Cost, Evaluator, metric, register_evaluator
 
 #: (linear actuators' metric, rotary actuators' metric, DynamicsResult.summary() key)
 MOTION_METRICS = (("peak_actuator_force", "peak_actuator_torque", "peak_force"),
@@ -62,6 +63,26 @@ class Motions(Evaluator):
                                  "the motions move: payload and platform)", None)
         plan.check_mobility(mech)
 
+    def cost(self, plan, evaluation, mech) -> list[Cost]:
+        """Every motion and its inverse dynamics are kept for ``actuators``: memory and time
+        scale with the samples of all motions; the motion with the most samples is named, with
+        the setting that drives it (rate for the generators, duration for a sinusoid)."""
+        n = [costs.motion_samples(s, plan.recorded) for s in plan.specs]
+        total = sum(n)
+        i = max(range(len(n)), key=n.__getitem__)
+        s = plan.specs[i]
+        need = (total * costs.MOTION_BYTES_PER_SAMPLE
+                + max(n) * costs.DYNAMICS_PEAK_BYTES_PER_SAMPLE)
+        secs = total * costs.DYNAMICS_SECONDS_PER_SAMPLE
+        got = (f"{len(n)} motions, {total:.3g} samples in all ({s.name!r}: {n[i]:.3g})")
+        if s.file is not None:       # rows are limited by the CSV reader; name the list
+            return [Cost("evaluate.motions", float(len(n)), "motions", 1.0, need, secs, got,
+                         integer=True)]
+        if s.sinusoid is not None:
+            return [Cost(f"evaluate.motions[{i}].duration", s.duration, "s", 1.0, need, secs,
+                         got)]
+        return [Cost(f"evaluate.motions[{i}].rate", s.rate, "Hz", 1.0, need, secs, got)]
+
     def compute(self, mech, ctx) -> dict:
         ev = ctx.evaluation
         body = ev.payload.for_mechanism(mech)
@@ -77,6 +98,10 @@ class Motions(Evaluator):
             out[name] = float(max(np.max(s[key]) for s in sums)) if sums else None
             if not sums:
                 ctx.notes[name] = "no feasible sample in any motion"
+            elif not np.isfinite(out[name]):        # never a silent null
+                out[name] = None
+                out["motions_feasible"] = 0.0
+                ctx.notes[name] = ctx.notes["motions_feasible"] = "a value is not finite"
             if other != name:
                 out[other] = None
                 ctx.notes[other] = (f"{'rotary' if rotary else 'linear'} actuators: see "

@@ -18,7 +18,12 @@ block. It declares, beside its computation:
 * ``after`` — the evaluators whose results it reads from the :class:`Context`: they run first,
   and it runs only when they do;
 * ``compute(mech, ctx) -> {metric: value}`` — a value is a float, or ``None`` with a note in
-  ``ctx.notes`` saying why.
+  ``ctx.notes`` saying why;
+* ``cost(plan, evaluation, mech) -> [Cost]`` — its cost model: the peak memory and the time
+  one candidate's block needs, each tied to the setting that drives it; :func:`check_budget`
+  (at load, so at ``validate``, and again before a run starts) refuses a block over the
+  memory or time budget (:mod:`pkmlab.runtime.memory`, :mod:`pkmlab.runtime.time_budget`),
+  naming the field and a setting that fits.
 
 :data:`EVALUATORS` holds them in registration order, which is the evaluation order (an
 evaluator can only name registered evaluators in ``after``, so dependencies come first). The
@@ -43,7 +48,8 @@ from ..metrics import METRICS, Metric
 
 __all__ = ["Evaluator", "Context", "EVALUATORS", "PLUGIN_GROUP", "PLUGIN_ERRORS",
            "metrics_markdown", "MECHANISM_NEEDS", "register_evaluator", "unregister_evaluator",
-           "metric", "load_evaluator_plugins", "check_requirements", "finite", "OMIT"]
+           "metric", "load_evaluator_plugins", "check_requirements", "finite", "OMIT", "Cost",
+           "check_budget"]
 
 #: entry point group of evaluator plugins (each names an :class:`Evaluator` class or instance)
 PLUGIN_GROUP = "pkmlab.evaluators"
@@ -70,6 +76,37 @@ class Context:
     notes: dict = field(default_factory=dict)
     choices: dict = field(default_factory=dict)   # evaluation choices: {"actuator": name}
     dynamics: list = field(default_factory=list)  # DynamicsResult per required motion
+
+
+@dataclass(frozen=True)
+class Cost:
+    """What one candidate's block needs, by its evaluator's cost model: peak ``bytes`` of its
+    arrays and ``seconds``, driven by the setting ``field`` = ``value`` ``unit`` (``got``
+    describes the request), where the need scales as ``value ** power`` (negative: a larger
+    value needs less, like a grid spacing)."""
+
+    field: str
+    value: float
+    unit: str
+    power: float
+    bytes: float = 0.0
+    seconds: float = 0.0
+    got: str = ""
+    integer: bool = False
+
+    def fits(self, need: float, limit: float) -> str:
+        """A setting of ``field`` whose need would fit ``limit`` (``try <= x`` / ``>= x``)."""
+        from ...runtime.memory import readable_step
+
+        x = self.value * (max(limit, 1e-300) / max(need, 1e-300)) ** (1.0 / self.power)
+        if self.power < 0:
+            x = readable_step(x * 1.05, self.value)
+            text = f"try >= {x:g}"
+        else:
+            x = x * 0.9
+            x = math.floor(x) if self.integer else float(f"{x:.2g}")
+            text = f"try <= {x:g}"
+        return f"{text} {self.unit}".rstrip()
 
 
 def metric(name: str, unit: str, statistic: str, description: str) -> Metric:
@@ -143,6 +180,12 @@ class Evaluator:
         need = [self.name] + [n for n in self.after if EVALUATORS[n].block is not None]
         need += sorted(r for r in self.requires if r in EVALUATORS and r not in need)
         return " and ".join(f"evaluate.{n}" for n in need)
+
+    def cost(self, plan: Any, evaluation: Any, mech: Any) -> list[Cost]:
+        """The cost model of one candidate's block on ``mech`` (the baseline): one
+        :class:`Cost` per setting that drives memory or time (default: none — a block whose
+        cost does not grow with its settings)."""
+        return []
 
     # ---- the computation ---------------------------------------------------------------
     def compute(self, mech, ctx: Context) -> dict:
@@ -272,6 +315,23 @@ def check_requirements(evaluation, mech, given: dict) -> None:
                                      where=where(("evaluate", ev.name)))
     for ev in asked:
         ev.check(evaluation.plan(ev.name), evaluation, mech)
+    check_budget(evaluation, mech)
+
+
+def check_budget(evaluation, mech) -> list[Cost]:
+    """Refuse (:class:`~pkmlab.runtime.memory.BudgetError`, naming the field and a setting
+    that fits) a block whose cost model on ``mech`` exceeds the memory or time budget; log a
+    long estimate. Returns every evaluator's costs."""
+    from ...runtime.memory import memory_limit, require
+    from ...runtime.time_budget import require_time, time_limit
+
+    costs = [c for ev in EVALUATORS.values() if ev.runs(evaluation)
+             for c in ev.cost(evaluation.plan(ev.name), evaluation, mech)]
+    mem, secs = memory_limit(), time_limit()
+    for c in costs:
+        require(c.field, c.bytes, "a request whose arrays", c.got, c.fits(c.bytes, mem))
+        require_time(c.field, c.seconds, "a request", c.got, c.fits(c.seconds, secs))
+    return costs
 
 
 def metrics_markdown() -> str:

@@ -7,8 +7,13 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from ...motion import paper_motion, trajectory_fit
-from .registry import Evaluator, finite, metric, register_evaluator
+from ...limits import MASS_MAX_KG, SEGMENT_TIME_S
+from ...motion import costs, paper_motion, trajectory_fit
+from ...motion.costs import paper_samples
+from .registry import Cost, Evaluator, finite, metric, register_evaluator
+
+#: sample rate of the paper motion checked (paper_motion's default)
+PAPER_RATE_HZ = 100.0
 
 
 class TrajectorySpec(BaseModel):
@@ -17,8 +22,10 @@ class TrajectorySpec(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
     paper_motion: Literal[True] = True
-    segment_time: float = Field(1.0, gt=0, allow_inf_nan=False, description="s per segment")
-    payload: float = Field(0.0, ge=0, allow_inf_nan=False, description="payload mass (kg)")
+    segment_time: float = Field(1.0, ge=SEGMENT_TIME_S[0], le=SEGMENT_TIME_S[1],
+                                allow_inf_nan=False, description="s per segment")
+    payload: float = Field(0.0, ge=0, le=MASS_MAX_KG, allow_inf_nan=False,
+                           description="payload mass (kg)")
 
 
 class Trajectory(Evaluator):
@@ -35,9 +42,18 @@ class Trajectory(Evaluator):
                "smallest stroke margin along that motion (negative: the overshoot)"),
     )
 
+    def cost(self, plan, evaluation, mech) -> list[Cost]:
+        """The paper motion at 100 Hz, checked sample by sample: time and memory scale with
+        ``segment_time`` (:func:`~pkmlab.motion.costs.paper_samples`)."""
+        n = paper_samples(plan.segment_time, PAPER_RATE_HZ)
+        return [Cost("evaluate.trajectory.segment_time", plan.segment_time, "s", 1.0,
+                     n * costs.TRAJECTORY_BYTES_PER_SAMPLE,
+                     n * costs.TRAJECTORY_SECONDS_PER_SAMPLE,
+                     f"{plan.segment_time:g} s ({n:.3g} samples at {PAPER_RATE_HZ:g} Hz)")]
+
     def compute(self, mech, ctx) -> dict:
         plan = ctx.evaluation.trajectory
-        motion = paper_motion(mech, segment_time=plan.segment_time)
+        motion = paper_motion(mech, segment_time=plan.segment_time, rate_hz=PAPER_RATE_HZ)
         t, X = motion.t, motion.poses
         # check_trajectory's fits and margins only (no limits: the payload changes neither)
         rep = trajectory_fit(mech, t, X)

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from ...config import WorkspaceSpec, to_display, workspace_spec
 from ...workspaces import workspace
-from ...workspaces.engine import SINGULAR_NOTE
-from .registry import Evaluator, metric, register_evaluator
+from ...workspaces.engine import SINGULAR_NOTE, request_cost
+from .registry import Cost, Evaluator, metric, register_evaluator
 
 
 class Workspace(Evaluator):
@@ -45,6 +45,13 @@ class Workspace(Evaluator):
         rotation (a translational mechanism has constant-orientation workspaces only)."""
         turned = plan.orientation is not None and any(a != 0 for a in plan.orientation)
         return frozenset({"rotations"}) if plan.kind != "constant" or turned else frozenset()
+
+    def cost(self, plan, evaluation, mech) -> list[Cost]:
+        """The grid's arrays and leg evaluations (:func:`~pkmlab.workspaces.engine.request_cost`)
+        scale as ``resolution ** -2`` (exact columns) or ``** -3`` (sampled voxels)."""
+        need, secs, got, exponent = request_cost(mech, **evaluation.request)
+        return [Cost("evaluate.workspace.resolution", plan.resolution, "mm", -exponent, need,
+                     secs, got)]
 
     def compute(self, mech, ctx) -> dict:
         res = workspace(mech, **ctx.evaluation.request)
