@@ -9,7 +9,9 @@
    lie in the exact set.
 3. The time to a 1 % guaranteed volume bracket (:mod:`pkmlab.workspaces.bracket_octree`).
 
-Run: .venv/bin/python benchmarks/bench_lowmob.py [ik|workspace|bracket ...]
+Run: .venv/bin/python benchmarks/bench_lowmob.py [ik|workspace|bracket|scaling[:h...] ...]
+(``scaling``: the delta3 exact / brute-force ratio against h, brute force timed on the
+middle x-slabs; docs/validation.md "Issue 24 follow-up").
 """
 
 from __future__ import annotations
@@ -124,6 +126,30 @@ def bench_workspace(only=None) -> None:
                   f"feasible voxels outside the exact set: {missed}")
 
 
+def bench_scaling(hs=(10.0, 5.0, 2.5, 1.0), slabs: int = 5) -> None:
+    """delta3: how the exact / brute-force ratio grows as h shrinks (∝ 1/h: the exact cost is
+    per column, the brute force's per voxel). The brute force is timed on the ``slabs``
+    middle x-slabs and scaled by the slab count (its cost per voxel is uniform), so that fine
+    grids (2·10⁹ voxels at 1 mm) take seconds, not an hour."""
+    m = _deltas()["delta3"]
+    for h in hs:
+        t_ex, w = timed(lambda: workspace(m, "constant", resolution=h,   # noqa: B023
+                                          constraints=CONNECTED_OFF), repeats=1 if h < 2 else 3)
+        box = m.position_bounds(np.eye(3)[None])[0]
+        zs = np.arange(math.ceil(box[0, 2] / h), math.floor(box[1, 2] / h) + 1) * h
+        nx, ny = len(w.xs), len(w.ys)
+        first = nx // 2 - slabs // 2
+        t = time.perf_counter()
+        _brute(m, w.xs[first:first + slabs], w.ys, zs)
+        t_s = time.perf_counter() - t
+        t_bf = t_s * nx / slabs
+        print(f"delta3 h = {h:4.2f} mm: {nx * ny:,} columns, {nx * ny * len(zs):.3g} voxels; "
+              f"exact {t_ex:.3f} s ({t_ex / (nx * ny) * 1e6:.2f} µs/column, kernel "
+              f"{w.timings['columns_s'] / (nx * ny) * 1e6:.2f}); brute force (from {slabs} "
+              f"middle x-slabs) {t_bf:.1f} s ({t_s / (slabs * ny * len(zs)) * 1e9:.0f} "
+              f"ns/voxel): {t_bf / t_ex:.0f}×", flush=True)
+
+
 def bench_bracket() -> None:
     for name, m in _deltas().items():
         b = volume_bracket(m, target=0.01, budget_s=300.0)
@@ -138,5 +164,8 @@ if __name__ == "__main__":
     for part in which:
         if part.startswith("workspace:"):            # workspace:ldelta3 runs one family
             bench_workspace(part.split(":")[1:])
+            continue
+        if part.startswith("scaling"):                # scaling:1.0:0.75 sets the grids
+            bench_scaling(tuple(map(float, part.split(":")[1:])) or (10.0, 5.0, 2.5, 1.0))
             continue
         {"ik": bench_ik, "workspace": bench_workspace, "bracket": bench_bracket}[part]()

@@ -232,11 +232,20 @@ class Results:
         from .workspaces import workspace
 
         req = self.study.evaluation.request
-        if req is None:
+        plan = getattr(self.study.evaluation, "planar_workspace", None)
+        if req is None and not plan:
             raise ParameterError("evaluate.workspace", "given in the study (it evaluates no "
-                                 "workspace)", None)
+                                 "workspace; a planar study: evaluate.planar_workspace)", None)
         if key not in self._workspaces:
-            self._workspaces[key] = workspace(mech, **req)
+            if req is None:   # a planar study: its PlanarWorkspace, with the study's request
+                from .study.evaluators.planar_workspace import _phi
+                from .workspaces.planar import planar_workspace
+
+                self._workspaces[key] = planar_workspace(
+                    mech, plan.kind, _phi(plan), plan.resolution, samples=plan.samples,
+                    target=plan.target, max_depth=plan.max_depth)
+            else:
+                self._workspaces[key] = workspace(mech, **req)
         return self._workspaces[key]
 
 

@@ -229,3 +229,25 @@ def test_actuated_hover_gives_the_value_in_degrees_or_mm(name):
     for text, n, v in zip(act.hovertext, m.actuator_names, q, strict=True):
         shown = f"{np.degrees(v):.2f}°" if m.actuator_unit == "rad" else f"{v:.2f} mm"
         assert abs(v) > 1e-2 and f"{n} = {shown}" in text, text
+
+
+def test_issue24_families_are_in_the_list_and_planar_scenes_are_not_degenerate():
+    """delta3, ldelta3, rpr3, fivebar and prs3 are drawn by the tests above (shipped files);
+    a planar mechanism's drawing lies in one z-plane, which ``aspectmode="data"`` made a
+    degenerate view zoomed into the plane: its scene keeps x:y to scale with a z share, the
+    spatial ones stay to scale ("data")."""
+    fams = {m.family for m in ALL.values()}
+    assert {"delta3", "ldelta3", "rpr3", "fivebar", "prs3"} <= fams
+    for name, m in ALL.items():
+        scene = design_scene(m, None).layout.scene
+        pts = np.vstack(_pieces(_trace(mechanism_traces(m), "legs (joint chains)")))
+        ext = np.ptp(pts, axis=0)
+        if ext[2] < 0.05 * max(ext[:2]):
+            assert scene.aspectmode == "manual", name
+            r = scene.aspectratio
+            assert r.z > 0 and abs(r.x / r.y - ext[0] / ext[1]) < 0.05 * ext[0] / ext[1], name
+        else:
+            assert scene.aspectmode == "data", name
+    flat = [n for n, m in ALL.items() if m.family in ("rpr3", "fivebar")]
+    assert flat and all(design_scene(ALL[n], None).layout.scene.aspectmode == "manual"
+                        for n in flat)

@@ -351,12 +351,11 @@ def compare(
     out_dir.mkdir(parents=True, exist_ok=True)
     md = comparison_markdown(table_rows, box)
     (out_dir / "compare.md").write_text(md)
-    plot_overlaid_slices(table_rows, out_dir / "compare_dexterous_slices.png", which=1)
-    plot_overlaid_slices(table_rows, out_dir / "compare_level_slices.png", which=0)
+    pngs = [plot_overlaid_slices(table_rows, out_dir / f"compare_{k}_slices.png", which=w)
+            for k, w in (("dexterous", 1), ("level", 0))]
     with log_lines():
         page = compare_html(table_rows, out_dir / "compare.html", box_deg=box)
-    names = ("compare.md", "compare.html", "compare_dexterous_slices.png",
-             "compare_level_slices.png")
+    names = ("compare.md", "compare.html", *(p.name for p in pngs if p is not None))
     if as_json:
         _emit({"designs": [{k: v for k, v in r.items() if k not in ("mechanism", "results")}
                            for r in table_rows],

@@ -18,6 +18,18 @@ request, so a compare row can be reproduced with the other commands:
 
 The inscribed shapes, GCI, κ and force are over the dexterous workspace, or over the level one
 when the dexterous one is empty (the row's ``reference`` says which).
+
+The protocol follows the mechanism's mobility (issue 24), and a cell that does not apply says
+why instead of holding a number:
+
+* x, y, z free without a free rotation (the deltas): the level workspace is the workspace (the
+  orientation is fixed), everything above is computed over it; the dexterous set and the
+  paper's motion (it turns the platform ±30°) are not applicable;
+* planar (3-RPR, five-bar): :func:`pkmlab.workspaces.planar.planar_workspace`, the area with its
+  guaranteed bracket at the nominal φ and, with φ free, the dexterous area over ±``box_deg``;
+  GCI and κ from the ``planar_workspace`` evaluator (same numbers as a study);
+* dependent coordinates (3-PRS): :func:`pkmlab.workspaces.tripod.tripod_workspace` over
+  |θx|, |θy| <= ``box_deg``, its sampled (z, θx, θy) volume and parasitic motions.
 """
 
 from __future__ import annotations
@@ -57,6 +69,88 @@ def _shape_text(shape, text: str) -> str:
     return text if shape.status == "ok" else f"{shape.status}: {text}"
 
 
+def _has_xyz(mech) -> bool:
+    mob = mech.mobility
+    return not mob.dependent and {"x", "y", "z"} <= set(mob.coordinates)
+
+
+def _fixed_orientation(mech) -> bool:
+    return not {"theta_x", "theta_y", "theta_z"} & set(mech.mobility.coordinates)
+
+
+def _na(mech, what: str) -> str:
+    mob = mech.mobility
+    return f"n/a: {what} ({mob.name} mobility: {', '.join(mob.coordinates)})"
+
+
+def _base_row(label, mech, request) -> dict:
+    """A row whose cells all say 'not applicable' until filled."""
+    row = {"label": label, "mechanism": mech, "request": request,
+           "footprint_mm": mech.footprint()["base_radius"], "results": (None, None)}
+    for key, _, _ in COLUMNS[1:]:
+        row[key] = _na(mech, "not computed for this mobility")
+    return row
+
+
+def _planar_row(label, mech, request, box_deg, resolution, samples) -> dict:
+    from types import SimpleNamespace
+
+    from ..workspaces.planar import planar_workspace
+    from .evaluators.planar_workspace import PlanarWorkspace, PlanarWorkspaceSpec
+    from .evaluators.registry import Context
+
+    row = _base_row(label, mech, request)
+    const = planar_workspace(mech, "constant", None, resolution)
+    row["constant_volume_cm3"] = _area_text(const)
+    rotates = "theta_z" in mech.mobility.coordinates and box_deg > 0
+    phi0 = float(mech.nominal_pose[5])
+    a = math.radians(box_deg)
+    if rotates:
+        dex = planar_workspace(mech, "dexterous", (phi0 - a, phi0 + a), resolution,
+                               samples=samples)
+        row["dexterous_volume_cm3"] = _area_text(dex)
+        plan = PlanarWorkspaceSpec(kind="dexterous", phi=[phi0 - a, phi0 + a],
+                                   resolution=resolution, samples=samples)
+    else:
+        row["dexterous_volume_cm3"] = _na(mech, "the orientation is fixed")
+        plan = PlanarWorkspaceSpec(kind="constant", resolution=resolution)
+    ctx = Context(SimpleNamespace(planar_workspace=plan), seed=0)
+    m = PlanarWorkspace().compute(mech, ctx)
+    row["gci"] = m["gci_planar"] if m["gci_planar"] is not None else ctx.notes["gci_planar"]
+    k = m["sampled_planar_worst_kappa"]
+    row["kappa_range"] = (f"worst sampled {k:.2f}" if k is not None
+                          else ctx.notes.get("sampled_planar_worst_kappa", "inf"))
+    row["reference"] = ("planar: area (cm²) with its guaranteed bracket; GCI / κ over the "
+                        + ("dexterous" if rotates else "constant") + " cells sampled")
+    row["planar"] = {"constant": const.metrics(), "gci_planar": m["gci_planar"],
+                     "sampled_planar_worst_kappa": k}
+    return row
+
+
+def _area_text(res) -> str:
+    lo, hi = res.bracket
+    exact = "" if res.exact is None else f", exact {res.exact / 100:.1f}"
+    return (f"area {res.estimate / 100:.1f} cm² (grid), bracket {lo / 100:.1f} … "
+            f"{hi / 100:.1f} cm²{exact}")
+
+
+def _tripod_row(label, mech, request, box_deg, resolution) -> dict:
+    from ..workspaces.tripod import tripod_workspace
+
+    row = _base_row(label, mech, request)
+    res = tripod_workspace(mech, math.radians(box_deg), resolution_z=resolution)
+    m = res.metrics()
+    row["dexterous_volume_cm3"] = (f"sampled {m['volume_mm_deg2']:.4g} mm·deg² over (z, θx, θy)"
+                                   f", |θx|, |θy| <= {box_deg:g}°")
+    row["constant_volume_cm3"] = _na(mech, "x, y, θz follow z, θx, θy (parasitic: "
+                                     + (f"|x, y| up to {m['parasitic_xy_max_mm']:.2f} mm"
+                                        if m["parasitic_xy_max_mm"] is not None
+                                        else "empty") + ")")
+    row["reference"] = "dependent coordinates: (z, θx, θy) grid, sampled"
+    row["tripod"] = m
+    return row
+
+
 def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
                     resolution: float = 2.5, samples: int = 7, force_limit: float = 150.0,
                     seed: int = 0) -> list[dict]:
@@ -84,9 +178,16 @@ def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
     rows = []
     for i, (label, mech) in enumerate(designs):
         log.info("compare: design %d of %d (%s)", i + 1, len(designs), label)
+        if mech.mobility.dependent:
+            rows.append(_tripod_row(label, mech, request, box_deg, resolution))
+            continue
+        if not _has_xyz(mech):
+            rows.append(_planar_row(label, mech, request, box_deg, resolution, samples))
+            continue
+        fixed = _fixed_orientation(mech)
         const = workspace(mech, "constant", None, resolution)
-        dex = workspace(mech, "dexterous", oset, resolution)
-        ref = dex if not dex.empty else const
+        dex = None if fixed else workspace(mech, "dexterous", oset, resolution)
+        ref = const if fixed or dex.empty else dex
         box = ref.inscribed_box(seed=seed)
         cyl = ref.inscribed_cylinder(seed=seed)
         length = dx.resolve_length(mech)
@@ -94,20 +195,18 @@ def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
         gci = dx.gci_grid(mech, ref, grid=grid)
         kmin = dx.kappa_statistics(grid.kappa[grid.valid]).min
         wc = dx.worst_case(mech, ref, length, force_limit)
-        motion = paper_motion(mech)
-        t, X = motion.t, motion.poses
-        rep = check_trajectory(mech, t, X, characteristic_length=length)
-        q = rep.q[np.all(np.isfinite(rep.q), axis=1)]
-        used = (q.max() - q.min()) / (mech.stroke[1] - mech.stroke[0]) if len(q) else math.nan
-        margin = min(rep.margin_low.min(), rep.margin_high.min())
-        L_text = f"{length.length:.2f} ({length.status})"
+        motion_text = _na(mech, "the paper's motion turns the platform ±30°") if fixed \
+            else _paper_motion_text(mech, length)
+        L_text = (f"{length.length:.2f} ({length.status})" if length.length is not None
+                  else f"n/a ({length.status}: {length.reason or 'no rotation is free'})")
         rows.append({
             "label": label,
             "mechanism": mech,
             "request": request,
             "footprint_mm": mech.footprint()["base_radius"],
             "constant_volume_cm3": const.volume / 1e3,
-            "dexterous_volume_cm3": dex.volume / 1e3,
+            "dexterous_volume_cm3": _na(mech, "the orientation is fixed") if fixed
+            else dex.volume / 1e3,
             "box_mm": _shape_text(box, " × ".join(f"{s:.1f}" for s in box.size)
                                   if box.ok else box.reason),
             "cylinder_mm": _shape_text(cyl, f"{cyl.radius:.1f} × {cyl.height:.1f}"
@@ -127,12 +226,21 @@ def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
                          else f"yes: {wc.reason}") if wc.ok
             else wc.status,
             "worst_case": wc.as_dict(),
-            "paper_motion": (f"{100 * used:.0f} % / {margin:.2f} mm"
-                             + ("" if rep.fits else " (does not fit)")),
+            "paper_motion": motion_text,
             "results": (const, dex),
-            "reference": "dexterous" if not dex.empty else "level (dexterous empty)",
+            "reference": ("level (the orientation is fixed)" if fixed else "dexterous"
+                          if not dex.empty else "level (dexterous empty)"),
         })
     return rows
+
+
+def _paper_motion_text(mech, length) -> str:
+    motion = paper_motion(mech)
+    rep = check_trajectory(mech, motion.t, motion.poses, characteristic_length=length)
+    q = rep.q[np.all(np.isfinite(rep.q), axis=1)]
+    used = (q.max() - q.min()) / (mech.stroke[1] - mech.stroke[0]) if len(q) else math.nan
+    margin = min(rep.margin_low.min(), rep.margin_high.min())
+    return f"{100 * used:.0f} % / {margin:.2f} mm" + ("" if rep.fits else " (does not fit)")
 
 
 def comparison_markdown(rows: list[dict], box_deg: float | None = None) -> str:
@@ -159,17 +267,24 @@ def comparison_markdown(rows: list[dict], box_deg: float | None = None) -> str:
 
 
 def plot_overlaid_slices(rows: list[dict], path: Path, which: int = 1,
-                         layout: str = "auto") -> Path:
+                         layout: str = "auto") -> Path | None:
     """Outlines of every design's workspace (``which``: 0 level, 1 dexterous; the level ones
     when every dexterous workspace is empty) per section, on one layout scaled to all of them
-    (``layout="paper"``: Hopkins & Williams' 152.4 mm every 12.7 mm), as a PNG at ``path``."""
+    (``layout="paper"``: Hopkins & Williams' 152.4 mm every 12.7 mm), as a PNG at ``path``;
+    designs without an x-y × z workspace (planar, 3-PRS) are left out, and ``None`` is returned
+    (nothing written) when no design has one."""
     from ..workspaces.output.plots import overlay_figure
 
-    res = [r["results"][which] for r in rows]
-    if all(x.empty for x in res):
-        res, which = [r["results"][0] for r in rows], 0
+    def pick(k):
+        return [(r["label"], r["results"][k]) for r in rows if r["results"][k] is not None]
+
+    res = pick(which)
+    if all(x.empty for _, x in res):
+        res, which = pick(0), 0
+    if not res:
+        return None
     kind = "dexterous" if which == 1 else "level"
-    fig = overlay_figure(res, [r["label"] for r in rows], layout=layout,
+    fig = overlay_figure([x for _, x in res], [lab for lab, _ in res], layout=layout,
                          title=f"{kind} workspaces, overlaid")
     fig.savefig(Path(path), dpi=110)
     return Path(path)

@@ -149,6 +149,31 @@ def _scene() -> dict:
                 camera=dict(eye=dict(x=1.6, y=-1.6, z=0.9)))
 
 
+def _extent(traces) -> np.ndarray:
+    """The ``(3,)`` extent (mm) of every drawn point of ``traces`` (NaN / None skipped)."""
+    out = np.zeros(3)
+    for i, k in enumerate("xyz"):
+        vals = [np.asarray([v for v in getattr(t, k) if v is not None], dtype=float)
+                for t in traces if getattr(t, k, None) is not None]
+        c = np.concatenate(vals) if vals else np.zeros(0)
+        c = c[np.isfinite(c)]
+        out[i] = c.max() - c.min() if len(c) else 0.0
+    return out
+
+
+def _fit_scene(fig) -> None:
+    """A flat drawing (planar mechanisms: every point in one z-plane) has no z extent, which
+    ``aspectmode="data"`` turns into a degenerate view zoomed into the plane: give z a
+    fixed share of the box and look at the plane from above."""
+    ext = _extent(fig.data)
+    span = max(ext[0], ext[1])
+    if span > 0 and ext[2] < 0.05 * span:
+        fig.update_layout(scene=dict(
+            aspectmode="manual",
+            aspectratio=dict(x=ext[0] / span, y=ext[1] / span, z=0.15),
+            camera=dict(eye=dict(x=0.5, y=-0.9, z=1.4))))
+
+
 def design_scene(mech, hull: dict | None):
     """One design: its hull (``{"vertices", "faces", "intensity", "label"}`` or None) and the
     mechanism at its nominal pose."""
@@ -163,6 +188,7 @@ def design_scene(mech, hull: dict | None):
     fig.update_layout(**_layout(height=560, scene=_scene(), margin=dict(l=0, r=0, t=10, b=0),
                                 legend=dict(orientation="h", x=0, y=0, yanchor="top",
                                             bgcolor="rgba(255,255,255,0.7)")))
+    _fit_scene(fig)
     return fig
 
 
@@ -184,4 +210,5 @@ def overlay_scene(items: list[dict], title: str = ""):
     fig.update_layout(**_layout(height=560, scene=_scene(), margin=dict(l=0, r=0, t=30, b=0),
                                 title=dict(text=title, x=0.01, font=dict(size=13)),
                                 legend=dict(x=0, y=1, bgcolor="rgba(255,255,255,0.7)")))
+    _fit_scene(fig)
     return fig

@@ -240,12 +240,14 @@ def _voxel_box(result):
 
 
 def _linearise(mech, pts, R):
-    """Actuator values ``(P, M, 6)`` and gradients ``(P, M, 6, 3)`` at points × orientations."""
-    P, M = len(pts), len(R)
+    """Actuator values ``(P, M, n)`` and gradients ``(P, M, n, 3)`` at points × orientations
+    (``n`` actuators; the first three Jacobian columns are x, y, z for every mobility with x,
+    y and z free, spatial or translational)."""
+    P, M, n = len(pts), len(R), mech.n_actuators
     p = np.repeat(pts, M, axis=0)
     Rr = np.ascontiguousarray(np.tile(R, (P, 1, 1)))
-    q = mech.inverse((p, Rr), stroke=NO_STROKE).q.reshape(P, M, 6)
-    G = mech.jacobian((p, Rr))[..., :3].reshape(P, M, 6, 3)
+    q = mech.inverse((p, Rr), stroke=NO_STROKE).q.reshape(P, M, n)
+    G = mech.jacobian((p, Rr))[..., :3].reshape(P, M, n, 3)
     return q, G
 
 
@@ -286,15 +288,15 @@ def _scp(result, x0, points_of, jac_of, objective, lower_bounds, iters=30):
     converged = False
     for it in range(1, iters + 1):  # noqa: B007
         V = points_of(x)                                       # (n, 3)
-        q, G = _linearise(mech, V, R)                          # (n, M, 6), (n, M, 6, 3)
+        q, G = _linearise(mech, V, R)                          # (n, M, k), (n, M, k, 3)
         if not (np.all(np.isfinite(q)) and np.all(np.isfinite(G))):
             problem = "the inverse kinematics or Jacobian is undefined at a lattice point"
             break
         M = len(R)
-        mi, li = np.meshgrid(np.arange(M), np.arange(6), indexing="ij")
+        mi, li = np.meshgrid(np.arange(M), np.arange(q.shape[2]), indexing="ij")
         rows, slack = [], []
         for pick, is_low in ((np.argmin(q, axis=0), True), (np.argmax(q, axis=0), False)):
-            g = G[pick, mi, li]                                 # (M, 6, 3)
+            g = G[pick, mi, li]                                 # (M, k, 3)
             r = np.einsum("mic,micx->mix", g, A[pick]).reshape(-1, len(x))
             qv = q[pick, mi, li].reshape(-1)
             rows.append(r * rho)

@@ -60,6 +60,14 @@ class PlanarWorkspace(Evaluator):
                "largest κ over the feasible sampled cells and orientations"),
     )
 
+    def written(self, plan):
+        """Units explicit: φ is held in rad, and a bare number in the file means degrees."""
+        d = plan.model_dump()
+        if d["phi"] is not None:
+            d["phi"] = [f"{a:.17g} rad" for a in d["phi"]]
+        d["resolution"] = f"{d['resolution']:.17g} mm"
+        return d
+
     def check(self, plan, evaluation, mech) -> None:
         mob = mech.mobility.coordinates
         if mob[:2] != ("x", "y") or "z" in mob or not hasattr(mech, "planar_cell_margins"):
