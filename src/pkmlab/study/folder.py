@@ -40,7 +40,8 @@ _DESIGNS = "designs"
 #: an exported design's folder, ``NN-<8 hex digits of its key>`` (:mod:`.export` names them)
 DESIGN_FOLDER = re.compile(r"^\d{2}-[0-9a-f]{8}$")
 _DESIGN_FILE = re.compile(r"^[a-z0-9_.-]+\.([a-z0-9]+)$")
-#: suffixes of a design's own files besides the registered mesh formats (pkmlab.export)
+#: suffixes of a design's own files besides the registered mesh and mechanism formats
+#: (pkmlab.export)
 _DESIGN_SUFFIXES = frozenset({"json", "yaml", "png", "npz", "csv"})
 #: ``atomic.write_bytes``'s scratch file of ``target``: ``.<target>.<8 random chars>.part``
 _SCRATCH_FILE = re.compile(r"^\.(.+)\.[a-z0-9_]{8}\.part$")
@@ -143,7 +144,11 @@ def _design_file(name: str) -> bool:
     from ..export import exporters
 
     m = _DESIGN_FILE.match(name)
-    return m is not None and (m.group(1) in _DESIGN_SUFFIXES or m.group(1) in exporters("mesh"))
+    if m is None:
+        return False
+    if m.group(1) in _DESIGN_SUFFIXES or m.group(1) in exporters("mesh"):
+        return True
+    return any(name.endswith(s) for e in exporters("mechanism").values() for s in e.files)
 
 
 def _designs(name: str):
