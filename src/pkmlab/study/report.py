@@ -212,7 +212,8 @@ def _summary(study: Study, records, front, baseline) -> str:
     lines += _catalogue_fits(study, records)
     if notes:
         lines += ["", "Notes (a value shown as — is undefined for the reason given):", *notes]
-    lines += ["", "Lengths in mm, angles in degrees, volumes in cm³, forces in N. Metric "
+    lines += ["", "Lengths in mm, angles in degrees, volumes in cm³, forces in N; "
+              "servos: torques in N·m, angular speeds in deg/s. Metric "
               "definitions: `pkmlab metrics`. Full tables: evaluations.csv, pareto.csv; "
               "exported designs (mechanism YAML, workspace STL, slices, κ map) under designs/."]
     return "\n".join(lines) + "\n"
@@ -224,7 +225,7 @@ REQUIREMENT_MARGINS = ("task_contained", "task_margin", "task_orientation_margin
                        "peak_actuator_torque", "peak_actuator_angular_speed",
                        "peak_actuator_power", "actuators_fit", "actuator_force_margin",
                        "actuator_speed_margin", "actuator_torque_speed_margin",
-                       "actuator_stroke_margin")
+                       "actuator_stroke_margin", "actuator_angle_margin")
 
 
 def _requirement_margins(study: Study, baseline, front, shown) -> list[str]:
@@ -232,7 +233,8 @@ def _requirement_margins(study: Study, baseline, front, shown) -> list[str]:
     (markdown lines; none when the study has no requirement blocks)."""
     rows = ([("baseline", baseline)] if baseline is not None else []) + \
         [(f"Pareto {i + 1}", r) for i, r in enumerate(front)]
-    names = [m for m in REQUIREMENT_MARGINS if any(m in r["metrics"] for _, r in rows)]
+    names = [m for m in REQUIREMENT_MARGINS if any(m in r["metrics"] for _, r in rows)
+             and not all(_other_kind(r, m) for _, r in rows)]
     if not names:
         return []
     head = [f"{METRICS[m].label}" for m in names]
@@ -243,6 +245,15 @@ def _requirement_margins(study: Study, baseline, front, shown) -> list[str]:
         out.append(f"| {label} | " + " | ".join(_fmt(r["metrics"].get(m)) for m in names)
                    + " |")
     return out
+
+
+def _other_kind(record, name: str) -> bool:
+    """Whether ``name`` is the other actuator kind's metric on this design (a servo's
+    ``actuator_stroke_margin``, a linear actuator's ``actuator_torque_rating``): null, with a
+    note pointing at the metric of its own kind."""
+    why = str(record.get("notes", {}).get(name, ""))
+    return record["metrics"].get(name) is None and (" actuator: see " in why
+                                                    or " actuators: see " in why)
 
 
 def _catalogue_fits(study: Study, records) -> list[str]:
