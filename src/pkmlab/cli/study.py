@@ -214,7 +214,8 @@ def run(
             t1 = time.perf_counter()
             info = write_report(outp, study, records)
             t2 = time.perf_counter()
-            _, problems = export_designs(outp, study, pareto_records(study, records))
+            _, problems = export_designs(outp, study, pareto_records(study, records),
+                                         records=records)
             t3 = time.perf_counter()
             page = write_study_page(outp, study, records)
     timings = {"evaluation_s": elapsed, "summary_s": t2 - t1, "export_s": t3 - t2,

@@ -19,6 +19,7 @@ import yaml
 from ..runtime import atomic
 from .definition import Study
 from .export import export_designs
+from .violations import least_violating, tally, violated_text
 from .metrics import METRICS
 from .run import BASELINE, feasible, objective_matrix, provenance
 from .selection import non_dominated
@@ -49,7 +50,7 @@ def _rows(study: Study, records: list[dict]):
     header = (["seq", "role", "status", "reason", "seconds"]
               + [f"design.{v.name} ({v.unit})" if v.unit else f"design.{v.name}"
                  for v in study.variables]
-              + [METRICS[m].label for m in metrics] + ["notes"])
+              + [METRICS[m].label for m in metrics] + ["violated", "notes"])
     rows = []
     for r in records:
         p = _params(study, r)
@@ -58,7 +59,7 @@ def _rows(study: Study, records: list[dict]):
         rows.append([r["seq"], r["role"], r["status"], r["reason"].splitlines()[0]
                      if r["reason"] else "", f"{r['seconds']:.4f}", *vals,
                      *["" if r["metrics"].get(m) is None else r["metrics"][m]
-                       for m in metrics], notes])
+                       for m in metrics], violated_text(study, r), notes])
     return header, rows
 
 
@@ -210,6 +211,7 @@ def _summary(study: Study, records, front, baseline) -> str:
         lines.append(row(f"Pareto {i + 1}", r))
     lines += _requirement_margins(study, baseline, front[:max(study.top, 1) * 2], metrics)
     lines += _catalogue_fits(study, records)
+    lines += _why_they_fail(study, records, front)
     if notes:
         lines += ["", "Notes (a value shown as — is undefined for the reason given):", *notes]
     lines += ["", "Lengths in mm, angles in degrees, volumes in cm³, forces in N; "
@@ -244,6 +246,26 @@ def _requirement_margins(study: Study, baseline, front, shown) -> list[str]:
     for label, r in rows:
         out.append(f"| {label} | " + " | ".join(_fmt(r["metrics"].get(m)) for m in names)
                    + " |")
+    return out
+
+
+def _why_they_fail(study: Study, records, front) -> list[str]:
+    """The tally of violated constraints over the candidates and, when nothing is feasible,
+    the least-violating designs (what each misses, by how much)."""
+    counts = [t for t in tally(study, records) if t[1]]
+    if not counts:
+        return []
+    out = ["", "Why candidates fail (violations per constraint; a candidate can violate "
+           "several; column `violated` of evaluations.csv):", "",
+           "| constraint | violated | of |", "|---|---|---|"]
+    out += [f"| {w} | {n} | {of} |" for w, n, of in counts]
+    if not front:
+        least = least_violating(study, records, max(study.top, 1))
+        if least:
+            out += ["", f"No feasible design. The {len(least)} least violating (fewest "
+                    "violations, then smallest; exported under designs/):", "",
+                    "| candidate | violated |", "|---|---|"]
+            out += [f"| {r['seq']} | {violated_text(study, r)} |" for r in least]
     return out
 
 

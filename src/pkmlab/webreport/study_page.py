@@ -14,6 +14,7 @@ import yaml
 
 from ..export import exporters
 from ..study.definition import Study
+from ..study.violations import tally, violated_text
 from ..study.export import read_index
 from ..study.metrics import METRICS
 from . import data as D
@@ -104,6 +105,8 @@ def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
             "short": info["why"].split(":")[0], "params": prow,
             "derived": D.derived_rows(study, params, rounded), "metrics": mrows,
             "constraints": D.constraint_rows(study, metrics), "notes": info.get("notes", {}),
+            "violated": violated_text(study, {"status": "ok", "metrics": metrics,
+                                              "notes": info.get("notes", {})}),
             "build_problem": problem, "slices": [], "files": [], "has_scene": False,
             "colour_options": [], "scene_note": ""}
     for name in info["files"]:
@@ -229,6 +232,7 @@ def write_study_page(out: Path, study: Study, records: list[dict], *, progress=N
             colours[card["number"]] = opts
     metrics = [m for m in METRICS if any(m in r["metrics"] for r in rows)]
     counts, reasons = D.failure_counts(records)
+    why_fail = [{"what": w, "count": n, "of": of} for w, n, of in tally(study, records) if n]
     resolved = out / "study.resolved.yaml"
     resolved_text = (resolved.read_text() if resolved.is_file() else
                      yaml.safe_dump(json.loads(json.dumps(study.resolved(), default=float)),
@@ -249,7 +253,7 @@ def write_study_page(out: Path, study: Study, records: list[dict], *, progress=N
         n_feasible=sum(r["feasible"] for r in rows if r["role"] == "candidate"),
         n_pareto=len(front), has_parcoords=has_parcoords,
         constraints_text=", ".join(c.describe() for c in study.constraints) or "none",
-        export_problems=index["problems"], variables=_variables(study),
+        export_problems=index["problems"], why_fail=why_fail, variables=_variables(study),
         optimizer=_optimizer_text(study),
         seed=study.seed, resolved_yaml=resolved_text, runs=_runs(out),
         length_step=D.LENGTH_STEP_MM, angle_step=D.ANGLE_STEP_DEG,
