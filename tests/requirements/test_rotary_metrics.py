@@ -53,7 +53,8 @@ def test_servo_study_metrics_say_torque_and_angle(tmp_path):
         math.degrees(float(np.max(np.abs(dyn.qdot)))), rel=1e-9)              # deg/s
     assert (METRICS["actuator_torque_rating"].unit, METRICS["actuator_angle_margin"].unit,
             METRICS["peak_actuator_torque"].unit,
-            METRICS["peak_actuator_angular_speed"].unit) == ("N·m", "deg", "N·m", "deg/s")
+            METRICS["peak_actuator_angular_speed"].unit, METRICS["peak_servo_torque"].unit
+            ) == ("N·m", "deg", "N·m", "deg/s", "N·m")
 
 
 def test_linear_study_leaves_the_servo_metrics_null(tmp_path):

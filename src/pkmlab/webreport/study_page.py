@@ -75,6 +75,14 @@ def _points(study: Study, rows: list[dict]) -> list[dict]:
     return pts
 
 
+def _other_kind(metrics: dict, notes: dict, name: str) -> bool:
+    """The other actuator kind's metric (a servo's ``actuator_force_rating``): null with a
+    note pointing at the metric of its own kind; left off the card (kept in the CSV)."""
+    why = str(notes.get(name, ""))
+    return metrics.get(name) is None and (" actuator: see " in why
+                                          or " actuators: see " in why)
+
+
 def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
           n: int) -> tuple[dict, object | None, list]:
     folder = out / "designs" / entry["folder"]
@@ -94,8 +102,10 @@ def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
                      "baseline": D.fmt(base_p.get(v.name)), "delta": d, "pct": pct})
     objectives = {o.metric: o.sense[:3] + "." for o in study.objectives}
     metrics = info["metrics"]
+    notes = info.get("notes", {})
     mrows = D.compare_rows([(m, METRICS[m].unit, metrics.get(m), base_m.get(m))
-                            for m in METRICS if m in metrics or m in base_m])
+                            for m in METRICS if (m in metrics or m in base_m)
+                            and not _other_kind(metrics, notes, m)])
     for r in mrows:
         r["objective"] = objectives.get(r["name"], "")
         r["title"] = METRICS[r["name"]].description
