@@ -8,6 +8,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from ...motion import check_trajectory, paper_motion
+from ...tolerances import TOL
 from .registry import Evaluator, finite, metric, register_evaluator
 
 
@@ -41,9 +42,13 @@ class Trajectory(Evaluator):
         t, X = motion.t, motion.poses
         rep = check_trajectory(mech, t, X, payload_mass_kg=plan.payload)
         margins = np.concatenate([rep.margin_low, rep.margin_high])
+        # a motion that uses exactly 100 % of the stroke has a margin of round-off size
+        # (−1.4e-13 mm): within the stroke round-off tolerance it reads 0
+        margin = float(np.min(margins)) if np.all(np.isfinite(margins)) else None
+        if margin is not None and abs(margin) <= TOL.stroke_roundoff_mm:
+            margin = 0.0
         out = {"paper_motion_fits": float(rep.fits),
-               "paper_motion_margin": finite(np.min(margins))
-               if np.all(np.isfinite(margins)) else None}
+               "paper_motion_margin": None if margin is None else finite(margin)}
         if out["paper_motion_margin"] is None:
             ctx.notes["paper_motion_margin"] = "a pose of the motion has no inverse kinematics"
         return out

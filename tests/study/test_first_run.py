@@ -1,0 +1,43 @@
+"""Issue 26 item 5 (honest first runs) and the rss6 template of item 1: a misspelt metric
+name gets a "did you mean"; the paper motion's margin at exactly 100 % of the stroke reads 0
+(not −1.4e-13 mm of round-off); the rss6 template validates and its baseline meets every
+constraint (so the template's first run has an answer)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from clihelp import small_study
+
+from pkmlab.errors import ParameterError
+from pkmlab.study import load_study
+from pkmlab.study.evaluators import evaluate_design
+from pkmlab.study.violations import violated_text
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_misspelt_metric_gets_a_did_you_mean(tmp_path):
+    path = small_study(tmp_path, objectives=[{"maximize": "constant_volum"}])
+    with pytest.raises(ParameterError, match=r"did you mean 'constant_volume'"):
+        load_study(path)
+
+
+def test_paper_motion_margin_at_full_stroke_reads_zero():
+    s = load_study(ROOT / "studies" / "hopkins-6psu-redesign.yaml")
+    rec = evaluate_design(s.space, None, s.evaluation, 0)
+    assert rec["status"] == "ok", rec.get("reason")
+    # the paper's z motion touches the stroke limit exactly: the margin is 0, not round-off
+    assert rec["metrics"]["paper_motion_margin"] == 0.0
+    assert rec["metrics"]["paper_motion_fits"] == 1.0
+
+
+def test_rss6_template_validates_and_its_baseline_is_feasible():
+    s = load_study(ROOT / "studies" / "templates" / "rss6-study.yaml")
+    rec = evaluate_design(s.space, None, s.evaluation, 0)
+    assert rec["status"] == "ok", rec.get("reason")
+    m = rec["metrics"]
+    assert violated_text(s, {**rec, "role": "candidate"}) == ""
+    assert m["actuator_torque_rating"] == pytest.approx(2.0)             # S-2Nm, in N·m
+    assert 0 < m["peak_actuator_torque"] < 2.0 and m["actuator_angle_margin"] > 0
