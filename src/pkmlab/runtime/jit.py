@@ -185,6 +185,16 @@ def jitable(fn, ident: str, **options):
     return register_jitable(**options)(_renamed(fn, f"{fn.__name__}_{ident[:16]}"))
 
 
+#: seconds this process has spent compiling (or loading from the cache) kernels
+_COMPILING = [0.0]
+
+
+def compile_seconds() -> float:
+    """Seconds this process has spent in :func:`cached_kernel` so far (compiles and cache
+    loads): subtracted from a measured evaluation time before it is used for an estimate."""
+    return _COMPILING[0]
+
+
 def cached_kernel(fn, sig, *, roots=(), extra=(), **options):
     """``njit(sig, cache=True, **options)`` of ``fn``, compiled now, named and compiled in a
     uid namespace after its identity (see the module notes).
@@ -215,6 +225,7 @@ def cached_kernel(fn, sig, *, roots=(), extra=(), **options):
                 compiled = njit(sig, cache=CACHE_SAFE, **options)(kernel)
     finally:
         notice.cancel()
+        _COMPILING[0] += time.perf_counter() - t0
     if time.perf_counter() - t0 > COMPILE_NOTICE_S:
         log.info("compiled %s in %.1f s", fn.__name__, time.perf_counter() - t0)
     return compiled
