@@ -70,3 +70,15 @@ def test_time_estimate_leaves_out_the_compilation(tmp_path, monkeypatch, capsys)
     rec = real(load_study(small_study(tmp_path)).space, None,
                load_study(small_study(tmp_path)).evaluation, 0)
     assert 0.0 <= rec["compile_seconds"] <= rec["seconds"]
+
+
+def test_summary_printed_piped_is_the_file_unwrapped(tmp_path, capsys):
+    """Piped, `pkmlab run` prints summary.md's own lines (before: hard-wrapped at 80 columns
+    of raw Markdown, tables broken across lines)."""
+    from clihelp import cli
+
+    code, o, err = cli(capsys, "run", small_study(tmp_path))
+    assert code == 0, err
+    text = (tmp_path / "out" / "summary.md").read_text()
+    long = [ln for ln in text.splitlines() if len(ln) > 80]
+    assert long and all(ln in o.splitlines() for ln in long)

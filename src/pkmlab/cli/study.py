@@ -228,7 +228,7 @@ def run(
     out.print(escape(f"{study.name}: {info['evaluations']} evaluations ({info['failed']} "
                      f"invalid or failed) in {elapsed:.1f} s, {info['pareto']} Pareto designs"),
               highlight=False)
-    out.print(escape((outp / "summary.md").read_text()), highlight=False)
+    _print_markdown((outp / "summary.md").read_text())
     for p in problems:
         err.print(escape(f"warning: export skipped: {p}"), highlight=False)
     out.print(escape(f"results in {outp}/ (report.html, summary.md, pareto.csv, pareto.png, "
@@ -278,3 +278,12 @@ def report(results_dir: Annotated[Path, typer.Argument(help="a study's results f
                      f"{info['pareto']} Pareto designs"), highlight=False)
 
 
+def _print_markdown(text: str) -> None:
+    """summary.md on the console: rendered (tables drawn) on a terminal; piped, the file's
+    own lines, never hard-wrapped at the console width."""
+    if out.is_terminal:
+        from rich.markdown import Markdown
+
+        out.print(Markdown(text))
+    else:
+        out.print(text, markup=False, highlight=False, soft_wrap=True, end="")
