@@ -82,3 +82,22 @@ def test_summary_printed_piped_is_the_file_unwrapped(tmp_path, capsys):
     text = (tmp_path / "out" / "summary.md").read_text()
     long = [ln for ln in text.splitlines() if len(ln) > 80]
     assert long and all(ln in o.splitlines() for ln in long)
+
+
+def test_fk_all_piped_is_one_line_per_mode(capsys):
+    """`fk --all` piped: a tab-separated line per assembly mode (before: a rich table
+    wrapped at 80 columns, a mode spread over several lines)."""
+    from clihelp import HW, cli
+
+    from pkmlab import load_mechanism
+
+    mech = load_mechanism(HW)
+    q = mech.inverse(mech.nominal_pose).q[0]
+    code, o, err = cli(capsys, "fk", HW, "--actuators", ",".join(f"{v:.9f}" for v in q),
+                       "--all", "--starts", "50")
+    assert code == 0, err
+    lines = [ln for ln in o.splitlines() if ln.count("\t") == 8]
+    assert lines[0].startswith("#\tx (mm)")
+    rows = lines[1:]
+    assert rows and all(len(ln.split("\t")) == 9 for ln in rows)
+    assert any(abs(float(r.split("\t")[3]) - mech.nominal_pose[2]) < 1e-3 for r in rows)
