@@ -46,8 +46,9 @@ def test_rss6_template_validates_and_its_baseline_is_feasible():
 def test_time_estimate_leaves_out_the_compilation(tmp_path, monkeypatch, capsys):
     """The first evaluation's kernel compilation (measured by pkmlab.runtime.jit) is left out
     of the seconds-per-evaluation the estimate uses (before: the demo announced 1.87 h)."""
-    import pkmlab.study.run as run
     from clihelp import cli
+
+    import pkmlab.study.run as run
 
     real = run.evaluate_design
     seen = []

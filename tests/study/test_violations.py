@@ -16,7 +16,6 @@ from pkmlab.study import load_study
 from pkmlab.study.violations import least_violating, tally, violated_text, violations
 
 
-
 def test_zero_feasible_study_says_why_and_exports_the_least_violating(tmp_path, capsys):
     path = small_study(tmp_path, constraints=[{"constant_volume": {"min": 1.0e12}}], top=2)
     code, o, e = cli(capsys, "run", path)

@@ -19,10 +19,10 @@ import yaml
 from ..runtime import atomic
 from .definition import Study
 from .export import export_designs
-from .violations import least_violating, tally, violated_text
 from .metrics import METRICS
 from .run import BASELINE, feasible, objective_matrix, provenance
 from .selection import non_dominated
+from .violations import least_violating, tally, violated_text
 
 log = logging.getLogger(__name__)
 

@@ -14,9 +14,9 @@ import yaml
 
 from ..export import exporters
 from ..study.definition import Study
-from ..study.violations import tally, violated_text
 from ..study.export import read_index
 from ..study.metrics import METRICS
+from ..study.violations import tally, violated_text
 from . import data as D
 from .figures import design_scene, pareto_matrix, pareto_parcoords
 from .page import colour_option, figure_json, hull_of_ply, png_uri, render_page
