@@ -274,8 +274,9 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
             per actuator, compared with ``|q̇|``.
         max_force: actuator force limit in N (torque limit in N·mm for a rotary actuator),
             scalar or one per actuator, compared with ``|f|``. On a lower-mobility mechanism
-            the forces balance the wrench's free components (the constraint wrench takes the rest); with more actuators than free
-            coordinates they are the least-norm solution.
+            the forces balance the wrench's free components (the constraint wrench takes the
+            rest); with more actuators than free coordinates they are the least-norm
+            solution.
         stroke_tolerance: round-off allowance in mm: an actuator value at most this far
             outside its window still counts as inside (a motion planned to touch a limit
             exactly, as the paper's z motion does, is not a violation).
