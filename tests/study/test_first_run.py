@@ -102,3 +102,21 @@ def test_fk_all_piped_is_one_line_per_mode(capsys):
     rows = lines[1:]
     assert rows and all(len(ln.split("\t")) == 9 for ln in rows)
     assert any(abs(float(r.split("\t")[3]) - mech.nominal_pose[2]) < 1e-3 for r in rows)
+
+
+def test_kappa_mesh_colours_are_clipped_to_percentiles(monkeypatch):
+    """A few near-singular voxels (κ 1e4) no longer squeeze every other vertex of the coloured
+    mesh into the bottom colour (the slices were already clipped; now the mesh is too)."""
+    import types
+
+    import numpy as np
+
+    import pkmlab.dexterity.maps as maps
+
+    vals = np.concatenate([np.linspace(2.0, 10.0, 998), [1e4, 1e4]])
+    monkeypatch.setattr(maps, "vertex_values", lambda mesh, mmap: vals)
+    rgba = maps.mesh_colours(types.SimpleNamespace(vertices=np.zeros((1000, 3))),
+                             types.SimpleNamespace(values=vals))
+    bulk = rgba[:998, :3].astype(int)
+    # the bulk spans the colour map: its first and last colours differ widely
+    assert np.abs(bulk[0] - bulk[-1]).max() > 150
