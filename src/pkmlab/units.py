@@ -8,13 +8,15 @@ from __future__ import annotations
 
 import math
 import re
+from dataclasses import dataclass
 from typing import Any
 
 from .errors import ParameterError
 
 __all__ = ["LENGTH_UNITS", "ANGLE_UNITS", "parse_length", "parse_angle", "parse_quantity",
            "parse_physical", "MASS_UNITS", "FORCE_UNITS", "TORQUE_UNITS", "SPEED_UNITS",
-           "ANGULAR_SPEED_UNITS", "INERTIA_UNITS", "TIME_UNITS", "FREQUENCY_UNITS", "LEAD_UNITS"]
+           "ANGULAR_SPEED_UNITS", "INERTIA_UNITS", "TIME_UNITS", "FREQUENCY_UNITS", "LEAD_UNITS",
+           "ActuatorDisplay", "LINEAR_DISPLAY", "ROTARY_DISPLAY", "actuator_display"]
 
 LENGTH_UNITS = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "inch": 25.4, "ft": 304.8}
 ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180.0, "°": math.pi / 180.0}
@@ -94,3 +96,50 @@ def parse_physical(value: Any, field: str, units: dict[str, float], default_unit
     ``units``, compound units allowed: ``"500 mm/s"``, ``"1.2 kg·m²"``, ``"3 N m"``) to the
     internal unit (factor 1.0). Raises :class:`ParameterError` naming ``field``."""
     return _parse(value, field, units, default_unit, _ANY_QUANTITY, _normalise_unit)
+
+
+# ---- the one display convention for actuator quantities ---------------------------------
+@dataclass(frozen=True)
+class ActuatorDisplay:
+    """How a person reads an actuator's quantities (tables, CSV headers, plots, CLI).
+
+    Internal units stay mm, rad, N and N·mm. A linear actuator is read in mm, mm/s and N
+    (its value is a *stroke*, its effort a *force*); a rotary one (servo / crank motor,
+    ``actuator_unit`` rad) in deg, deg/s and N·m (its value is an *angle*, its effort a
+    *torque*), and its stiffness in N·m/rad. Multiply an internal value by ``value_scale``,
+    ``rate_scale``, ``effort_scale`` or ``stiffness_scale`` to get the displayed one.
+    """
+
+    rotary: bool
+    value: str            # "stroke" / "angle"
+    value_unit: str       # "mm" / "deg"
+    value_scale: float
+    rate: str             # "speed" / "angular speed"
+    rate_unit: str        # "mm/s" / "deg/s"
+    rate_scale: float
+    effort: str           # "force" / "torque"
+    effort_unit: str      # "N" / "N·m"
+    effort_scale: float
+    stiffness_unit: str   # "N/mm" / "N·m/rad"
+    stiffness_scale: float
+
+    @property
+    def value_name(self) -> str:
+        """Axis label of the actuator value: ``Leg length (mm)`` / ``Crank angle (deg)``."""
+        return "Crank angle (deg)" if self.rotary else "Leg length (mm)"
+
+    def ascii(self, unit: str) -> str:
+        """A unit for a CSV header / JSON key: ``N·m`` → ``N_m``, ``deg/s`` → ``deg_s``."""
+        return unit.replace("·", "_").replace("/", "_")
+
+
+LINEAR_DISPLAY = ActuatorDisplay(False, "stroke", "mm", 1.0, "speed", "mm/s", 1.0, "force",
+                                 "N", 1.0, "N/mm", 1.0)
+ROTARY_DISPLAY = ActuatorDisplay(True, "angle", "deg", 180.0 / math.pi, "angular speed",
+                                 "deg/s", 180.0 / math.pi, "torque", "N·m", 1e-3, "N·m/rad",
+                                 1e-3)
+
+
+def actuator_display(actuator_unit: str) -> ActuatorDisplay:
+    """The display convention of a mechanism's ``actuator_unit`` (``"mm"`` or ``"rad"``)."""
+    return ROTARY_DISPLAY if actuator_unit == "rad" else LINEAR_DISPLAY

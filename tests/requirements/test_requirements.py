@@ -629,7 +629,7 @@ def test_rotary_servo_fit_on_rss6_and_kind_mismatch_is_refused(tmp_path):
 
 
 def test_motion_metrics_carry_the_actuators_units(tmp_path):
-    """A rotary family's motion loads are torques (N·mm) and angular speeds (rad/s): they go
+    """A rotary family's motion loads are torques (N·m) and angular speeds (deg/s): they go
     to the torque metrics, and the force metrics (N, mm/s) stay null with a note; a linear
     family the other way round. The torque equals the dynamics' own peak."""
     motion = [{"name": "s", "sinusoid": {"amplitude": {"z": "3 mm"}, "frequency": {"z": "1 Hz"}},
@@ -651,7 +651,9 @@ def test_motion_metrics_carry_the_actuators_units(tmp_path):
         peak = float(np.max(dyn.summary()["peak_force"]))
         have, null = (("peak_actuator_torque", "peak_actuator_force") if rotary else
                       ("peak_actuator_force", "peak_actuator_torque"))
-        assert m[have] == pytest.approx(peak) and m[null] is None and have in notes[null]
+        # issue 26: torques are shown in N·m (the dynamics give N·mm), forces in N
+        shown = peak * (1e-3 if rotary else 1.0)
+        assert m[have] == pytest.approx(shown) and m[null] is None and have in notes[null]
         assert (m["peak_actuator_angular_speed"] is None) != rotary
 
 

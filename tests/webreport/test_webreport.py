@@ -180,8 +180,9 @@ def test_data_is_strict_json_without_nan(tiny_report):
     json.loads(m.group(1), parse_constant=lambda c: pytest.fail(f"non-JSON constant {c}"))
 
 
-def test_report_without_exported_designs(tmp_path):
-    """A study with no feasible candidate still gets a page (no cards, a reason)."""
+def test_report_without_feasible_designs(tmp_path):
+    """A study with no feasible candidate gets a page with the least-violating designs drawn
+    (issue 26: before, no cards and nothing said which constraint failed)."""
     import yaml
     from conftest import TINY_STUDY
 
@@ -192,4 +193,5 @@ def test_report_without_exported_designs(tmp_path):
     r = CliRunner().invoke(app, ["run", str(path), "--json"])
     assert r.exit_code == 0, r.output
     html = (tmp_path / "out" / "report.html").read_text()
-    assert "No design was exported" in html and 'id="design-1"' not in html
+    assert "No design was exported" not in html and 'id="design-1"' in html
+    assert "Why candidates fail" in html and "violated: z_span ≥ 1e+06 by" in html

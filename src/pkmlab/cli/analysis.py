@@ -66,12 +66,20 @@ def dexterity(
     = "auto",
     well_conditioned: Annotated[float, typer.Option(
         help="κ bound of the well-conditioned sub-workspace")] = 10.0,
-    force_limit: Annotated[float, typer.Option(help="actuator force limit (N)")] = 150.0,
+    force_limit: Annotated[float | None, typer.Option(
+        help="linear actuator force limit (N); default 150 N for linear actuators")] = None,
+    max_torque: Annotated[float | None, typer.Option(
+        help="rotary actuator (servo) torque limit (N·m); required for a rotary family")]
+    = None,
     force_required: Annotated[float, typer.Option(
         help="force (N) the platform must hold in every direction: its sub-workspace")]
     = 100.0,
-    actuator_stiffness: Annotated[float, typer.Option(help="actuator stiffness (N/mm)")]
-    = 1.0e4,
+    actuator_stiffness: Annotated[float | None, typer.Option(
+        help="linear actuator stiffness (N/mm); default 10000 N/mm for linear actuators")]
+    = None,
+    torsional_stiffness: Annotated[float | None, typer.Option(
+        help="rotary actuator (servo) torsional stiffness (N·m/rad); required for a rotary "
+             "family")] = None,
     gci_samples: Annotated[int, typer.Option(help="Monte-Carlo GCI samples")] = 2000,
     seed: Annotated[int, typer.Option(help="Monte-Carlo seed")] = 0,
     out_dir: Annotated[Path, typer.Option("--out", help="output folder")]
@@ -105,6 +113,8 @@ def dexterity(
         if not L > 0:
             _fail(ParameterError("--characteristic-length", "a length > 0 mm or 'auto'",
                                  characteristic_length))
+    force_limit, actuator_stiffness = _dexterity_actuators(
+        mech, force_limit, actuator_stiffness, max_torque, torsional_stiffness)
     for name, v, lo in (("--force-limit", force_limit, 0), ("--actuator-stiffness",
                                                               actuator_stiffness, 0),
                         ("--well-conditioned", well_conditioned, 1),
@@ -153,6 +163,35 @@ def dexterity(
     _print_dexterity(rep, force_limit, well_conditioned, force_required, written)
 
 
+def _dexterity_actuators(mech, force_limit, actuator_stiffness, max_torque,
+                         torsional_stiffness):
+    """Effort limit and actuator stiffness in internal units (N, N/mm; N·mm, N·mm/rad for a
+    servo) from the options of the mechanism's actuator kind. A rotary family needs
+    --max-torque and --torsional-stiffness: no linear default is applied to a servo."""
+    if mech.actuator_unit != "rad":
+        for opt, v in (("--max-torque", max_torque),
+                       ("--torsional-stiffness", torsional_stiffness)):
+            if v is not None:
+                _fail(ParameterError(opt, f"--force-limit (N) / --actuator-stiffness (N/mm): "
+                                     f"{mech.family} has linear actuators", v))
+        return (LINEAR_FORCE_DEFAULT_N if force_limit is None else force_limit,
+                1.0e4 if actuator_stiffness is None else actuator_stiffness)
+    for opt, v in (("--force-limit", force_limit), ("--actuator-stiffness",
+                                                    actuator_stiffness)):
+        if v is not None:
+            _fail(ParameterError(opt, f"--max-torque (N·m) / --torsional-stiffness (N·m/rad): "
+                                 f"{mech.family} has rotary actuators", v))
+    for opt, v, what in (("--max-torque", max_torque, "the servo torque limit (N·m)"),
+                         ("--torsional-stiffness", torsional_stiffness,
+                          "the servo torsional stiffness (N·m/rad)")):
+        if v is None:
+            _fail(ParameterError(opt, f"{what}: {mech.family} has rotary actuators and no "
+                                 "linear default applies to them", "not given"))
+        if not (math.isfinite(v) and v > 0):
+            _fail(ParameterError(opt, "a number > 0", v))
+    return max_torque * 1e3, torsional_stiffness * 1e3
+
+
 def _print_dexterity(rep, force_limit, well_conditioned, force_required, written) -> None:
     """Text output of ``dexterity`` (everything printed is in ``rep.data``)."""
     def g(v, fmt):
@@ -170,7 +209,7 @@ def _print_dexterity(rep, force_limit, well_conditioned, force_required, written
     moment = n["moment_all_directions_Nmm"]
     out.print(f"  force in every direction {g(n['force_all_directions_N'], '.1f')} N, moment "
               f"{g(None if moment is None else moment / 1e3, '.2f')} "
-              f"N·m (actuators ±{force_limit:g} N); stiffness ≥ "
+              f"N·m ({_limit_text(mech, force_limit)}); stiffness ≥ "
               f"{g(n['stiffness_translational_min_N_per_mm'], '.0f')} N/mm")
     if agg["empty"]:
         out.print("  workspace: [bold]empty[/] — no aggregates")
@@ -213,9 +252,14 @@ def trajectory(
     segment_time: Annotated[float, typer.Option(help="paper motion: s per cubic segment")]
     = 1.0,
     payload: Annotated[float, typer.Option(help="payload mass (kg) at the tool point")] = 0.0,
-    max_speed: Annotated[float | None, typer.Option(help="actuator speed limit (mm/s)")]
-    = None,
-    max_force: Annotated[float | None, typer.Option(help="actuator force limit (N)")] = 150.0,
+    max_speed: Annotated[float | None, typer.Option(
+        help="linear actuator speed limit (mm/s)")] = None,
+    max_force: Annotated[float | None, typer.Option(
+        help="linear actuator force limit (N); default 150 N for linear actuators")] = None,
+    max_torque: Annotated[float | None, typer.Option(
+        help="rotary actuator (servo) torque limit (N·m); no default")] = None,
+    max_angular_speed: Annotated[float | None, typer.Option(
+        help="rotary actuator (servo) angular speed limit (deg/s)")] = None,
     out_dir: Annotated[Path, typer.Option("--out", help="output folder")]
     = Path("results/trajectory"),
     as_json: JsonOpt = False,
@@ -230,6 +274,8 @@ def trajectory(
     from .. import motion as tr
 
     mech = _load(mech_file)
+    max_speed, max_force = _actuator_limits(mech, max_speed, max_force, max_torque,
+                                            max_angular_speed)
     if (csv is None) == (not paper_motion):
         _fail(ParameterError("--csv / --paper-motion", "exactly one of them", "both"
                              if paper_motion else "neither"))
@@ -251,12 +297,15 @@ def trajectory(
         (tmp / "trajectory.json").write_text(json.dumps(summary, indent=2, default=float)
                                              + "\n")
         names = mech.actuator_names
-        u = mech.actuator_unit     # internal units: mm, or rad for rotary families
-        header = ",".join(["t", *[f"{n}_{u}" for n in names], *[f"{n}_rate_{u}_s" for n in names],
-                           *[f"{n}_force_N" for n in names], "status"])
-        rows = [",".join([f"{t[i]:.6g}", *[f"{v:.6g}" for v in rep.q[i]],
-                          *[f"{v:.6g}" for v in rep.qdot[i]], *[f"{v:.6g}" for v in
-                                                               rep.force[i]], str(rep.status[i])])
+        d = rep.display     # mm, mm/s, N; or deg, deg/s, N·m for rotary actuators
+        a = d.ascii
+        header = ",".join(["t", *[f"{n}_{a(d.value_unit)}" for n in names],
+                           *[f"{n}_rate_{a(d.rate_unit)}" for n in names],
+                           *[f"{n}_{d.effort}_{a(d.effort_unit)}" for n in names], "status"])
+        rows = [",".join([f"{t[i]:.6g}", *[f"{v * d.value_scale:.6g}" for v in rep.q[i]],
+                          *[f"{v * d.rate_scale:.6g}" for v in rep.qdot[i]],
+                          *[f"{v * d.effort_scale:.6g}" for v in rep.force[i]],
+                          str(rep.status[i])])
                 for i in range(len(t))]
         (tmp / "trajectory.csv").write_text(header + "\n" + "\n".join(rows) + "\n")
         phases = tr.paper_motion_phases(segment_time) if paper_motion else None
@@ -272,20 +321,66 @@ def trajectory(
     verdict = "[bold green]fits[/]" if rep.fits else "[bold red]does not fit[/]"
     out.print(f"{escape(mech.name or mech.family)}: {len(t)} samples over {t[-1] - t[0]:.2f} s "
               f"— {verdict} the limits")
+    d = rep.display
+    shown = {"stroke": (d.value, d.value_scale, d.value_unit),
+             "speed": (d.rate, d.rate_scale, d.rate_unit),
+             "force": (d.effort, d.effort_scale, d.effort_unit)}
     for kind, v in rep.violations.items():
         if v is not None:
+            name, scale, unit = shown.get(kind, (kind, 1.0, ""))
             what = "" if v.value is None else (
-                f", {escape(str(v.actuator))} = {v.value:.6g}"
-                + ("" if v.limit is None else f" vs limit {v.limit:.6g}"))
-            out.print(f"  first {kind} violation: sample {v.index} (t = {v.time:.3f} s){what}"
+                f", {escape(str(v.actuator))} = {v.value * scale:.6g} {unit}"
+                + ("" if v.limit is None else f" vs limit {v.limit * scale:.6g} {unit}"))
+            out.print(f"  first {name} violation: sample {v.index} (t = {v.time:.3f} s){what}"
                       + (f" — {escape(v.reason)}" if v.reason else ""))
-    lo_m, hi_m = rep.margin_low, rep.margin_high
-    out.print("  stroke margins (mm) below / above: " + ", ".join(
+    lo_m, hi_m = rep.margin_low * d.value_scale, rep.margin_high * d.value_scale
+    out.print(f"  {d.value} margins ({d.value_unit}) below / above: " + ", ".join(
         f"{n} {a:.2f}/{b:.2f}" for n, a, b in zip(mech.actuator_names, lo_m, hi_m)))
-    out.print(f"  peak speed {np.nanmax(np.abs(rep.qdot)):.1f} mm/s, peak force "
-              f"{np.nanmax(np.abs(rep.force)):.2f} N")
+    out.print(f"  peak {d.rate} {_nanpeak(rep.qdot) * d.rate_scale:.4g} {d.rate_unit}, peak "
+              f"{d.effort} {_nanpeak(rep.force) * d.effort_scale:.4g} {d.effort_unit}"
+              + ("" if rep.max_force is not None else f" (no {d.effort} limit given)"))
     for p in written:
         out.print(f"  wrote {escape(str(p))}")
+
+
+def _limit_text(mech, force_limit) -> str:
+    if mech.actuator_unit == "rad":
+        return f"servos ±{force_limit / 1e3:g} N·m"
+    return f"actuators ±{force_limit:g} N"
+
+
+def _nanpeak(a) -> float:
+    a = np.abs(np.asarray(a, dtype=float))
+    return float(np.nanmax(a)) if np.isfinite(a).any() else math.nan
+
+
+#: the linear force limit applied when none is given (never to a rotary actuator)
+LINEAR_FORCE_DEFAULT_N = 150.0
+
+
+def _actuator_limits(mech, max_speed, max_force, max_torque, max_angular_speed):
+    """The speed and effort limits in internal units (mm/s, N; rad/s, N·mm for a servo)
+    from the options of the mechanism's actuator kind; the other kind's options are refused
+    and no linear default is applied to a rotary actuator."""
+    rotary = mech.actuator_unit == "rad"
+    given = {"--max-speed": max_speed, "--max-force": max_force, "--max-torque": max_torque,
+             "--max-angular-speed": max_angular_speed}
+    wrong = ("--max-speed", "--max-force") if rotary else ("--max-torque",
+                                                           "--max-angular-speed")
+    for opt in wrong:
+        if given[opt] is not None:
+            kind = "rotary" if rotary else "linear"
+            use = ("--max-torque (N·m) / --max-angular-speed (deg/s)" if rotary else
+                   "--max-force (N) / --max-speed (mm/s)")
+            _fail(ParameterError(opt, f"{use}: {mech.family} has {kind} actuators",
+                                 given[opt]))
+    for opt, v in given.items():
+        if v is not None and not (math.isfinite(v) and v > 0):
+            _fail(ParameterError(opt, "a number > 0", v))
+    if rotary:
+        return (None if max_angular_speed is None else math.radians(max_angular_speed),
+                None if max_torque is None else max_torque * 1e3)
+    return max_speed, LINEAR_FORCE_DEFAULT_N if max_force is None else max_force
 
 
 @app.command()

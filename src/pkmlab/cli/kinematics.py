@@ -172,7 +172,18 @@ def fk(mech_file: MechArg,
     elif res.converged[0]:
         out.print(f"no other working-mode assembly mode reached from {res.mode_starts} starts "
                   "in the working region (a search, not a proof; --all searches wider)")
-    if all_modes:
+    if all_modes and not out.is_terminal:
+        # piped: one line per mode, tab-separated, never wrapped at a console width
+        lines = [f"# {len(modes.residual)} assembly modes from {modes.starts} starts "
+                 "(a multi-start search: not known to be complete)",
+                 "\t".join(["#", "x (mm)", "y (mm)", "z (mm)", "θx (deg)", "θy (deg)",
+                            "θz (deg)", "residual (mm)", "working mode"])]
+        for i, (p, r, w) in enumerate(zip(modes.pose, modes.residual, modes.working_mode)):
+            pj = _pose_json(p)
+            lines.append("\t".join([str(i + 1), *[f"{pj[k]:.4f}" for k in POSE_KEYS],
+                                    f"{r:.2e}", "yes" if w else "no"]))
+        out.file.write("\n".join(lines) + "\n")
+    elif all_modes:
         table = Table("#", "x (mm)", "y (mm)", "z (mm)", "θx (deg)", "θy (deg)", "θz (deg)",
                       "residual (mm)", "working mode",
                       title=f"{len(modes.residual)} assembly modes from {modes.starts} starts")

@@ -218,7 +218,8 @@ def run(
             t1 = time.perf_counter()
             info = write_report(outp, study, records)
             t2 = time.perf_counter()
-            _, problems = export_designs(outp, study, pareto_records(study, records))
+            _, problems = export_designs(outp, study, pareto_records(study, records),
+                                         records=records)
             t3 = time.perf_counter()
             page = write_study_page(outp, study, records)
     timings = {"evaluation_s": elapsed, "summary_s": t2 - t1, "export_s": t3 - t2,
@@ -231,7 +232,7 @@ def run(
     out.print(escape(f"{study.name}: {info['evaluations']} evaluations ({info['failed']} "
                      f"invalid or failed) in {elapsed:.1f} s, {info['pareto']} Pareto designs"),
               highlight=False)
-    out.print(escape((outp / "summary.md").read_text()), highlight=False)
+    _print_markdown((outp / "summary.md").read_text())
     for p in problems:
         err.print(escape(f"warning: export skipped: {p}"), highlight=False)
     out.print(escape(f"results in {outp}/ (report.html, summary.md, pareto.csv, pareto.png, "
@@ -281,3 +282,12 @@ def report(results_dir: Annotated[Path, typer.Argument(help="a study's results f
                      f"{info['pareto']} Pareto designs"), highlight=False)
 
 
+def _print_markdown(text: str) -> None:
+    """summary.md on the console: rendered (tables drawn) on a terminal; piped, the file's
+    own lines, never hard-wrapped at the console width."""
+    if out.is_terminal:
+        from rich.markdown import Markdown
+
+        out.print(Markdown(text))
+    else:
+        out.print(text, markup=False, highlight=False, soft_wrap=True, end="")

@@ -184,15 +184,21 @@ def vertex_values(mesh, mmap: MetricMap) -> np.ndarray:
 
 
 def mesh_colours(mesh, mmap: MetricMap, vmin=None, vmax=None, cmap: str = "viridis"):
-    """``(n_vertices, 4)`` uint8 RGBA colours: each vertex takes its nearest voxel's value."""
+    """``(n_vertices, 4)`` uint8 RGBA colours: each vertex takes its nearest voxel's value;
+    the colour range is the slices' (1st-99th percentiles when outliers stretch it)."""
     import matplotlib
 
     vals = mmap.values.astype(float)
     finite = np.isfinite(vals)
     if not finite.any():
         return np.tile([128, 128, 128, 255], (len(mesh.vertices), 1)).astype(np.uint8)
-    lo = np.min(vals[finite]) if vmin is None else vmin
-    hi = np.max(vals[finite]) if vmax is None else vmax
+    # the slices' colour range: clipped to the 1st-99th percentiles when a few near-singular
+    # voxels would stretch it (so κ of the bulk is not one colour)
+    from ..workspaces.output.plots import _colour_range
+
+    plo, phi, _ = _colour_range(vals)
+    lo = plo if vmin is None else vmin
+    hi = phi if vmax is None else vmax
     v = vertex_values(mesh, mmap)
     t = np.clip((np.where(np.isfinite(v), v, hi) - lo) / max(hi - lo, 1e-300), 0, 1)
     rgba = matplotlib.colormaps[cmap](t)

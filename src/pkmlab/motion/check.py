@@ -134,6 +134,15 @@ class TrajectoryReport:
     payload_mass_kg: float
     fits: bool = field(default=False)
     length: CharacteristicLength | None = None
+    actuator_unit: str = "mm"
+
+    @property
+    def display(self):
+        """The display convention of these actuators (:func:`pkmlab.units.actuator_display`):
+        mm, mm/s, N for linear ones; deg, deg/s, N·m for rotary ones."""
+        from ..units import actuator_display
+
+        return actuator_display(self.actuator_unit)
 
     @property
     def min_margin(self) -> tuple[float, str, int, str]:
@@ -194,11 +203,39 @@ class TrajectoryReport:
                           else None),
             "singular_samples": int(np.sum(~np.isfinite(self.condition))),
             "characteristic_length": None if self.length is None else self.length.as_dict(),
+            "display": self._display_summary(peak),
             "limits": {
                 "stroke_mm": self.actuator_limits.tolist(),
                 "max_speed_mm_s": None if self.max_speed is None else self.max_speed.tolist(),
                 "max_force_n": None if self.max_force is None else self.max_force.tolist(),
             },
+        }
+
+
+    def _display_summary(self, peak) -> dict:
+        """Margins, peaks and limits in the display convention (deg, deg/s, N·m for rotary
+        actuators; the ``*_mm`` / ``*_n`` keys above are internal units: rad, N·mm)."""
+        d, names = self.display, self.actuator_names
+
+        def conv(values, scale) -> dict:
+            return {n: (None if not np.isfinite(v) else float(v) * scale)
+                    for n, v in zip(names, values)}
+
+        a = d.ascii
+        return {
+            "units": {"value": d.value_unit, "rate": d.rate_unit, "effort": d.effort_unit},
+            "effort": d.effort,
+            f"margin_low_{a(d.value_unit)}": conv(self.margin_low, d.value_scale),
+            f"margin_high_{a(d.value_unit)}": conv(self.margin_high, d.value_scale),
+            f"peak_rate_{a(d.rate_unit)}": conv(peak(self.qdot), d.rate_scale),
+            f"peak_{d.effort}_{a(d.effort_unit)}": conv(peak(self.force), d.effort_scale),
+            f"limit_{d.value}_{a(d.value_unit)}": (self.actuator_limits
+                                                   * d.value_scale).tolist(),
+            f"limit_rate_{a(d.rate_unit)}": (None if self.max_speed is None else
+                                             (self.max_speed * d.rate_scale).tolist()),
+            f"limit_{d.effort}_{a(d.effort_unit)}": (None if self.max_force is None else
+                                                    (self.max_force
+                                                     * d.effort_scale).tolist()),
         }
 
 
@@ -323,12 +360,13 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
         payload_mass_kg: payload mass in kg (>= 0).
         payload_com: payload centre of mass ``(3,)`` in mm in the tool frame.
         gravity: gravitational acceleration ``(3,)`` in mm/s², base frame.
-        max_speed: actuator speed limit in mm/s, scalar or one per actuator, compared with
-            ``|q̇|``.
-        max_force: actuator force limit in N, scalar or one per actuator, compared with
-            ``|f|``. On a lower-mobility mechanism the forces balance the wrench's free
-            components (the constraint wrench takes the rest); with more actuators than free
-            coordinates they are the least-norm solution.
+        max_speed: actuator speed limit in mm/s (rad/s for a rotary actuator), scalar or one
+            per actuator, compared with ``|q̇|``.
+        max_force: actuator force limit in N (torque limit in N·mm for a rotary actuator),
+            scalar or one per actuator, compared with ``|f|``. On a lower-mobility mechanism
+            the forces balance the wrench's free components (the constraint wrench takes the
+            rest); with more actuators than free coordinates they are the least-norm
+            solution.
         stroke_tolerance: round-off allowance in mm: an actuator value at most this far
             outside its window still counts as inside (a motion planned to touch a limit
             exactly, as the paper's z motion does, is not a violation).
@@ -467,6 +505,7 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
         ik_valid=ik_valid, ik_reason=ik_reason, status=status, ok=ok, violations=violations,
         margin_low=margin_low, margin_high=margin_high, margin_low_index=idx_low,
         margin_high_index=idx_high, actuator_names=names, actuator_limits=limits,
-        max_speed=vmax, max_force=fmax, payload_mass_kg=mass, fits=fits, length=length)
+        max_speed=vmax, max_force=fmax, payload_mass_kg=mass, fits=fits, length=length,
+        actuator_unit=str(getattr(mech, "actuator_unit", "mm")))
     log.debug("trajectory check: %d samples, fits=%s, %d failing", T, fits, int(np.sum(~ok)))
     return report

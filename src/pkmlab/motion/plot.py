@@ -13,25 +13,38 @@ from .paper import MM_PER_IN as _MM_PER_IN
 
 log = logging.getLogger(__name__)
 
-__all__ = ["plot_actuators"]
+__all__ = ["plot_actuators", "actuators_figure"]
 
 
 def plot_actuators(report: TrajectoryReport, path: str | Path, title: str | None = None,
                    phases: Sequence[tuple[str, float, float]] | None = None) -> Path:
     """Actuator values against time, as the paper's Fig. 13 (leg length in inches vs s).
 
-    Draws one line per actuator (left axis in inches, right axis the same in mm), the stroke
+    Draws one line per actuator (left axis in inches, right axis the same in mm; a rotary
+    actuator's crank angle in degrees, :func:`pkmlab.units.actuator_display`), the stroke
     limits as dashed horizontal lines labelled in both units, samples whose status is not
     ``"ok"`` as red marks, and optionally the motion phases (e.g. :func:`paper_motion_phases`)
     as labelled bands. Writes a PNG with matplotlib's Agg canvas (pyplot and the global backend
     are not touched) and returns the path.
     """
+    path = Path(path)
+    fig = actuators_figure(report, title, phases)
+    fig.savefig(path, format="png")
+    log.debug("wrote %s", path)
+    return path
+
+
+def actuators_figure(report: TrajectoryReport, title: str | None = None,
+                     phases: Sequence[tuple[str, float, float]] | None = None):
+    """The matplotlib Figure :func:`plot_actuators` writes (Agg canvas)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    path = Path(path)
     t = np.asarray(report.t)
-    q_in = np.asarray(report.q) / _MM_PER_IN
+    d = report.display
+    # linear: inches on the left (the paper's axis), mm on the right; rotary: degrees only
+    scale = d.value_scale if d.rotary else 1.0 / _MM_PER_IN
+    q_in = np.asarray(report.q) * scale
     fig = Figure(figsize=(10, 5), dpi=120)
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(1, 1, 1)
@@ -41,9 +54,10 @@ def plot_actuators(report: TrajectoryReport, path: str | Path, title: str | None
     levels = sorted({(float(v), "min" if j == 0 else "max") for j in range(2)
                      for v in lim[:, j]})
     for v, side in levels:
-        ax.axhline(v / _MM_PER_IN, color="k", ls="--", lw=0.9)
-        ax.annotate(f"stroke {side} {v / _MM_PER_IN:.3g} in ({v:.4g} mm)",
-                    xy=(1.0, v / _MM_PER_IN), xycoords=("axes fraction", "data"),
+        ax.axhline(v * scale, color="k", ls="--", lw=0.9)
+        text = (f"{d.value} {side} {v * scale:.4g} {d.value_unit}" if d.rotary else
+                f"stroke {side} {v * scale:.3g} in ({v:.4g} mm)")
+        ax.annotate(text, xy=(1.0, v * scale), xycoords=("axes fraction", "data"),
                     xytext=(-4, 3 if side == "max" else -11), textcoords="offset points",
                     ha="right", fontsize=8)
     bad = ~np.asarray(report.ok)
@@ -65,17 +79,18 @@ def plot_actuators(report: TrajectoryReport, path: str | Path, title: str | None
                         xycoords=("data", "axes fraction"), xytext=(0, 2),
                         textcoords="offset points", ha="center", va="bottom", fontsize=8)
     ax.set_xlabel("Time (s)")
-    ax.set_ylabel("Leg length L (in.)")
-    lo_in, hi_in = ax.get_ylim()
-    ax2 = ax.twinx()
-    ax2.set_ylim(lo_in * _MM_PER_IN, hi_in * _MM_PER_IN)
-    ax2.set_ylabel("Leg length L (mm)")
+    if d.rotary:
+        ax.set_ylabel(d.value_name)
+    else:
+        ax.set_ylabel("Leg length L (in.)")
+        lo_in, hi_in = ax.get_ylim()
+        ax2 = ax.twinx()
+        ax2.set_ylim(lo_in * _MM_PER_IN, hi_in * _MM_PER_IN)
+        ax2.set_ylabel("Leg length L (mm)")
     ax.set_xlim(t[0], t[-1])
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), fontsize=8, ncol=8,
               frameon=False)
     if title:
         ax.set_title(title, pad=14 if phases else 6)
     fig.tight_layout()
-    fig.savefig(path, format="png")
-    log.debug("wrote %s", path)
-    return path
+    return fig

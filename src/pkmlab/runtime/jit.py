@@ -186,6 +186,16 @@ def jitable(fn, ident: str, **options):
     return register_jitable(**options)(_renamed(fn, f"{fn.__name__}_{ident[:16]}"))
 
 
+#: seconds this process has spent compiling (or loading from the cache) kernels
+_COMPILING = [0.0]
+
+
+def compile_seconds() -> float:
+    """Seconds this process has spent in :func:`cached_kernel` so far (compiles and cache
+    loads): subtracted from a measured evaluation time before it is used for an estimate."""
+    return _COMPILING[0]
+
+
 def cached_kernel(fn, sig, *, roots=(), extra=(), **options):
     """``njit(sig, cache=True, **options)`` of ``fn``, compiled now, named and compiled in a
     uid namespace after its identity (see the module notes).
@@ -220,6 +230,7 @@ def cached_kernel(fn, sig, *, roots=(), extra=(), **options):
         notice.cancel()
     dt = time.perf_counter() - t0
     if rec.compiled:
+        _COMPILING[0] += dt
         log.log(logging.INFO if dt > COMPILE_NOTICE_S else logging.DEBUG,
                 "compiled %s in %.1f s", fn.__name__, dt)
     elif dt > COMPILE_NOTICE_S:

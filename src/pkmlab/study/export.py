@@ -42,6 +42,7 @@ from .definition import Study
 from .folder import DESIGN_FOLDER
 from .run import BASELINE, objective_matrix
 from .selection import select_designs
+from .violations import least_violating, violated_text
 
 log = logging.getLogger(__name__)
 
@@ -65,7 +66,8 @@ def chosen_designs(study: Study, front: list[dict]) -> list[tuple[dict, int, str
 
 
 def export_designs(out: Path, study: Study, front: list[dict], *, maps=("kappa",),
-                   progress=None) -> tuple[list[Path], list[str]]:
+                   progress=None, records: list[dict] | None = None
+                   ) -> tuple[list[Path], list[str]]:
     """Write the chosen designs of ``front`` (the Pareto records, in pareto.csv order).
 
     Args:
@@ -75,12 +77,19 @@ def export_designs(out: Path, study: Study, front: list[dict], *, maps=("kappa",
         maps: per-voxel metrics of :mod:`pkmlab.dexterity.maps` written as PLY vertex
             properties (the first also colours the GLB and the slices).
         progress: optional ``progress(done, total, message)``, called as each step starts.
+        records: every evaluation: when ``front`` is empty (nothing feasible), the
+            ``study.top`` least-violating candidates (:func:`.violations.least_violating`)
+            are exported instead, with Pareto rank 0 and ``why`` naming what they violate.
 
     Returns ``(folders, problems)``: a design whose export fails is skipped with its reason
     in ``problems`` (logged), so an export error never stops the report.
     """
     out = Path(out)
     chosen = chosen_designs(study, front)
+    if not front and records:
+        least = least_violating(study, records, max(study.top, 1))
+        chosen = [(r, 0, f"least violating {i + 1} of {len(least)} (no feasible design): "
+                   f"{violated_text(study, r)}") for i, r in enumerate(least)]
     root = out / "designs"
     root.mkdir(parents=True, exist_ok=True)
     folders, problems, entries = [], [], []
@@ -93,7 +102,7 @@ def export_designs(out: Path, study: Study, front: list[dict], *, maps=("kappa",
             if progress:
                 progress(i, len(chosen), message)
 
-        step(f"Pareto rank {rank} ({why})")
+        step(f"Pareto rank {rank} ({why})" if rank else why)
         try:
             info = _export_one(d, study, r, i + 1, rank, why, maps, step)
             folders.append(d)

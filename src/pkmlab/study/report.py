@@ -22,6 +22,7 @@ from .export import export_designs
 from .metrics import METRICS
 from .run import BASELINE, feasible, objective_matrix, provenance
 from .selection import non_dominated
+from .violations import least_violating, tally, violated_text
 
 log = logging.getLogger(__name__)
 
@@ -49,7 +50,7 @@ def _rows(study: Study, records: list[dict]):
     header = (["seq", "role", "status", "reason", "seconds"]
               + [f"design.{v.name} ({v.unit})" if v.unit else f"design.{v.name}"
                  for v in study.variables]
-              + [METRICS[m].label for m in metrics] + ["notes"])
+              + [METRICS[m].label for m in metrics] + ["violated", "notes"])
     rows = []
     for r in records:
         p = _params(study, r)
@@ -58,7 +59,7 @@ def _rows(study: Study, records: list[dict]):
         rows.append([r["seq"], r["role"], r["status"], r["reason"].splitlines()[0]
                      if r["reason"] else "", f"{r['seconds']:.4f}", *vals,
                      *["" if r["metrics"].get(m) is None else r["metrics"][m]
-                       for m in metrics], notes])
+                       for m in metrics], violated_text(study, r), notes])
     return header, rows
 
 
@@ -210,9 +211,11 @@ def _summary(study: Study, records, front, baseline) -> str:
         lines.append(row(f"Pareto {i + 1}", r))
     lines += _requirement_margins(study, baseline, front[:max(study.top, 1) * 2], metrics)
     lines += _catalogue_fits(study, records)
+    lines += _why_they_fail(study, records, front)
     if notes:
         lines += ["", "Notes (a value shown as — is undefined for the reason given):", *notes]
-    lines += ["", "Lengths in mm, angles in degrees, volumes in cm³, forces in N. Metric "
+    lines += ["", "Lengths in mm, angles in degrees, volumes in cm³, forces in N; "
+              "servos: torques in N·m, angular speeds in deg/s. Metric "
               "definitions: `pkmlab metrics`. Full tables: evaluations.csv, pareto.csv; "
               "exported designs (mechanism YAML, workspace STL, slices, κ map) under designs/."]
     return "\n".join(lines) + "\n"
@@ -224,7 +227,7 @@ REQUIREMENT_MARGINS = ("task_contained", "task_margin", "task_orientation_margin
                        "peak_actuator_torque", "peak_actuator_angular_speed",
                        "peak_actuator_power", "actuators_fit", "actuator_force_margin",
                        "actuator_speed_margin", "actuator_torque_speed_margin",
-                       "actuator_stroke_margin")
+                       "actuator_stroke_margin", "actuator_angle_margin")
 
 
 def _requirement_margins(study: Study, baseline, front, shown) -> list[str]:
@@ -232,7 +235,8 @@ def _requirement_margins(study: Study, baseline, front, shown) -> list[str]:
     (markdown lines; none when the study has no requirement blocks)."""
     rows = ([("baseline", baseline)] if baseline is not None else []) + \
         [(f"Pareto {i + 1}", r) for i, r in enumerate(front)]
-    names = [m for m in REQUIREMENT_MARGINS if any(m in r["metrics"] for _, r in rows)]
+    names = [m for m in REQUIREMENT_MARGINS if any(m in r["metrics"] for _, r in rows)
+             and not all(_other_kind(r, m) for _, r in rows)]
     if not names:
         return []
     head = [f"{METRICS[m].label}" for m in names]
@@ -243,6 +247,35 @@ def _requirement_margins(study: Study, baseline, front, shown) -> list[str]:
         out.append(f"| {label} | " + " | ".join(_fmt(r["metrics"].get(m)) for m in names)
                    + " |")
     return out
+
+
+def _why_they_fail(study: Study, records, front) -> list[str]:
+    """The tally of violated constraints over the candidates and, when nothing is feasible,
+    the least-violating designs (what each misses, by how much)."""
+    counts = [t for t in tally(study, records) if t[1]]
+    if not counts:
+        return []
+    out = ["", "Why candidates fail (violations per constraint; a candidate can violate "
+           "several; column `violated` of evaluations.csv):", "",
+           "| constraint | violated | of |", "|---|---|---|"]
+    out += [f"| {w} | {n} | {of} |" for w, n, of in counts]
+    if not front:
+        least = least_violating(study, records, max(study.top, 1))
+        if least:
+            out += ["", f"No feasible design. The {len(least)} least violating (fewest "
+                    "violations, then smallest; exported under designs/):", "",
+                    "| candidate | violated |", "|---|---|"]
+            out += [f"| {r['seq']} | {violated_text(study, r)} |" for r in least]
+    return out
+
+
+def _other_kind(record, name: str) -> bool:
+    """Whether ``name`` is the other actuator kind's metric on this design (a servo's
+    ``actuator_stroke_margin``, a linear actuator's ``actuator_torque_rating``): null, with a
+    note pointing at the metric of its own kind."""
+    why = str(record.get("notes", {}).get(name, ""))
+    return record["metrics"].get(name) is None and (" actuator: see " in why
+                                                    or " actuators: see " in why)
 
 
 def _catalogue_fits(study: Study, records) -> list[str]:

@@ -247,7 +247,11 @@ def _check_actuator_choices(variables, evaluation: Evaluation, mech) -> None:
 
 def _metric(name: Any, where: str, evaluation: Evaluation) -> str:
     if not isinstance(name, str) or name not in METRICS:
-        raise ParameterError(where, f"one of {sorted(METRICS)}", name)
+        import difflib
+
+        near = difflib.get_close_matches(str(name), list(METRICS), n=3, cutoff=0.6)
+        hint = (f"did you mean {' or '.join(repr(n) for n in near)}? " if near else "")
+        raise ParameterError(where, f"{hint}one of {sorted(METRICS)}", name)
     if name in KIND_VOLUMES and evaluation.workspace is not None \
             and evaluation.workspace.kind != KIND_VOLUMES[name]:
         raise ParameterError(where, f"the volume of the evaluated kind "

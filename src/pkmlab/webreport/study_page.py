@@ -16,6 +16,7 @@ from ..export import exporters
 from ..study.definition import Study
 from ..study.export import read_index
 from ..study.metrics import METRICS
+from ..study.violations import tally, violated_text
 from . import data as D
 from .figures import design_scene, pareto_matrix, pareto_parcoords
 from .page import colour_option, figure_json, hull_of_ply, png_uri, render_page
@@ -74,6 +75,14 @@ def _points(study: Study, rows: list[dict]) -> list[dict]:
     return pts
 
 
+def _other_kind(metrics: dict, notes: dict, name: str) -> bool:
+    """The other actuator kind's metric (a servo's ``actuator_force_rating``): null with a
+    note pointing at the metric of its own kind; left off the card (kept in the CSV)."""
+    why = str(notes.get(name, ""))
+    return metrics.get(name) is None and (" actuator: see " in why
+                                          or " actuators: see " in why)
+
+
 def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
           n: int) -> tuple[dict, object | None, list]:
     folder = out / "designs" / entry["folder"]
@@ -93,8 +102,10 @@ def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
                      "baseline": D.fmt(base_p.get(v.name)), "delta": d, "pct": pct})
     objectives = {o.metric: o.sense[:3] + "." for o in study.objectives}
     metrics = info["metrics"]
+    notes = info.get("notes", {})
     mrows = D.compare_rows([(m, METRICS[m].unit, metrics.get(m), base_m.get(m))
-                            for m in METRICS if m in metrics or m in base_m])
+                            for m in METRICS if (m in metrics or m in base_m)
+                            and not _other_kind(metrics, notes, m)])
     for r in mrows:
         r["objective"] = objectives.get(r["name"], "")
         r["title"] = METRICS[r["name"]].description
@@ -104,6 +115,8 @@ def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
             "short": info["why"].split(":")[0], "params": prow,
             "derived": D.derived_rows(study, params, rounded), "metrics": mrows,
             "constraints": D.constraint_rows(study, metrics), "notes": info.get("notes", {}),
+            "violated": violated_text(study, {"status": "ok", "metrics": metrics,
+                                              "notes": info.get("notes", {})}),
             "build_problem": problem, "slices": [], "files": [], "has_scene": False,
             "colour_options": [], "scene_note": ""}
     for name in info["files"]:
@@ -229,6 +242,7 @@ def write_study_page(out: Path, study: Study, records: list[dict], *, progress=N
             colours[card["number"]] = opts
     metrics = [m for m in METRICS if any(m in r["metrics"] for r in rows)]
     counts, reasons = D.failure_counts(records)
+    why_fail = [{"what": w, "count": n, "of": of} for w, n, of in tally(study, records) if n]
     resolved = out / "study.resolved.yaml"
     resolved_text = (resolved.read_text() if resolved.is_file() else
                      yaml.safe_dump(json.loads(json.dumps(study.resolved(), default=float)),
@@ -249,7 +263,7 @@ def write_study_page(out: Path, study: Study, records: list[dict], *, progress=N
         n_feasible=sum(r["feasible"] for r in rows if r["role"] == "candidate"),
         n_pareto=len(front), has_parcoords=has_parcoords,
         constraints_text=", ".join(c.describe() for c in study.constraints) or "none",
-        export_problems=index["problems"], variables=_variables(study),
+        export_problems=index["problems"], why_fail=why_fail, variables=_variables(study),
         optimizer=_optimizer_text(study),
         seed=study.seed, resolved_yaml=resolved_text, runs=_runs(out),
         length_step=D.LENGTH_STEP_MM, angle_step=D.ANGLE_STEP_DEG,

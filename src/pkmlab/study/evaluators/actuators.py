@@ -6,6 +6,7 @@ from __future__ import annotations
 from ...errors import ParameterError
 from ...requirements.actuators import fit as actuator_fit
 from ...requirements.spec import ActuatorsSpec, build_actuators
+from ...units import ROTARY_DISPLAY
 from .registry import Evaluator, metric, register_evaluator
 
 
@@ -27,10 +28,16 @@ class Actuators(Evaluator):
                "100·min over samples of (available − required motor torque) / peak curve "
                "torque"),
         metric("actuator_stroke_margin", "mm", "worst-case",
-               "actuator travel − the largest travel an actuator uses over the motions "
-               "(rotary actuators: angle range, in deg)"),
+               "actuator travel − the largest travel an actuator uses over the motions; "
+               "linear actuators only, null for rotary ones (actuator_angle_margin)"),
         metric("actuator_force_rating", "N", "exact",
-               "force limit of the chosen actuator (its size; rotary: torque limit in N·mm)"),
+               "force limit of the chosen actuator (its size); linear actuators only, null "
+               "for rotary ones (actuator_torque_rating)"),
+        metric("actuator_angle_margin", "deg", "worst-case",
+               "servo angle range − the largest angle range a servo uses over the motions; "
+               "rotary actuators only"),
+        metric("actuator_torque_rating", "N·m", "exact",
+               "torque limit of the chosen servo (its size); rotary actuators only"),
     )
 
     def plan(self, data, base):
@@ -53,11 +60,22 @@ class Actuators(Evaluator):
                                  f"{mech.family!r}", f"{spec.name} ({spec.kind})")
         f = actuator_fit(spec, ctx.dynamics)
         ctx.notes.update(f.notes)
-        return {"actuators_fit": float(f.fits), "actuator_force_margin": f.force_margin,
-                "actuator_speed_margin": f.speed_margin,
-                "actuator_torque_speed_margin": f.torque_speed_margin,
-                "actuator_stroke_margin": f.stroke_margin,
-                "actuator_force_rating": spec.force}
+        out = {"actuators_fit": float(f.fits), "actuator_force_margin": f.force_margin,
+               "actuator_speed_margin": f.speed_margin,
+               "actuator_torque_speed_margin": f.torque_speed_margin}
+        # one convention (pkmlab.units.actuator_display): a servo's size is a torque in
+        # N·m and its travel an angle in deg (ActuatorFit gives the angle margin in deg)
+        rotary = spec.kind == "rotary"
+        size = ROTARY_DISPLAY.effort_scale * spec.force if rotary else spec.force
+        pairs = (("actuator_stroke_margin", "actuator_angle_margin", f.stroke_margin),
+                 ("actuator_force_rating", "actuator_torque_rating", size))
+        for linear, turning, value in pairs:
+            name, other = (turning, linear) if rotary else (linear, turning)
+            out[name], out[other] = value, None
+            if value is None and linear in f.notes:
+                ctx.notes[name] = f.notes[linear]
+            ctx.notes[other] = f"{spec.kind} actuator: see {name}"
+        return out
 
 
 register_evaluator(Actuators())

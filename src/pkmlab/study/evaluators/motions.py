@@ -9,13 +9,18 @@ from ...errors import ParameterError
 from ...motion import costs
 from ...motion.dynamics import inverse_dynamics
 from ...requirements.spec import MotionSpec, build_motions
+from ...units import ROTARY_DISPLAY
 from .registry import Cost, Evaluator, metric, register_evaluator
 
-#: (linear actuators' metric, rotary actuators' metric, DynamicsResult.summary() key)
-MOTION_METRICS = (("peak_actuator_force", "peak_actuator_torque", "peak_force"),
-                  ("rms_actuator_force", "rms_actuator_torque", "rms_force"),
-                  ("peak_actuator_speed", "peak_actuator_angular_speed", "peak_speed"),
-                  ("peak_actuator_power", "peak_actuator_power", "peak_power"))
+#: (linear actuators' metric, rotary actuators' metric, DynamicsResult.summary() key,
+#: rotary display scale from internal units: :data:`pkmlab.units.ROTARY_DISPLAY`)
+MOTION_METRICS = (("peak_actuator_force", "peak_actuator_torque", "peak_force",
+                   ROTARY_DISPLAY.effort_scale),
+                  ("rms_actuator_force", "rms_actuator_torque", "rms_force",
+                   ROTARY_DISPLAY.effort_scale),
+                  ("peak_actuator_speed", "peak_actuator_angular_speed", "peak_speed",
+                   ROTARY_DISPLAY.rate_scale),
+                  ("peak_actuator_power", "peak_actuator_power", "peak_power", 1.0))
 
 
 class Motions(Evaluator):
@@ -37,13 +42,13 @@ class Motions(Evaluator):
         metric("peak_actuator_speed", "mm/s", "worst-case",
                "largest |actuator speed| over every sample of every required motion; linear "
                "actuators only, null for rotary ones (peak_actuator_angular_speed)"),
-        metric("peak_actuator_torque", "N·mm", "worst-case",
+        metric("peak_actuator_torque", "N·m", "worst-case",
                "largest |servo torque| over every sample of every required motion "
                "(τ = J⁻ᵀ·w); rotary actuators only, null for linear ones"),
-        metric("rms_actuator_torque", "N·mm", "worst-case",
+        metric("rms_actuator_torque", "N·m", "worst-case",
                "largest RMS servo torque (time-weighted, per actuator and motion); rotary "
                "actuators only"),
-        metric("peak_actuator_angular_speed", "rad/s", "worst-case",
+        metric("peak_actuator_angular_speed", "deg/s", "worst-case",
                "largest |servo angular speed| over every sample of every required motion; "
                "rotary actuators only"),
         metric("peak_actuator_power", "W", "worst-case",
@@ -93,9 +98,10 @@ class Motions(Evaluator):
             ctx.notes["motions_feasible"] = bad[0]
         sums = [r.summary() for r in ctx.dynamics if np.any(r.ok)]
         rotary = mech.actuator_unit == "rad"
-        for linear, turning, key in MOTION_METRICS:
+        for linear, turning, key, scale in MOTION_METRICS:
             name, other = (turning, linear) if rotary else (linear, turning)
-            out[name] = float(max(np.max(s[key]) for s in sums)) if sums else None
+            k = scale if rotary else 1.0
+            out[name] = float(max(np.max(s[key]) for s in sums)) * k if sums else None
             if not sums:
                 ctx.notes[name] = "no feasible sample in any motion"
             elif not np.isfinite(out[name]):        # never a silent null

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from ...requirements.spec import PayloadSpec, build_payload
 from ...requirements.static import static_loads
+from ...units import ROTARY_DISPLAY
 from .registry import Evaluator, metric, register_evaluator
 
 
@@ -15,7 +16,7 @@ class Payload(Evaluator):
     requires = frozenset()     # the gravity wrench, balanced on the free coordinates
     after = ("workspace",)      # the static torque is computed over it (skipped without one)
     metrics = (
-        metric("peak_servo_torque", "N·mm", "worst-case",
+        metric("peak_servo_torque", "N·m", "worst-case",
                "largest |servo torque| holding the payload at rest (τ = J⁻ᵀ·w, w the gravity "
                "wrench of payload + platform + leg-end masses) over every voxel × orientation "
                "sample of the workspace; rotary actuators only (null for prismatic)"),
@@ -45,7 +46,7 @@ class Payload(Evaluator):
         if loads.poses == 0:
             ctx.notes["peak_servo_torque"] = "no valid pose on the workspace grid"
             return {"peak_servo_torque": None}
-        return {"peak_servo_torque": loads.peak}
+        return {"peak_servo_torque": ROTARY_DISPLAY.effort_scale * loads.peak}   # N·m
 
 
 register_evaluator(Payload())

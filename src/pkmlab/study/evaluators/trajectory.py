@@ -10,6 +10,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from ...limits import MASS_MAX_KG, SEGMENT_TIME_S
 from ...motion import costs, paper_motion, trajectory_fit
 from ...motion.costs import paper_samples
+from ...tolerances import TOL
 from .registry import Cost, Evaluator, finite, metric, register_evaluator
 
 #: sample rate of the paper motion checked (paper_motion's default)
@@ -58,9 +59,13 @@ class Trajectory(Evaluator):
         # check_trajectory's fits and margins only (no limits: the payload changes neither)
         rep = trajectory_fit(mech, t, X)
         margins = np.concatenate([rep.margin_low, rep.margin_high])
+        # a motion that uses exactly 100 % of the stroke has a margin of round-off size
+        # (−1.4e-13 mm): within the stroke round-off tolerance it reads 0
+        margin = float(np.min(margins)) if np.all(np.isfinite(margins)) else None
+        if margin is not None and abs(margin) <= TOL.stroke_roundoff_mm:
+            margin = 0.0
         out = {"paper_motion_fits": float(rep.fits),
-               "paper_motion_margin": finite(np.min(margins))
-               if np.all(np.isfinite(margins)) else None}
+               "paper_motion_margin": None if margin is None else finite(margin)}
         if out["paper_motion_margin"] is None:
             ctx.notes["paper_motion_margin"] = "a pose of the motion has no inverse kinematics"
         return out
