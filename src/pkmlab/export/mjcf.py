@@ -13,6 +13,15 @@ Conventions (MuJoCo XML reference, mujoco.readthedocs.io/en/stable/XMLreference.
 * every tree joint's coordinate is 0 at the exported pose except the actuated ones, whose
   ``ref`` is pkmlab's actuator value there (m or rad): ``qpos`` of an actuated joint *is*
   pkmlab's actuator value (mm / 1000 for a slide), also under ``ctrl``;
+* a mechanism whose mobility frees no tilt (translational, planar, a point: see
+  :func:`.model.orientation_guide`) has its platform's orientation held by a declared guide:
+  the body ``platform.guide``, the last child of ``base``, with slides along the base frame's
+  x, y, z (and a hinge about z when ``theta_z`` is free or dependent), welded (equality
+  ``platform.guide``) to the platform. It carries no geometry, a mass of
+  :data:`GUIDE_MASS` kg with gravity compensated (``gravcomp="1"``) and undamped joints, so
+  it frees the translations and that rotation and acts on nothing else (MuJoCo has no
+  orientation-only equality; a delta's parallelogram forearms are declared as S–S rods, which
+  alone would let the platform turn);
 * actuators are ``position`` servos named after pkmlab's actuators, ``ctrlrange`` and the
   joint's ``range`` the stroke or servo window, ``kp`` giving a 20 Hz servo on an equal share
   of the moving mass, critically damped (``dampratio="1"``);
@@ -31,7 +40,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from ..tolerances import TOL
-from .model import MassModel, build_model, relative, segments
+from .model import MassModel, build_model, orientation_guide, relative, segments
 
 __all__ = ["mjcf_text", "quat", "GRAVITY", "SERVO_HZ", "M"]
 
@@ -44,6 +53,8 @@ SERVO_HZ = 50.0
 #: time constant (s) of the loop-closing equalities (MuJoCo's default 0.02 lets a loop open
 #: by about g·0.02² under gravity; 2 time steps is the stiffest MuJoCo recommends)
 EQ_TIMECONST = 0.002
+#: kg: the orientation guide's mass (MuJoCo needs a positive one for a body with joints)
+GUIDE_MASS = 1e-6
 
 
 def quat(R: np.ndarray) -> np.ndarray:
@@ -205,6 +216,25 @@ def mjcf_text(mech, pose=None, mass: MassModel | None = None) -> str:
                 lines.append(f"{pad}  <geom{_a(name=f'{b.name}.geom{k + 1}', **shape, **gkw)}/>")
         for child in model.children(b.name):
             lines += body_xml(child, depth + 1)
+        if b.name == "base" and guide:
+            lines += guide_xml(pad + "  ")
+        lines.append(f"{pad}</body>")
+        return lines
+
+    guide = orientation_guide(mech)
+    plat = model.bodies["platform"]
+
+    def guide_xml(pad):
+        """The orientation guide (module docstring): at the platform's frame."""
+        head = _a(name="platform.guide", pos=_v(plat.pos * M), quat=_v(quat(plat.R)),
+                  gravcomp="1")
+        lines = [f"{pad}<body{head}>",
+                 _tag(pad + "  ", "inertial", pos="0 0 0", mass=_f(GUIDE_MASS),
+                      diaginertia=_v([GUIDE_MASS * (0.5 * model.link_diameter * M) ** 2] * 3))]
+        for name, kind, axis in guide:
+            lines.append(_tag(pad + "  ", "joint", name=name, type=kind, pos="0 0 0",
+                              axis=_v(plat.R.T @ axis), damping="0"))
+            qpos0.append(0.0)
         lines.append(f"{pad}</body>")
         return lines
 
@@ -241,6 +271,9 @@ def mjcf_text(mech, pose=None, mass: MassModel | None = None) -> str:
             pos, Rr = relative(b1, b2)
             out.append(_tag("    ", "weld", name=cl.name, body1=cl.body1, body2=cl.body2,
                             relpose=_v(np.r_[pos * M, quat(Rr)])))
+    if guide:
+        out.append(_tag("    ", "weld", name="platform.guide", body1="platform.guide",
+                        body2="platform", relpose="0 0 0 1 0 0 0"))
     out.append("  </equality>")
     out.append("  <actuator>")
     w = 2 * math.pi * SERVO_HZ

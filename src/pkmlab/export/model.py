@@ -36,6 +36,16 @@ spread over each leg's links in proportion to their volumes. A payload given wit
 (a point mass) gets that of a solid sphere of its mass and the link diameter, since MuJoCo
 needs a positive-definite inertia. Joint bodies (U crosses, closure bodies) are spheres of
 half the link diameter in the same material.
+
+**Orientation guide** (:func:`orientation_guide`). The declared joints need not hold the
+platform's orientation where the mobility says it is fixed: a delta's parallelogram forearm is
+declared as one S–S rod (the kinematics needs no more), so three rods let the platform turn,
+which the real parallelograms do not. A mechanism whose mobility frees (or makes dependent) no
+tilt — translational, planar, a point — therefore gets, in the simulator export, a guide: a
+light body under the base carrying slides along the base frame's x, y and z (and a hinge about
+z when ``theta_z`` is free or dependent), welded to the platform. It frees every translation
+and the rotation the mobility has, and holds the others at the exported pose's; it adds no
+constraint to the free coordinates.
 """
 
 from __future__ import annotations
@@ -48,7 +58,7 @@ from ..errors import ParameterError
 from ..tolerances import TOL
 
 __all__ = ["MechanismModel", "MassModel", "Body", "TreeJoint", "Closure", "build_model",
-           "DENSITY", "LINK_DIAMETER_SHARE"]
+           "DENSITY", "LINK_DIAMETER_SHARE", "orientation_guide"]
 
 #: default density of links and platform, kg/m³ (aluminium)
 DENSITY = 2700.0
@@ -374,3 +384,18 @@ def segments(model: MechanismModel, body: Body) -> list[tuple[np.ndarray, np.nda
         if all(np.linalg.norm(x - u) > tol for u in uniq):
             uniq.append(x)
     return [(pts[0], x) for x in uniq] or [(pts[0], pts[0])]
+
+
+def orientation_guide(mech) -> list[tuple[str, str, np.ndarray]]:
+    """The guide's joints ``[(name, kind, axis in the base frame)]`` (module docstring), or
+    ``[]`` when the mobility frees or makes dependent a tilt (the joints then hold or free
+    every rotation themselves, six-coordinate mechanisms included)."""
+    mob = mech.mobility
+    known = set(mob.coordinates) | set(mob.dependent)
+    if known & {"theta_x", "theta_y"}:
+        return []
+    axes = np.eye(3)
+    out = [(f"platform.guide.{c}", "slide", axes[k]) for k, c in enumerate("xyz")]
+    if "theta_z" in known:
+        out.append(("platform.guide.theta_z", "hinge", axes[2]))
+    return out

@@ -20,7 +20,8 @@ import numpy as np
 from ..poses import log_so3
 from .mjcf import M, mjcf_text
 
-__all__ = ["load", "drive", "project", "compare", "sag", "actuator_targets"]
+__all__ = ["load", "drive", "project", "compare", "sag", "actuator_targets",
+           "orientation_defined"]
 
 
 def _mujoco():
@@ -116,6 +117,20 @@ def loop_gaps(model, data) -> np.ndarray:
                                   & (data.efc_id == e))
             gaps.append(np.linalg.norm(data.efc_pos[rows[:3]]) / M)
     return np.array(gaps)
+
+
+def orientation_defined(mech) -> bool:
+    """True when the platform's orientation is a property of the mechanism: its joint centres
+    (``mech.legs()`` at the nominal pose) are not all on one line. A platform whose joints meet
+    at one point (the five-bar's end point, a point tool) has none: the tool's rotation is
+    then reported by :func:`compare` but means nothing (the export holds it, see
+    :mod:`.mjcf`)."""
+    P = np.array([j.location for leg in mech.legs() for j in leg.joints
+                  if "platform" in (j.parent, j.child)])
+    if len(P) < 3:
+        return False
+    tol = 1e-9 * max(1.0, float(mech.scale))
+    return bool(np.linalg.matrix_rank(P[1:] - P[0], tol=tol) >= 2)
 
 
 def compare(mech, model, data, pose) -> dict:

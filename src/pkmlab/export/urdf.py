@@ -22,6 +22,12 @@ URDF describes trees only (its loop-closing constraint element is still a propos
   a 3-D or 6-D contact; Drake's distance and weld constraints), every standard URDF parser
   reads the file as a plain tree (unknown elements are ignored), and a user sees where each
   loop was cut. The same closures are in the ``joints`` JSON (``closures``).
+* **a held orientation**: a mechanism whose mobility frees no tilt (translational, planar, a
+  point; :func:`.model.orientation_guide`) gets one element ``<pkmlab:orientation_hold
+  link="platform" free_rotation="z"|"none"/>``: the platform keeps the exported pose's
+  orientation except for that rotation about the base frame's z, with no constraint on its
+  translations. The declared joints need not hold it (a delta's parallelogram forearm is one
+  S–S rod); the MJCF export realises it as its ``platform.guide`` chain and weld.
 """
 
 from __future__ import annotations
@@ -33,7 +39,7 @@ import numpy as np
 
 from ..tolerances import TOL
 from .mjcf import M, _masses, _platform_disc, _regular_inertia
-from .model import MassModel, build_model
+from .model import MassModel, build_model, orientation_guide
 
 __all__ = ["urdf_text", "rpy"]
 
@@ -184,6 +190,10 @@ def urdf_text(mech, pose=None, mass: MassModel | None = None) -> str:
                           type="point" if cl.kind == "connect" else "weld",
                           frame_a=cl.name + "__a", frame_b=cl.name + "__b",
                           cut_joint_type=cl.protocol_type))
+    guide = orientation_guide(mech)
+    if guide:
+        extra.append(_tag("  ", "pkmlab:orientation_hold", link="platform",
+                          free_rotation="z" if len(guide) > 3 else "none"))
     head = ['<?xml version="1.0" encoding="utf-8"?>',
             f"<!-- pkmlab {mech.family} mechanism {mech.name or '(unnamed)'}: exported by pkmlab "
             "export, format urdf. SI units (m, kg, rad). A spanning tree; loops closed by "
