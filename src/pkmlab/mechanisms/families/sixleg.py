@@ -189,11 +189,11 @@ def _directions(value, field: str, need: np.ndarray) -> np.ndarray:
     arr = np.asarray(value, dtype=float)        # legs numbered from 0, as in schema errors
     if arr.shape != (6, 3):
         raise ParameterError(field, "an array of shape (6, 3) of directions", arr.shape)
-    scale = np.max(np.abs(arr), axis=1)          # NaN for a NaN row, inf for an inf one
-    if np.any(bad := need & ~(np.isfinite(scale) & (scale > 0))):
+    if np.any(bad := need & ~(np.isfinite(scale := np.max(np.abs(arr), axis=1)) & (scale > 0))):
         i = int(np.argmax(bad))
         raise ParameterError(f"legs[{i}].{field}", "a finite non-zero direction", arr[i].tolist())
-    return np.where(need[:, None], unit_rows(arr / np.where(need, scale, 1.0)[:, None]), 0.0)
+    big = need & ((scale > 1e150) | (scale < 1e-150))  # algorithm constant: squares overflow
+    return np.where(need[:, None], unit_rows(arr / np.where(big, scale, 1.0)[:, None]), 0.0)
 
 
 def _per_leg(value, field: str, need: np.ndarray, positive: bool = True) -> np.ndarray:
