@@ -25,10 +25,10 @@ singularity is ``det A = 0``: the three rods parallel to one plane; the platform
 uncontrolled motion there, and the two assembly modes merge.
 
 **Exact columns**. Each leg's feasible z set on a vertical column is closed form (the family
-modules); :func:`make_columns` intersects the three legs' sets column by column, for the one
-orientation a translational mechanism has (the engine's constant workspace, mode ``"all"``).
-The driver takes any number of legs and set-valued legs (:mod:`.._set_columns`'s
-convention), unlike the six-leg drivers of :mod:`..column_kernels`.
+modules). For the one orientation a translational mechanism has (the engine's constant
+workspace, mode ``"all"``), the legs' sets are intersected column by column by the shared
+set-leg kernel (:mod:`..kernels.set_columns`, sized from the leg count), or by
+:func:`make_columns` when every leg's set is one interval (the towers).
 """
 
 from __future__ import annotations
@@ -48,7 +48,7 @@ from ...tolerances import TOL
 from ..base import NO_STROKE, Mechanism
 from ..kernels import ik as _kernels
 from ..kernels.columns import inlined
-from ..kernels.set_columns import intersect_sets
+from ..kernels.set_columns import make_set_column_kernel
 from ..legs.crank import PIECES
 from ..mobility import POSE, TRANSLATIONAL
 from ..results import AssemblyModes, FKResult
@@ -308,8 +308,12 @@ class DeltaFamily(Mechanism):
         lo, hi = np.empty((len(xs), len(ys), K)), np.empty((len(xs), len(ys), K))
         count = np.empty((len(xs), len(ys)), dtype=np.int64)
         W = _kernels.carray(self.leg_offsets(R)[0])
-        make_columns(type(self).column_set_leg, K == 1)(
-            xs, ys, W, _kernels.carray(self.column_params()), lo, hi, count)
+        P = _kernels.carray(self.column_params())
+        if K == 1:          # every leg's set is one interval: no set machinery
+            make_columns(type(self).column_set_leg)(xs, ys, W, P, lo, hi, count)
+        else:               # the shared set-leg kernel, one orientation
+            make_set_column_kernel(type(self).column_set_leg, "all")(
+                xs, ys, _kernels.carray(W[None]), P, lo, hi, count)
         if allowed is not None:
             off = ~np.asarray(allowed, dtype=bool).reshape(len(xs), len(ys), -1)[..., 0]
             lo[off], hi[off] = np.inf, -np.inf
@@ -320,12 +324,12 @@ _F1, _F2, _F3 = nt.float64[::1], nt.float64[:, ::1], nt.float64[:, :, ::1]
 
 
 @cache
-def make_columns(leg, single: bool = False):
+def make_columns(leg):
     """Parallel ``columns(xs (nx,), ys (ny,), W (L, 3), P (L, np), out_lo, out_hi (nx, ny,
-    K), count (nx, ny) int64)``: the intersection over the ``L`` legs of the set leg ``leg``'s
-    pieces on every column (one orientation; ``count`` is ``K + 1`` on overflow), built and
-    cached by :func:`pkmlab._jit.cached_kernel` like every family kernel. ``single``: every
-    leg's set is one interval (``K = 1``), intersected without the set machinery."""
+    1), count (nx, ny) int64)``: the intersection over the ``L`` legs of the set leg ``leg``
+    on every column when each leg's set is one interval (one orientation), without the set
+    machinery; cached by :func:`pkmlab.runtime.jit.cached_kernel`. Sets of several pieces go
+    through :func:`~pkmlab.mechanisms.kernels.set_columns.make_set_column_kernel`."""
     leg = inlined(leg)
 
     def columns_single(xs, ys, W, P, out_lo, out_hi, count):
@@ -348,34 +352,6 @@ def make_columns(leg, single: bool = False):
                 out_hi[ix, iy, 0] = b
                 count[ix, iy] = 1 if a <= b else 0
 
-    def columns(xs, ys, W, P, out_lo, out_hi, count):
-        nx, ny, L, K = xs.shape[0], ys.shape[0], W.shape[0], out_lo.shape[2]
-        for ix in prange(nx):
-            slo = np.empty(K)
-            shi = np.empty(K)
-            tlo = np.empty(K)
-            thi = np.empty(K)
-            llo = np.empty(PIECES)
-            lhi = np.empty(PIECES)
-            for iy in range(ny):
-                slo[0] = -np.inf
-                shi[0] = np.inf
-                n = 1
-                over = False
-                for i in range(L):
-                    nl = leg(xs[ix], ys[iy], W[i, 0], W[i, 1], W[i, 2], P[i], slo[0],
-                             shi[n - 1], llo, lhi)
-                    n, o = intersect_sets(slo, shi, n, llo, lhi, nl, tlo, thi, K)
-                    over = over or o
-                    slo, tlo = tlo, slo
-                    shi, thi = thi, shi
-                    if n == 0:
-                        break
-                for k in range(K):
-                    out_lo[ix, iy, k] = slo[k] if k < n else np.inf
-                    out_hi[ix, iy, k] = shi[k] if k < n else -np.inf
-                count[ix, iy] = K + 1 if over else n
-
-    return cached_kernel(columns_single if single else columns,
-                         nt.void(_F1, _F1, _F2, _F2, _F3, _F3, nt.int64[:, ::1]), parallel=True)
+    return cached_kernel(columns_single, nt.void(_F1, _F1, _F2, _F2, _F3, _F3, nt.int64[:, ::1]),
+                         parallel=True)
 

@@ -62,14 +62,14 @@ def make_set_column_kernel(leg, mode: str):
     """Parallel ``columns_all`` (``mode="all"``) or ``columns_any`` (``"any"``) for the set leg
     ``leg``; cached like :func:`.column_kernels.make_column_kernel`.
 
-    ``columns_all(xs (nx,), ys (ny,), W (M, 6, 3), P (6, np), out_lo, out_hi (nx, ny, K),
+    ``columns_all(xs (nx,), ys (ny,), W (M, L, 3), P (L, np), out_lo, out_hi (nx, ny, K),
     count (nx, ny) int64)``; ``columns_any(xs, ys, W, P, allowed (nx, ny, M) bool, out_lo,
     out_hi, count)``. ``count`` is the number of pieces, ``K + 1`` on overflow.
     """
     leg = inlined(leg)
 
     def columns_all(xs, ys, W, P, out_lo, out_hi, count):
-        """Intersection over orientations ``W (M, 6, 3)`` and legs, column by column; a column
+        """Intersection over orientations ``W (M, L, 3)`` and the L legs, column by column; a column
         stops at its first empty intersection (most tilted orientations come first)."""
         nx, ny, M, K = xs.shape[0], ys.shape[0], W.shape[0], out_lo.shape[2]
         for ix in prange(nx):
@@ -85,7 +85,7 @@ def make_set_column_kernel(leg, mode: str):
                 n = 1
                 over = False
                 for m in range(M):
-                    for i in range(6):
+                    for i in range(W.shape[1]):
                         nl = leg(xs[ix], ys[iy], W[m, i, 0], W[m, i, 1], W[m, i, 2], P[i],
                                  slo[0], shi[n - 1], llo, lhi)
                         n, o = intersect_sets(slo, shi, n, llo, lhi, nl, tlo, thi, K)
@@ -122,7 +122,7 @@ def make_set_column_kernel(leg, mode: str):
                     slo[0] = -np.inf
                     shi[0] = np.inf
                     n = 1
-                    for i in range(6):
+                    for i in range(W.shape[1]):
                         nl = leg(xs[ix], ys[iy], W[m, i, 0], W[m, i, 1], W[m, i, 2], P[i],
                                  slo[0], shi[n - 1], llo, lhi)
                         n, o = intersect_sets(slo, shi, n, llo, lhi, nl, tlo, thi, K)
@@ -154,7 +154,7 @@ def set_column_intervals(leg, W, P, xs, ys, R, mode, allowed=None, K=8):
     """``Mechanism.column_intervals`` for a family with a set leg: ``(lo, hi, overflow)``,
     ``lo, hi (nx, ny, K)`` sorted disjoint pieces (empty slots ``inf, -inf``).
 
-    ``W (M, 6, 3)`` are the leg offsets of the rotations ``R (M, 3, 3)``, ``P`` the legs'
+    ``W (M, L, 3)`` are the L legs' offsets of the rotations ``R (M, 3, 3)``, ``P`` the legs'
     parameter rows; ``mode`` and ``allowed`` as in :meth:`.base.Mechanism.column_intervals`.
     """
     xs, ys, P = carray(xs), carray(ys), carray(P)
