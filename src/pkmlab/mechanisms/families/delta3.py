@@ -54,7 +54,7 @@ from ...specbase import FamilySpec, _Model
 from ..base import NO_STROKE, as_points, as_positive, as_vector3
 from ..joints import DEFAULT_FIELDS, ParamField, kind_arrays, kind_template, platform_joints
 from ..kernels import ik as _kernels
-from ..legs.crank import crank_leg_set, crank_params
+from ..legs.crank import crank_ik_geometry, crank_leg_set, crank_params
 from ..legs.crank_cells import crank_cell_terms
 from ..validation import unit_rows, without_component
 from ._delta import DeltaFamily
@@ -303,13 +303,7 @@ class Delta3(DeltaFamily):
                      + np.max(self.crank_length) + np.max(self.rod_length))
 
     def _gparams(self) -> np.ndarray:
-        a2 = 2.0 * self.crank_length[:, None]
-        return np.concatenate([self.base_points.ravel(), self.tool_points.ravel(),
-                               (a2 * self.zero_directions).ravel(),
-                               (a2 * self.v_directions).ravel(),
-                               self.crank_length ** 2 - self.rod_length ** 2,
-                               1e-24 * self.crank_length ** 4, self.branch,
-                               self.servo_axes.ravel(),
+        return np.concatenate([crank_ik_geometry(self), self.servo_axes.ravel(),
                                self.rod_length * math.sin(self.cone_limit)])
 
     def driven_points(self, q):

@@ -57,7 +57,7 @@ from ..base import NO_STROKE, Mechanism, as_points, as_positive, as_vector3
 from ..joints import DEFAULT_FIELDS, ParamField, kind_arrays, kind_template, platform_joints
 from ..kernels import ik as _kernels
 from ..kernels.set_columns import set_column_intervals
-from ..legs.crank import crank_column_leg, crank_params
+from ..legs.crank import crank_column_leg, crank_ik_geometry, crank_params
 from ..legs.crank_cells import crank_cell_terms, crank_position_curvature
 from ..legs.layout import PAIRED_ALIASES, build_paired
 from ..validation import unit_rows, without_component
@@ -379,12 +379,7 @@ class RSS6(Mechanism):
                      + np.max(self.crank_length) + np.max(self.rod_length))
 
     def _gparams(self) -> np.ndarray:
-        a2 = 2.0 * self.crank_length[:, None]
-        return np.concatenate([self.base_points.ravel(), self.tool_points.ravel(),
-                               (a2 * self.zero_directions).ravel(),
-                               (a2 * self.v_directions).ravel(),
-                               self.crank_length**2 - self.rod_length**2,
-                               1e-24 * self.crank_length**4, self.branch])
+        return crank_ik_geometry(self)
 
     def crank_ends(self, q: np.ndarray) -> np.ndarray:
         """Crank end points C_i ``(N, 6, 3)`` (mm, base frame) for servo angles ``q (N, 6)``."""

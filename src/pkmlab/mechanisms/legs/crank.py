@@ -37,7 +37,8 @@ import math
 import numpy as np
 from numba.extending import register_jitable
 
-__all__ = ["crank_leg_set", "crank_column_leg", "crank_params", "PIECES", "NPARAM"]
+__all__ = ["crank_leg_set", "crank_column_leg", "crank_params", "crank_ik_geometry", "PIECES",
+           "NPARAM"]
 
 #: capacity the output arrays of :func:`crank_leg_set` need (it sorts its ≤ 8 breakpoints and
 #: the two range ends in ``out_hi``); it returns at most 4 pieces
@@ -289,3 +290,15 @@ def crank_params(u, v, crank_length, rod_length, branch, window) -> np.ndarray:
         u, np.asarray(v, dtype=float), np.broadcast_to(crank_length, (n,)),
         np.broadcast_to(rod_length, (n,)), np.broadcast_to(branch, (n,)), win,
         np.cos(win[:, 0]), np.sin(win[:, 0]), np.cos(win[:, 1]), np.sin(win[:, 1])]))
+
+
+def crank_ik_geometry(mech) -> np.ndarray:
+    """The geometry vector every crank-and-rod IK kernel reads (rss6, delta3): base points,
+    tool points, ``2a·u`` and ``2a·v`` (zero and 90° crank directions), ``a² − l²``, the
+    degenerate-root floor ``1e-24·a⁴`` and the branches; families append their own fields."""
+    a2 = 2.0 * mech.crank_length[:, None]
+    return np.concatenate([mech.base_points.ravel(), mech.tool_points.ravel(),
+                           (a2 * mech.zero_directions).ravel(),
+                           (a2 * mech.v_directions).ravel(),
+                           mech.crank_length**2 - mech.rod_length**2,
+                           1e-24 * mech.crank_length**4, mech.branch])
