@@ -120,3 +120,28 @@ def test_kappa_mesh_colours_are_clipped_to_percentiles(monkeypatch):
     bulk = rgba[:998, :3].astype(int)
     # the bulk spans the colour map: its first and last colours differ widely
     assert np.abs(bulk[0] - bulk[-1]).max() > 150
+
+
+def test_paper_motion_margin_of_a_servo_is_an_angle_in_degrees(tmp_path):
+    """A servo's paper-motion margin is reported in deg under its own name, never as mm
+    (issue 26 item 1). Checked against the crank angles of the motion's IK."""
+    import numpy as np
+
+    from pkmlab.config import load_mechanism
+    from pkmlab.motion import paper_motion
+
+    rss6 = ROOT / "studies" / "mechanisms" / "instructables-servo-6rss.yaml"
+    path = small_study(tmp_path, mechanism={"file": str(rss6)},
+                       design={"crank_length": {"low": "45 mm", "high": "55 mm"}},
+                       evaluate={"trajectory": {"paper_motion": True}},
+                       objectives=[{"maximize": "paper_motion_angle_margin"}])
+    s = load_study(path)
+    rec = evaluate_design(s.space, None, s.evaluation, 0)
+    assert rec["status"] == "ok", rec.get("reason")
+    m = rec["metrics"]
+    assert m["paper_motion_margin"] is None
+    mech = load_mechanism(rss6)
+    q = mech.inverse(paper_motion(mech, segment_time=1.0, rate_hz=100.0).poses).q
+    lo, hi = mech.stroke
+    margin_deg = np.degrees(min(np.nanmin(q - lo), np.nanmin(hi - q)))
+    assert m["paper_motion_angle_margin"] == pytest.approx(margin_deg, abs=1e-9)

@@ -11,6 +11,7 @@ from ...limits import MASS_MAX_KG, SEGMENT_TIME_S
 from ...motion import costs, paper_motion, trajectory_fit
 from ...motion.costs import paper_samples
 from ...tolerances import TOL
+from ...units import actuator_display
 from .registry import Cost, Evaluator, finite, metric, register_evaluator
 
 #: sample rate of the paper motion checked (paper_motion's default)
@@ -40,7 +41,11 @@ class Trajectory(Evaluator):
         metric("paper_motion_fits", "", "flag",
                "1 if Hopkins & Williams' ±2 in / ±30° motion stays within the stroke"),
         metric("paper_motion_margin", "mm", "exact",
-               "smallest stroke margin along that motion (negative: the overshoot)"),
+               "smallest stroke margin along that motion (negative: the overshoot); linear "
+               "actuators only, null for rotary ones (paper_motion_angle_margin)"),
+        metric("paper_motion_angle_margin", "deg", "exact",
+               "smallest servo angle margin along that motion (negative: the overshoot); "
+               "rotary actuators only"),
     )
 
     def cost(self, plan, evaluation, mech) -> list[Cost]:
@@ -64,10 +69,17 @@ class Trajectory(Evaluator):
         margin = float(np.min(margins)) if np.all(np.isfinite(margins)) else None
         if margin is not None and abs(margin) <= TOL.stroke_roundoff_mm:
             margin = 0.0
+        # one convention (pkmlab.units.actuator_display): a servo's margin is an angle in deg
+        shown = actuator_display(mech.actuator_unit)
+        name, other = (("paper_motion_angle_margin", "paper_motion_margin") if shown.rotary
+                       else ("paper_motion_margin", "paper_motion_angle_margin"))
         out = {"paper_motion_fits": float(rep.fits),
-               "paper_motion_margin": None if margin is None else finite(margin)}
-        if out["paper_motion_margin"] is None:
-            ctx.notes["paper_motion_margin"] = "a pose of the motion has no inverse kinematics"
+               name: None if margin is None else finite(shown.value_scale * margin),
+               other: None}
+        if out[name] is None:
+            ctx.notes[name] = "a pose of the motion has no inverse kinematics"
+        ctx.notes[other] = (f"{'rotary' if shown.rotary else 'linear'} actuators: "
+                            f"see {name}")
         return out
 
 
