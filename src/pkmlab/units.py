@@ -16,7 +16,8 @@ from .errors import ParameterError
 __all__ = ["LENGTH_UNITS", "ANGLE_UNITS", "parse_length", "parse_angle", "parse_quantity",
            "parse_physical", "MASS_UNITS", "FORCE_UNITS", "TORQUE_UNITS", "SPEED_UNITS",
            "ANGULAR_SPEED_UNITS", "INERTIA_UNITS", "TIME_UNITS", "FREQUENCY_UNITS", "LEAD_UNITS",
-           "ActuatorDisplay", "LINEAR_DISPLAY", "ROTARY_DISPLAY", "actuator_display"]
+           "ActuatorDisplay", "LINEAR_DISPLAY", "ROTARY_DISPLAY", "actuator_display",
+           "effort_limit"]
 
 LENGTH_UNITS = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "inch": 25.4, "ft": 304.8}
 ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180.0, "°": math.pi / 180.0}
@@ -143,3 +144,13 @@ ROTARY_DISPLAY = ActuatorDisplay(True, "angle", "deg", 180.0 / math.pi, "angular
 def actuator_display(actuator_unit: str) -> ActuatorDisplay:
     """The display convention of a mechanism's ``actuator_unit`` (``"mm"`` or ``"rad"``)."""
     return ROTARY_DISPLAY if actuator_unit == "rad" else LINEAR_DISPLAY
+
+
+def effort_limit(actuator_unit: str, force_limit: float | None,
+                 torque_limit: float | None) -> float | None:
+    """An actuator effort limit in internal units (N for ``mm`` actuators, N·mm for ``rad``
+    ones) from a force limit in N and a servo torque limit in N·m. A linear force limit is
+    never read as a torque: a servo without ``torque_limit`` gets ``None``."""
+    if actuator_unit == "rad":
+        return None if torque_limit is None else float(torque_limit) / ROTARY_DISPLAY.effort_scale
+    return None if force_limit is None else float(force_limit)

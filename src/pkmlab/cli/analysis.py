@@ -396,6 +396,10 @@ def compare(
     out_dir: Annotated[Path, typer.Option("--out", help="output folder")]
     = Path("results/compare"),
     as_json: JsonOpt = False,
+    force_limit: Annotated[float, typer.Option(
+        help="linear actuator force limit (N) of the force row")] = 150.0,
+    max_torque: Annotated[float | None, typer.Option(
+        help="servo torque limit (N·m) of a rotary family's force row; no default")] = None,
 ) -> None:
     """Compare designs side by side: volumes, inscribed shapes, GCI, κ, force, footprint,
     stroke use on the paper's motion; writes compare.md and overlaid slice plots.
@@ -438,9 +442,13 @@ def compare(
         _fail(ParameterError("--box", "an angle in [0, 90] deg", box))
     if not 1 <= samples <= 101:
         _fail(ParameterError("--samples", "an integer in [1, 101]", samples))
+    for name, v in (("--force-limit", force_limit), ("--max-torque", max_torque)):
+        if v is not None and not (math.isfinite(v) and v > 0):
+            _fail(ParameterError(name, "a finite value > 0", v))
     try:
         with log_lines():
-            table_rows = compare_designs(designs, box_deg=box, resolution=h, samples=samples)
+            table_rows = compare_designs(designs, box_deg=box, resolution=h, samples=samples,
+                                         force_limit=force_limit, torque_limit=max_torque)
     except ParameterError as exc:
         _fail(exc)
     out_dir.mkdir(parents=True, exist_ok=True)

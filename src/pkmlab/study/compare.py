@@ -44,6 +44,7 @@ from .. import dexterity as dx
 from ..escaping import markdown_text
 from ..motion import check_trajectory, paper_motion
 from ..workspaces import OrientationSet, workspace
+from ..units import effort_limit
 
 log = logging.getLogger(__name__)
 
@@ -153,7 +154,7 @@ def _tripod_row(label, mech, request, box_deg, resolution) -> dict:
 
 def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
                     resolution: float = 2.5, samples: int = 7, force_limit: float = 150.0,
-                    seed: int = 0) -> list[dict]:
+                    seed: int = 0, torque_limit: float | None = None) -> list[dict]:
     """Evaluate each ``(label, mechanism)`` with the same protocol → one row per design.
 
     Args:
@@ -161,8 +162,11 @@ def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
         box_deg: half-range (deg) of the simultaneous Euler box of the dexterous workspace.
         resolution: grid spacing (mm).
         samples: orientation samples per angle of the box.
-        force_limit: actuator force limit (N) of the force capability.
+        force_limit: linear actuator force limit (N) of the force capability.
         seed: seed of the inscribed shapes' verification sample.
+        torque_limit: servo torque limit (N·m) of a rotary family's force capability; no
+            linear default is ever applied to a servo: without it the force cell of a rotary
+            design says why it is empty.
 
     Returns:
         One dict per design: the :data:`COLUMNS` values (text or numbers), plus
@@ -174,6 +178,7 @@ def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
     request = {"dexterous_set": f"±{box_deg:g}° simultaneous Euler box, {samples} samples per "
                                 f"angle ({samples ** 3} orientations)",
                "resolution_mm": float(resolution), "force_limit_N": float(force_limit),
+               "torque_limit_N_m": None if torque_limit is None else float(torque_limit),
                "inscribed": f"inscribed_box() / inscribed_cylinder() defaults (seed {seed})"}
     rows = []
     for i, (label, mech) in enumerate(designs):
@@ -194,7 +199,8 @@ def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
         grid = dx.kappa_grid(mech, ref, length)
         gci = dx.gci_grid(mech, ref, grid=grid)
         kmin = dx.kappa_statistics(grid.kappa[grid.valid]).min
-        wc = dx.worst_case(mech, ref, length, force_limit)
+        effort = effort_limit(mech.actuator_unit, force_limit, torque_limit)
+        wc = dx.worst_case(mech, ref, length, force_limit if effort is None else effort)
         motion_text = _na(mech, "the paper's motion turns the platform ±30°") if fixed \
             else _paper_motion_text(mech, length)
         L_text = (f"{length.length:.2f} ({length.status})" if length.length is not None
@@ -221,7 +227,9 @@ def compare_designs(designs: list[tuple[str, object]], box_deg: float = 15.0,
                            "method": gci.method, "reason": gci.reason},
             "kappa_range": (f"{kmin:.2f} … {wc.worst_kappa:.2f}" if wc.ok and not wc.singular
                             else f"{kmin:.2f} … inf" if wc.ok else wc.reason),
-            "force_N": wc.min_force if wc.ok else wc.reason,
+            "force_N": (_na(mech, "servos need a torque limit (--max-torque, N·m)")
+                        if effort is None and mech.actuator_unit == "rad"
+                        else wc.min_force if wc.ok else wc.reason),
             "singular": ("not found (not excluded between samples)" if not wc.singular
                          else f"yes: {wc.reason}") if wc.ok
             else wc.status,
@@ -260,10 +268,18 @@ def comparison_markdown(rows: list[dict], box_deg: float | None = None) -> str:
               "`pkmlab workspace --inscribed`. L: Angeles' characteristic length (status in "
               "brackets). GCI: every voxel × orientation sample. κ range and force: the grid's "
               "smallest κ and `pkmlab.dexterity.worst_case` (every voxel and column end × "
-              "orientation sample; inf / 0 N when a singular pose is found inside or on the "
+              f"orientation sample; {_limits_text(req)}; inf / 0 N when a singular pose is found inside or on the "
               "boundary, at a sample or column end or by a sign change of det J between "
               "neighbours; otherwise a singular pose between samples is not excluded)."]
     return "\n".join(lines) + "\n"
+
+
+def _limits_text(req: dict) -> str:
+    """The actuator limits the force row was computed with."""
+    torque = req.get("torque_limit_N_m")
+    servos = ("servos ±" + f"{torque:g} N·m" if torque is not None
+              else "servos: no torque limit given")
+    return f"linear actuators ±{req.get('force_limit_N', float('nan')):g} N, {servos}"
 
 
 def plot_overlaid_slices(rows: list[dict], path: Path, which: int = 1,

@@ -13,7 +13,7 @@ from ... import dexterity as dx
 from ... import limits
 from ...dexterity.budget import WORST_BYTES_PER_SAMPLE, require_grid
 from ...errors import NumericalError, ParameterError
-from ...units import parse_length
+from ...units import effort_limit, parse_length
 from .registry import Evaluator, finite, metric, register_evaluator
 
 
@@ -39,7 +39,10 @@ class DexteritySpec(BaseModel):
         None, description="'auto' (Angeles' length, the default) or a length > 0")
     gci_samples: int = Field(2000, ge=limits.GCI_SAMPLES[0], le=limits.GCI_SAMPLES[1])
     force_limit: float = Field(150.0, gt=0, allow_inf_nan=False,
-                               description="actuator force limit (N)")
+                               description="linear actuator force limit (N)")
+    torque_limit: float | None = Field(None, gt=0, allow_inf_nan=False,
+                                       description="servo torque limit (N·m) of a rotary "
+                                                   "family; no default")
 
 
 _OVER_WORKSPACE = ("worst_kappa", "min_force", "singularity_free", "gci", "gci_std_error",
@@ -65,7 +68,7 @@ class Dexterity(Evaluator):
                "or on the boundary: stored as null with a note)"),
         metric("min_force", "N", "worst-case",
                "smallest force held in every direction over every voxel and column end × "
-               "orientation sample"),
+               "orientation sample (servos: with torque_limit; null without)"),
         metric("singularity_free", "", "flag",
                "0 when a singular pose is certified in the workspace or on its boundary (a "
                "singular voxel or column end, or a sign change of det J between neighbours); "
@@ -84,9 +87,18 @@ class Dexterity(Evaluator):
     def written(self, plan):
         L = plan.characteristic_length
         return {"characteristic_length": "auto" if L is None else f"{L:.12g} mm",
-                "gci_samples": plan.gci_samples, "force_limit": plan.force_limit}
+                "gci_samples": plan.gci_samples, "force_limit": plan.force_limit,
+                **({} if plan.torque_limit is None else {"torque_limit": plan.torque_limit})}
 
     def check(self, plan, evaluation, mech) -> None:
+        rotary = mech.actuator_unit == "rad"
+        if rotary and "force_limit" in plan.model_fields_set:
+            raise ParameterError("evaluate.dexterity.force_limit", "torque_limit (N·m) for a "
+                                 "rotary family: its actuators are servos",
+                                 f"{plan.force_limit:g} N")
+        if not rotary and plan.torque_limit is not None:
+            raise ParameterError("evaluate.dexterity.torque_limit", "force_limit (N) for a "
+                                 "linear family", f"{plan.torque_limit:g} N·m")
         if plan.characteristic_length is not None and not mech.mobility.rotations:
             mob = mech.mobility
             raise ParameterError("evaluate.dexterity.characteristic_length",
@@ -114,11 +126,13 @@ class Dexterity(Evaluator):
             out.update(dict.fromkeys(_OVER_WORKSPACE))
             return out
         require_grid(res, "evaluate.workspace.resolution", WORST_BYTES_PER_SAMPLE)
-        wc = dx.worst_case(res.mechanism, res, length, plan.force_limit)
+        effort = effort_limit(mech.actuator_unit, plan.force_limit, plan.torque_limit)
+        wc = dx.worst_case(res.mechanism, res, length,
+                           plan.force_limit if effort is None else effort)
         if wc.status != "ok":
             raise NumericalError("worst case over the workspace", wc.reason)
         out["worst_kappa"] = finite(wc.worst_kappa)
-        out["min_force"] = float(wc.min_force)
+        out["min_force"] = float(wc.min_force) if effort is not None else None
         out["singularity_free"] = float(not wc.singular)
         if wc.singular:
             ctx.notes["worst_kappa"] = (f"singular pose in the workspace or on its boundary: "
@@ -132,8 +146,13 @@ class Dexterity(Evaluator):
         out["sampled_max_kappa"] = finite(g.sampled_max_kappa) if g.ok else None
         valid = mech.inverse((p, R)).valid
         F = dx.max_force_all_directions(mech.jacobian((p[valid], R[valid])),
-                                        plan.force_limit, L=L, mobility=mech.mobility)
-        out["sampled_min_force"] = float(np.min(F)) if len(F) else None
+                                        plan.force_limit if effort is None else effort, L=L,
+                                        mobility=mech.mobility)
+        out["sampled_min_force"] = float(np.min(F)) if len(F) and effort is not None else None
+        if effort is None:
+            for n in ("min_force", "sampled_min_force"):
+                ctx.notes[n] = ("servos need evaluate.dexterity.torque_limit (N·m): a linear "
+                                "force limit is never applied to a servo")
         for n in ("gci", "gci_std_error", "sampled_max_kappa", "sampled_min_force"):
             if out[n] is None:
                 ctx.notes.setdefault(n, "a sampled pose is singular" if g.ok and
