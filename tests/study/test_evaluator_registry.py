@@ -136,7 +136,7 @@ def test_validate_refuses_what_a_translational_family_cannot_serve(tri3_family, 
     ({"workspace": {"kind": "constant", "resolution": "20 mm"},
       "dexterity": {"gci_samples": 200}}, "worst_kappa"),
     # the paper's motion on the free coordinates (refused before: "needs rotations")
-    ({"trajectory": {"payload": 2.0}}, "paper_motion_margin"),
+    ({"trajectory": {"segment_time": 2.0}}, "paper_motion_margin"),
     # Newton–Euler balanced on the free coordinates (refused before: "needs six free pose
     # coordinates")
     ({"motions": [{"name": "p", "paper": True, "rate": "20 Hz"}],

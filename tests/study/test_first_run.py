@@ -145,3 +145,15 @@ def test_paper_motion_margin_of_a_servo_is_an_angle_in_degrees(tmp_path):
     lo, hi = mech.stroke
     margin_deg = np.degrees(min(np.nanmin(q - lo), np.nanmin(hi - q)))
     assert m["paper_motion_angle_margin"] == pytest.approx(margin_deg, abs=1e-9)
+
+
+def test_a_payload_on_the_kinematic_trajectory_block_is_refused_not_ignored(tmp_path):
+    """``evaluate.trajectory.payload`` changed no metric: it is refused unless 0 kg."""
+    ok = small_study(tmp_path, evaluate={"trajectory": {"paper_motion": True, "payload": 0}},
+                     objectives=[{"maximize": "paper_motion_margin"}])
+    load_study(ok)
+    bad = small_study(tmp_path, evaluate={"trajectory": {"paper_motion": True, "payload": 2}},
+                      objectives=[{"maximize": "paper_motion_margin"}])
+    with pytest.raises(ParameterError, match=r"evaluate\.trajectory\.payload.*must be 0 kg.*"
+                                             r"motions"):
+        load_study(bad)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from ...limits import MASS_MAX_KG, SEGMENT_TIME_S
 from ...motion import costs, paper_motion, trajectory_fit
@@ -19,7 +19,9 @@ PAPER_RATE_HZ = 100.0
 
 
 class TrajectorySpec(BaseModel):
-    """The paper motion: seconds per segment, payload mass."""
+    """The paper motion: seconds per segment. The metrics are kinematic (stroke fit and
+    margin): ``payload`` is accepted only as 0 kg, since a mass would change neither; forces
+    along the paper's motion come from ``motions: [{paper: true}]`` with ``payload:``."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
@@ -27,7 +29,16 @@ class TrajectorySpec(BaseModel):
     segment_time: float = Field(1.0, ge=SEGMENT_TIME_S[0], le=SEGMENT_TIME_S[1],
                                 allow_inf_nan=False, description="s per segment")
     payload: float = Field(0.0, ge=0, le=MASS_MAX_KG, allow_inf_nan=False,
-                           description="payload mass (kg)")
+                           description="0 kg only: the paper-motion metrics are kinematic")
+
+    @field_validator("payload")
+    @classmethod
+    def _kinematic(cls, v: float) -> float:
+        if v != 0.0:
+            raise ValueError("must be 0 kg (paper_motion_fits and its margin are kinematic: a "
+                             "payload changes neither; for forces along the paper's motion use "
+                             f"motions: [{{paper: true}}] with payload:); got {v:g} kg")
+        return v
 
 
 class Trajectory(Evaluator):
