@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 from clihelp import small_study
 
@@ -102,6 +103,31 @@ def test_fk_all_piped_is_one_line_per_mode(capsys):
     rows = lines[1:]
     assert rows and all(len(ln.split("\t")) == 9 for ln in rows)
     assert any(abs(float(r.split("\t")[3]) - mech.nominal_pose[2]) < 1e-3 for r in rows)
+    assert "multi-start search: not known to be complete" in o
+
+
+@pytest.mark.parametrize("mech_file", ["clavel-delta3.yaml", "planar-3rpr.yaml",
+                                       "fivebar-scara.yaml"])
+def test_fk_all_of_a_closed_form_family_says_the_list_is_complete(capsys, mech_file):
+    """A closed-form family's `fk --all` lists every real mode: it says so, not "from 0
+    starts (a multi-start search)"."""
+    import json
+
+    from clihelp import cli
+
+    from pkmlab import load_mechanism
+
+    path = ROOT / "studies" / "mechanisms" / mech_file
+    mech = load_mechanism(path)
+    q = mech.inverse(mech.nominal_pose).q[0]
+    act = np.degrees(q) if mech.actuator_unit == "rad" else q
+    code, o, err = cli(capsys, "fk", path, "--actuators", ",".join(f"{v:.9f}" for v in act),
+                       "--all")
+    assert code == 0, err
+    assert "every real one (closed form)" in o and "multi-start" not in o
+    code, o, err = cli(capsys, "fk", path, "--actuators", ",".join(f"{v:.9f}" for v in act),
+                       "--all", "--json")
+    assert code == 0 and json.loads(o)["modes_complete"] is True
 
 
 def test_kappa_mesh_colours_are_clipped_to_percentiles(monkeypatch):

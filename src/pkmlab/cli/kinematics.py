@@ -154,6 +154,7 @@ def fk(mech_file: MechArg,
              "distance_to_nominal": float(d)}
             for p, r, w, d in zip(modes.pose, modes.residual, modes.working_mode, modes.distance)]
         data["starts"] = modes.starts
+        data["modes_complete"] = bool(getattr(mech, "closed_form_modes", False))
     if as_json:
         _emit(data)
         return
@@ -172,10 +173,14 @@ def fk(mech_file: MechArg,
     elif res.converged[0]:
         out.print(f"no other working-mode assembly mode reached from {res.mode_starts} starts "
                   "in the working region (a search, not a proof; --all searches wider)")
+    if all_modes:
+        found = (f"{len(modes.residual)} assembly modes: every real one (closed form)"
+                 if getattr(mech, "closed_form_modes", False) else
+                 f"{len(modes.residual)} assembly modes from {modes.starts} starts (a "
+                 "multi-start search: not known to be complete)")
     if all_modes and not out.is_terminal:
         # piped: one line per mode, tab-separated, never wrapped at a console width
-        lines = [f"# {len(modes.residual)} assembly modes from {modes.starts} starts "
-                 "(a multi-start search: not known to be complete)",
+        lines = [f"# {found}",
                  "\t".join(["#", "x (mm)", "y (mm)", "z (mm)", "θx (deg)", "θy (deg)",
                             "θz (deg)", "residual (mm)", "working mode"])]
         for i, (p, r, w) in enumerate(zip(modes.pose, modes.residual, modes.working_mode)):
@@ -186,7 +191,7 @@ def fk(mech_file: MechArg,
     elif all_modes:
         table = Table("#", "x (mm)", "y (mm)", "z (mm)", "θx (deg)", "θy (deg)", "θz (deg)",
                       "residual (mm)", "working mode",
-                      title=f"{len(modes.residual)} assembly modes from {modes.starts} starts")
+                      title=found)
         for i, (p, r, w) in enumerate(zip(modes.pose, modes.residual, modes.working_mode)):
             pj = _pose_json(p)
             table.add_row(str(i + 1), *[f"{pj[k]:.4f}" for k in POSE_KEYS], f"{r:.2e}",

@@ -112,6 +112,8 @@ class FiveBar(Mechanism):
     mobility = POINT
     actuator_names = ("theta1", "theta2")
     actuator_unit = "rad"
+    #: forward kinematics and assembly modes are complete (closed form), not a search
+    closed_form_modes = True
     design_aliases = {
         "base_separation": ("base_separation", "length"),
         "proximal": ("proximal", "length"),

@@ -113,6 +113,8 @@ class Rpr3(Mechanism):
     spec_model = Rpr3Spec
     mobility = PLANAR
     actuator_names = ("q1", "q2", "q3")
+    #: forward kinematics and assembly modes are complete (closed form), not a search
+    closed_form_modes = True
     design_aliases = {
         "base_radius": ("generator.base_radius", "length"),
         "platform_radius": ("generator.platform_radius", "length"),
