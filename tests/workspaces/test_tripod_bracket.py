@@ -131,3 +131,20 @@ def test_workspace_metrics_carry_the_bracket(mech):
     assert m["sampled_volume_mm_deg2"] == pytest.approx(res.volume * d2, rel=1e-15)
     assert m["bracket"]["stop_reason"] == "converged"
     assert "volume_mm_deg2" not in m
+
+
+def test_a_z_range_clips_the_bracket_like_the_grid(mech):
+    """With a z range the bracket is of the set within it (column form clipped; the box
+    form over the same range agrees), and the grid count over that range lies inside."""
+    zr = (-240.0, -60.0)                       # crosses the set's lower boundary
+    col = tripod_volume_bracket(mech, TILT, z_range=zr, target=0.01)
+    full = tripod_volume_bracket(mech, TILT, target=0.01)
+    assert col.stop_reason == "converged" and 0 < col.lower and col.upper < full.lower
+    grid = tripod_workspace(mech, TILT, z_range=zr, resolution_z=2.0,
+                            resolution_angle=math.radians(1.0), bracket_target=None)
+    # the grid's end row z = -60 mm (inside the set) counts a whole 2 mm row where the range
+    # holds half of one (the row at -240 mm is empty): 181 mm of rows for 180 mm
+    est = grid.volume * 180.0 / 181.0
+    assert col.lower <= est <= col.upper, (col.lower, est, col.upper)
+    box = tripod_volume_bracket(mech, TILT, z_range=zr, target=0.08, classify=classify_boxes)
+    assert box.lower <= col.upper and col.lower <= box.upper

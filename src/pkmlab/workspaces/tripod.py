@@ -249,13 +249,14 @@ def tripod_volume_bracket(mech, tilt_max: float, *, z_range=None, target: float 
     level or ``budget_s`` seconds (a level predicted, at 8× the last, to end past it is not
     started).
 
-    Where every rail is vertical (and neither ``z_range`` nor ``classify`` is given), z enters
+    Where every rail is vertical (and no ``classify`` is given), z enters
     each leg linearly and the set is bracketed on **columns** instead: cells of (θx, θy),
     starting ``2·initial[1]`` per angle, each given a z interval proved feasible and one
     holding every feasible z (:func:`~pkmlab.mechanisms.families.prs3_boxes.column_bounds`);
     each step splits in four the cells holding the largest gaps (together at least
     :data:`_SPLIT_SHARE` of the total), until the target (``max_level`` counts steps).
-    ``inner`` and ``undecided`` are then the columns' z intervals as boxes."""
+    ``inner`` and ``undecided`` are then the columns' z intervals (clipped to ``z_range``
+    when one is given) as boxes."""
     from ..mechanisms.families.prs3_boxes import classify_boxes, vertical_rails
 
     t0 = time.perf_counter()
@@ -267,9 +268,9 @@ def tripod_volume_bracket(mech, tilt_max: float, *, z_range=None, target: float 
     if not 0 < target < 1:
         raise ParameterError("target", "a relative width in (0, 1)", target)
     slack = 1e-9 + 1e-12 * mech.scale
-    if classify is None and z_range is None and vertical_rails(mech):
+    if classify is None and vertical_rails(mech):
         return _column_bracket(mech, tilt_max, target, 2 * initial[1], max_level, max_boxes,
-                               budget_s, slack, t0)
+                               budget_s, slack, t0, z_range)
     classify = classify or classify_boxes
     zr = _z_bounds(mech) if z_range is None else tuple(map(float, z_range))
     nz, na = initial
@@ -323,8 +324,10 @@ def tripod_volume_bracket(mech, tilt_max: float, *, z_range=None, target: float 
                          np.stack([lo, hi], axis=1), slack, time.perf_counter() - t0)
 
 
-def _column_bracket(mech, tilt_max, target, n0, max_steps, max_cells, budget_s, slack, t0):
-    """The column form of :func:`tripod_volume_bracket` (its docstring)."""
+def _column_bracket(mech, tilt_max, target, n0, max_steps, max_cells, budget_s, slack, t0,
+                    z_range=None):
+    """The column form of :func:`tripod_volume_bracket` (its docstring); both z intervals of
+    a column are clipped to ``z_range`` when one is given."""
     from ..mechanisms.families.prs3_boxes import column_bounds
 
     e = np.linspace(-tilt_max, tilt_max, n0 + 1)
@@ -337,6 +340,10 @@ def _column_bracket(mech, tilt_max, target, n0, max_steps, max_cells, budget_s, 
         for s in range(0, len(lo), _CHUNK):
             zin[s:s + _CHUNK], zout[s:s + _CHUNK] = column_bounds(
                 mech, lo[s:s + _CHUNK], hi[s:s + _CHUNK], slack)
+        if z_range is not None:
+            for z in (zin, zout):
+                z[:, 0] = np.maximum(z[:, 0], float(z_range[0]))
+                z[:, 1] = np.minimum(z[:, 1], float(z_range[1]))
         area = np.prod(hi - lo, axis=1)
         return (zin, zout, area * np.maximum(zin[:, 1] - zin[:, 0], 0.0),
                 area * np.maximum(zout[:, 1] - zout[:, 0], 0.0))
