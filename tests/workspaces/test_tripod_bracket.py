@@ -93,7 +93,7 @@ def test_column_bracket_against_a_dense_grid_and_random_points(mech):
 
 
 def test_box_bracket_on_inclined_rails(inclined):
-    br = tripod_volume_bracket(inclined, TILT, target=0.12)
+    br = tripod_volume_bracket(inclined, TILT, target=0.05)
     assert br.stop_reason == "converged"
     grid = tripod_workspace(inclined, TILT, resolution_z=5.0,
                             resolution_angle=math.radians(1.0), bracket_target=None)

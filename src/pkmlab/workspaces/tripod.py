@@ -32,6 +32,9 @@ __all__ = ["TripodWorkspace", "TripodBracket", "tripod_workspace", "tripod_volum
 #: the column bracket splits, each step, the cells holding the largest gaps, together at
 #: least this share of the total gap (algorithm constant)
 _SPLIT_SHARE = 0.6
+#: the box form splits a box in z only while its z side exceeds this × its widest angle side ×
+#: the largest platform joint radius (mm per rad; algorithm constant)
+_Z_SPLIT = 1.0
 #: boxes classified per call of the enclosure (bounds the temporaries: ~40 arrays of this size)
 _CHUNK = 100_000
 
@@ -244,7 +247,8 @@ def tripod_volume_bracket(mech, tilt_max: float, *, z_range=None, target: float 
     :func:`_z_bounds`, which holds every feasible z) × the tilt box; each level classifies
     them with ``classify(mech, lo, hi, slack)`` (default
     :func:`pkmlab.mechanisms.families.prs3_boxes.classify_boxes`) into proved feasible
-    (counted in ``lower``), proved infeasible (dropped) and undecided (split in eight), until
+    (counted in ``lower``), proved infeasible (dropped) and undecided (split in eight, or in
+    two along z while their z side is long against their angle sides, :func:`_split`), until
     ``upper - lower <= target·upper``, ``max_level`` levels, ``max_boxes`` boxes in the next
     level or ``budget_s`` seconds (a level predicted, at 8× the last, to end past it is not
     started).
@@ -281,6 +285,7 @@ def tripod_volume_bracket(mech, tilt_max: float, *, z_range=None, target: float 
     hi = np.stack([ze[I.ravel() + 1], ae[J.ravel() + 1], ae[K.ravel() + 1]], axis=1)
     inner, history = [], []
     lower, upper, stop, last = 0.0, math.inf, "budget: levels", 0.0
+    z_per_rad = _Z_SPLIT * float(np.max(np.linalg.norm(mech.tool_points, axis=1)))
     for level in range(max_level + 1):
         t = time.perf_counter()
         ins = np.zeros(len(lo), dtype=bool)
@@ -312,16 +317,29 @@ def tripod_volume_bracket(mech, tilt_max: float, *, z_range=None, target: float 
                 > budget_s:
             stop = "budget: seconds"
             break
-        mid = 0.5 * (lo + hi)
-        nlo, nhi = [], []
-        for c in range(8):
-            bit = np.array([(c >> k) & 1 for k in range(3)], dtype=bool)
-            nlo.append(np.where(bit, mid, lo))
-            nhi.append(np.where(bit, hi, mid))
-        lo, hi = np.concatenate(nlo), np.concatenate(nhi)
+        lo, hi = _split(lo, hi, z_per_rad)
     return TripodBracket(lower, upper, target, stop, history,
                          np.concatenate(inner) if inner else np.empty((0, 2, 3)),
                          np.stack([lo, hi], axis=1), slack, time.perf_counter() - t0)
+
+
+def _split(lo, hi, z_per_rad):
+    """Undecided boxes split: in z only (two) where their z side exceeds ``z_per_rad`` × their
+    widest angle side, else in eight (the z blur of a box's enclosure grows as its angle
+    sides times about the platform radius: finer z slabs then resolve the top and bottom
+    surfaces, as the column form does)."""
+    w = hi - lo
+    zonly = w[:, 0] > z_per_rad * np.maximum(w[:, 1], w[:, 2])
+    mid = 0.5 * (lo + hi)
+    nlo, nhi = [], []
+    cut = np.where(zonly[:, None], np.array([True, False, False]), True)    # (N, 3) split sides
+    for c in range(8):
+        bit = np.array([(c >> k) & 1 for k in range(3)], dtype=bool)
+        sel = ~zonly if c > 1 else np.ones(len(lo), dtype=bool)
+        up, k = bit & cut[sel], cut[sel]
+        nlo.append(np.where(k & up, mid[sel], lo[sel]))
+        nhi.append(np.where(k & ~up, mid[sel], hi[sel]))
+    return np.concatenate(nlo), np.concatenate(nhi)
 
 
 def _column_bracket(mech, tilt_max, target, n0, max_steps, max_cells, budget_s, slack, t0,
