@@ -158,6 +158,29 @@ def bench_bracket() -> None:
               f"(set-up {b.setup_seconds:.1f} s), final cube {b.resolution:.3g} mm")
 
 
+def bench_tripod_bracket() -> None:
+    """3-PRS (tripod-3prs): time to a guaranteed (z, θx, θy) volume bracket
+    (:func:`pkmlab.workspaces.tripod.tripod_volume_bracket`): column form (vertical rails) to
+    1 % and 0.1 %, and the box form (the same design with rails inclined 15°) to what its
+    budget reaches."""
+    from pkmlab.mechanisms.families.prs3 import Prs3, tripod_layout
+    from pkmlab.workspaces.tripod import tripod_volume_bracket
+
+    tp = pkmlab.load_mechanism(MECH / "tripod-3prs.yaml")
+    a, d, n, b = tripod_layout(200.0, 100.0, math.radians(15.0))
+    runs = [("vertical rails", tp, 0.01), ("vertical rails", tp, 0.001),
+            ("rails at 15°", Prs3(a, b, d, n, [250.0] * 3, (0.0, 400.0)), 0.01)]
+    for label, m, target in runs:
+        c0 = time.process_time()
+        br = tripod_volume_bracket(m, math.radians(30.0), target=target, max_level=60,
+                                   budget_s=120.0)
+        print(f"tripod {label:15s} ±30°, target {target:.1%}: [{br.lower:.3f}, "
+              f"{br.upper:.3f}] mm·rad² ({br.relative_width:.3%}), {br.stop_reason}, "
+              f"{br.seconds:.2f} s wall, {time.process_time() - c0:.2f} s CPU, "
+              f"{br.history[-1].get('cells', br.history[-1].get('boxes'))} cells/boxes in "
+              f"the last step", flush=True)
+
+
 if __name__ == "__main__":
     print(f"numba threads: {numba.get_num_threads()}")
     which = sys.argv[1:] or ["ik", "workspace", "bracket"]
@@ -168,4 +191,5 @@ if __name__ == "__main__":
         if part.startswith("scaling"):                # scaling:1.0:0.75 sets the grids
             bench_scaling(tuple(map(float, part.split(":")[1:])) or (10.0, 5.0, 2.5, 1.0))
             continue
-        {"ik": bench_ik, "workspace": bench_workspace, "bracket": bench_bracket}[part]()
+        {"ik": bench_ik, "workspace": bench_workspace, "bracket": bench_bracket,
+         "tripod": bench_tripod_bracket}[part]()

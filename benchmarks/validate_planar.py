@@ -103,14 +103,14 @@ def main(out: Path) -> None:
         w = tripod_workspace(tp, math.radians(30.0), resolution_z=hz,
                              resolution_angle=math.radians(ha))
         m = w.metrics()
-        print(f"  {hz} mm / {ha}°: volume {m['volume_mm_deg2']:,.0f} mm·deg², z "
+        print(f"  {hz} mm / {ha}°: volume {m['sampled_volume_mm_deg2']:,.0f} mm·deg², z "
               f"{m['z_range_mm']}, parasitic |x| {m['parasitic_x_max_mm']:.4f} mm, |y| "
               f"{m['parasitic_y_max_mm']:.4f} mm, |(x, y)| {m['parasitic_xy_max_mm']:.4f} mm, "
               f"|θz| {m['parasitic_theta_z_max_deg']:.4f}° ({m['seconds']:.1f} s)")
     w = tripod_workspace(tp, math.radians(60.0), resolution_z=5.0,
                          resolution_angle=math.radians(1.0))
     plot_tripod(w, out / "tripod-tilts.png", title="tripod-3prs: tilt region per height")
-    print(f"  tilt box ±60° (5 mm / 1°): {w.metrics()['volume_mm_deg2']:,.0f} mm·deg²")
+    print(f"  tilt box ±60° (5 mm / 1°): {w.metrics()['sampled_volume_mm_deg2']:,.0f} mm·deg²")
 
 
 if __name__ == "__main__":

@@ -64,7 +64,9 @@ def test_planar_and_tripod_rows_carry_their_own_workspaces(rows, tmp_path):
     assert rows["fivebar-scara"]["dexterous_volume_cm3"].startswith("n/a")
     v = tripod_workspace(MECHANISMS["tripod-3prs"], a, resolution_z=H).metrics()
     tri = rows["tripod-3prs"]["dexterous_volume_cm3"]
-    assert f"sampled {v['volume_mm_deg2']:.4g} mm·deg²" in tri
+    lo, hi = v["volume_bracket_mm_deg2"]
+    assert f"bracket {lo:.4g} … {hi:.4g} mm·deg² (sampled {v['sampled_volume_mm_deg2']:.4g})" \
+        in tri
     md = comparison_markdown(list(rows.values()), 10.0)
     assert md.count("\n| ") >= 12
     planar = [rows["fivebar-scara"], rows["tripod-3prs"]]

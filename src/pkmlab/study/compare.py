@@ -141,13 +141,16 @@ def _tripod_row(label, mech, request, box_deg, resolution) -> dict:
     row = _base_row(label, mech, request)
     res = tripod_workspace(mech, math.radians(box_deg), resolution_z=resolution)
     m = res.metrics()
-    row["dexterous_volume_cm3"] = (f"sampled {m['volume_mm_deg2']:.4g} mm·deg² over (z, θx, θy)"
-                                   f", |θx|, |θy| <= {box_deg:g}°")
+    lo, hi = m["volume_bracket_mm_deg2"]
+    row["dexterous_volume_cm3"] = (f"bracket {lo:.4g} … {hi:.4g} mm·deg² (sampled "
+                                   f"{m['sampled_volume_mm_deg2']:.4g}) over (z, θx, θy), "
+                                   f"|θx|, |θy| <= {box_deg:g}°")
     row["constant_volume_cm3"] = _na(mech, "x, y, θz follow z, θx, θy (parasitic: "
                                      + (f"|x, y| up to {m['parasitic_xy_max_mm']:.2f} mm"
                                         if m["parasitic_xy_max_mm"] is not None
                                         else "empty") + ")")
-    row["reference"] = "dependent coordinates: (z, θx, θy) grid, sampled"
+    row["reference"] = ("dependent coordinates: (z, θx, θy) volume with its guaranteed "
+                        "bracket; grid estimate sampled")
     row["tripod"] = m
     return row
 
