@@ -109,7 +109,10 @@ class TaskSpec(_Model):
     shape: Literal["box", "cylinder", "points"]
     frame: Literal["nominal", "base"] = Field("nominal", description="positions relative to "
                                               "the nominal pose's position, or the base frame")
-    centre: list[Length] = Field([0.0, 0.0, 0.0], min_length=3, max_length=3)
+    centre: Literal["auto"] | list[Length | Literal["auto"]] = Field(
+        [0.0, 0.0, 0.0], description="box / cylinder centre [x, y, z] in the frame; 'auto' "
+        "(or 'auto' for some coordinates): placed per candidate where the task fits best, "
+        "a search (pkmlab.requirements.placement)")
     size: list[NonNegLength] | None = Field(None, min_length=3, max_length=3,
                                             description="box: full edges [x, y, z]")
     radius: NonNegLength | None = None
@@ -135,6 +138,8 @@ class TaskPlan:
     orientations: OrientationSet
     resolution: float
     source: dict
+    #: coordinates of the centre placed per candidate (``centre: auto``)
+    auto: tuple[bool, bool, bool] = (False, False, False)
 
 
 def _read_points(path: Path, field: str) -> np.ndarray:
@@ -170,7 +175,17 @@ def build_task(data: Any, base: Path) -> TaskPlan:
             points = np.array(t.points)
             if len(points) == 0:
                 raise ParameterError(f"{f}.points", "at least one point", [])
-    region = TaskRegion(t.shape, t.frame, tuple(t.centre), tuple(t.size or (0, 0, 0)),
+    centre = ["auto"] * 3 if t.centre == "auto" else list(t.centre)
+    if len(centre) != 3:
+        raise ParameterError(f"{f}.centre", "three coordinates [x, y, z] or 'auto'", t.centre)
+    auto = tuple(c == "auto" for c in centre)
+    if any(auto) and t.shape == "points":
+        raise ParameterError(f"{f}.centre", "a fixed centre for a point set (a point set "
+                             "has no centre; give frame: nominal and shift the points)",
+                             t.centre)
+    region = TaskRegion(t.shape, t.frame, tuple(0.0 if a else float(c) for a, c in
+                                                zip(auto, centre)),
+                        tuple(t.size or (0, 0, 0)),
                         t.radius or 0.0, t.height or 0.0, points)
     given = [k for k in ("orientation", "box", "tilt") if getattr(t, k) is not None]
     if len(given) > 1:
@@ -196,7 +211,7 @@ def build_task(data: Any, base: Path) -> TaskPlan:
     for k in ("tilt", "torsion"):
         if k in source:
             source[k] = f"{math.degrees(source[k]):.12g} deg"
-    return TaskPlan(region, oset, t.resolution, source)
+    return TaskPlan(region, oset, t.resolution, source, auto)
 
 
 # ---- motions ---------------------------------------------------------------------------------

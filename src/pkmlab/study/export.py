@@ -102,7 +102,7 @@ def export_designs(out: Path, study: Study, front: list[dict], *, maps=("kappa",
             if progress:
                 progress(i, len(chosen), message)
 
-        step(f"Pareto rank {rank} ({why})" if rank else why)
+        step(f"design #{r['seq']}: {why}")
         try:
             info = _export_one(d, study, r, i + 1, rank, why, maps, step)
             folders.append(d)
@@ -110,9 +110,8 @@ def export_designs(out: Path, study: Study, front: list[dict], *, maps=("kappa",
                             "why": why, "seq": r["seq"], "key": r["key"],
                             "files": info["files"]})
         except (ParameterError, NumericalError, ValueError, OSError) as exc:
-            log.warning("export of design %d (Pareto rank %d) failed: %s", i + 1, rank, exc)
-            problems.append(f"design {i + 1} (Pareto rank {rank}): {type(exc).__name__}: "
-                            f"{exc}")
+            log.warning("export of design #%s failed: %s", r["seq"], exc)
+            problems.append(f"design #{r['seq']}: {type(exc).__name__}: {exc}")
     keep = {d.name for d in folders}
     for stale in root.iterdir():
         if stale.is_dir() and DESIGN_FOLDER.match(stale.name) and stale.name not in keep:
@@ -156,9 +155,10 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
     d.mkdir(parents=True, exist_ok=True)
     params = study.space.baseline_values() if r["params"] == BASELINE else r["params"]
     spec = study.space.spec_of(r["params"] if r["params"] != BASELINE else None)
-    spec = spec.model_copy(update={"name": f"{study.name}-design-{number}"})
+    spec = spec.model_copy(update={"name": f"{study.name}-design-{r['seq']}"})
     atomic.write_text(d / "mechanism.yaml",
-                      f"# Design {number} of study {study.name}: Pareto rank {rank}, {why} "
+                      f"# Design #{r['seq']} of study {study.name} (its evaluation number, "
+                      f"the seq column of evaluations.csv): {why} "
                       f"(candidate {r['key']}). Lengths in mm, angles in degrees.\n"
                       + yaml.safe_dump(_plain(to_display(spec)), sort_keys=False,
                                        allow_unicode=True))

@@ -19,6 +19,8 @@ import yaml
 from ..runtime import atomic
 from .definition import Study
 from .export import export_designs
+from .flags import design_flags
+from .flags import label as design_label
 from .metrics import METRICS
 from .run import BASELINE, feasible, objective_matrix, provenance
 from .selection import non_dominated
@@ -207,11 +209,16 @@ def _summary(study: Study, records, front, baseline) -> str:
         label = "baseline" + ("" if baseline["status"] == "ok" else
                               f" ({baseline['status']}: {baseline['reason'].splitlines()[0]})")
         lines.append(row(label, baseline))
-    for i, r in enumerate(front[:max(study.top, 1) * 2]):
-        lines.append(row(f"Pareto {i + 1}", r))
+    for r in front[:max(study.top, 1) * 2]:
+        lines.append(row(design_label(r), r))
     lines += _requirement_margins(study, baseline, front[:max(study.top, 1) * 2], metrics)
     lines += _catalogue_fits(study, records)
     lines += _why_they_fail(study, records, front)
+    shown = front[:max(study.top, 1) * 2] or least_violating(study, records, max(study.top, 1))
+    flags = design_flags(study, shown, lambda r: _params(study, r))
+    if flags:
+        lines += ["", "Flags (" + ("Pareto" if front else "least-violating") + " designs; "
+                  "designs are named by their evaluation number, the `seq` column):", *flags]
     if notes:
         lines += ["", "Notes (a value shown as — is undefined for the reason given):", *notes]
     lines += ["", "Lengths in mm, angles in degrees, volumes in cm³, forces in N; "
@@ -234,7 +241,7 @@ def _requirement_margins(study: Study, baseline, front, shown) -> list[str]:
     """The task and actuator margins of the baseline and the Pareto designs listed above
     (markdown lines; none when the study has no requirement blocks)."""
     rows = ([("baseline", baseline)] if baseline is not None else []) + \
-        [(f"Pareto {i + 1}", r) for i, r in enumerate(front)]
+        [(design_label(r), r) for r in front]
     names = [m for m in REQUIREMENT_MARGINS if any(m in r["metrics"] for _, r in rows)
              and not all(_other_kind(r, m) for _, r in rows)]
     if not names:
@@ -264,8 +271,8 @@ def _why_they_fail(study: Study, records, front) -> list[str]:
         if least:
             out += ["", f"No feasible design. The {len(least)} least violating (fewest "
                     "violations, then smallest; exported under designs/):", "",
-                    "| candidate | violated |", "|---|---|"]
-            out += [f"| {r['seq']} | {violated_text(study, r)} |" for r in least]
+                    "| design | violated |", "|---|---|"]
+            out += [f"| {design_label(r)} | {violated_text(study, r)} |" for r in least]
     return out
 
 

@@ -16,7 +16,8 @@ from ..export import exporters
 from ..study.definition import Study
 from ..study.export import read_index
 from ..study.metrics import METRICS
-from ..study.violations import tally, violated_text
+from ..study.flags import design_flags
+from ..study.violations import least_violating, tally, violated_text
 from . import data as D
 from .figures import design_scene, pareto_matrix, pareto_parcoords
 from .page import colour_option, figure_json, hull_of_ply, png_uri, render_page
@@ -71,7 +72,7 @@ def _points(study: Study, rows: list[dict]) -> list[dict]:
                     "hover": r["hover"]})
         if r["design"]:
             pts.append({"seq": r["seq"], "group": "exported", "values": values,
-                        "hover": r["hover"], "text": str(r["design"])})
+                        "hover": r["hover"], "text": f"#{r['seq']}"})
     return pts
 
 
@@ -243,6 +244,9 @@ def write_study_page(out: Path, study: Study, records: list[dict], *, progress=N
     metrics = [m for m in METRICS if any(m in r["metrics"] for r in rows)]
     counts, reasons = D.failure_counts(records)
     why_fail = [{"what": w, "count": n, "of": of} for w, n, of in tally(study, records) if n]
+    shown = front[:max(study.top, 1) * 2] or least_violating(study, records, max(study.top, 1))
+    flags = [f[2:] for f in design_flags(study, shown, lambda r: D.params_of(study, r),
+                                         quiet=True)]
     resolved = out / "study.resolved.yaml"
     resolved_text = (resolved.read_text() if resolved.is_file() else
                      yaml.safe_dump(json.loads(json.dumps(study.resolved(), default=float)),
@@ -264,6 +268,7 @@ def write_study_page(out: Path, study: Study, records: list[dict], *, progress=N
         n_pareto=len(front), has_parcoords=has_parcoords,
         constraints_text=", ".join(c.describe() for c in study.constraints) or "none",
         export_problems=index["problems"], why_fail=why_fail, variables=_variables(study),
+        flags=flags,
         optimizer=_optimizer_text(study),
         seed=study.seed, resolved_yaml=resolved_text, runs=_runs(out),
         length_step=D.LENGTH_STEP_MM, angle_step=D.ANGLE_STEP_DEG,
