@@ -118,3 +118,37 @@ def test_requirement_study_flags_poor_conditioning_without_dexterity(tmp_path, c
     assert any("poor conditioning at the task" in r.message for r in caplog.records)
     with open(tmp_path / "out" / "evaluations.csv") as fh:
         assert "sampled_task_kappa" in fh.readline()
+
+
+def test_home_height_is_a_design_variable_with_units(tmp_path):
+    """home_height (nominal_pose[2], mm) is a named variable even when the mechanism file
+    gives no nominal pose: the candidate's nominal pose is the family's default with that
+    height, and the task (frame nominal) moves with it."""
+    import yaml
+
+    from pkmlab.study import load_study
+
+    rss = MECH_DIR / "instructables-servo-6rss.yaml"
+    base = load_mechanism(rss)
+    z0 = float(base.nominal_pose[2])
+    data = {"study": "home", "mechanism": {"file": str(rss)},
+            "design": {"home_height": {"low": f"{z0 - 20} mm", "high": "0.3 m"}},
+            "evaluate": {"task": {"shape": "box", "size": [2, 2, 2]}},
+            "objectives": [{"maximize": "task_margin"}], "optimizer": {"method": "grid"},
+            "output": str(tmp_path / "out")}
+    p = tmp_path / "s.yaml"
+    p.write_text(yaml.safe_dump(data))
+    s = load_study(p)
+    v = s.variables[0]
+    assert v.unit == "mm" and v.high == pytest.approx(300.0)
+    assert s.space.baseline_values()["home_height"] == pytest.approx(z0)
+    mech = s.space.decode({"home_height": z0 - 10.0})
+    np.testing.assert_allclose(mech.nominal_pose, [0, 0, z0 - 10.0, 0, 0, 0], atol=1e-12)
+    lo, _ = s.evaluation.task.region.boxes(mech)
+    assert lo[0, 2] == pytest.approx(z0 - 11.0)
+    for bad, match in (({"path": "nominal_pose[7]", "quantity": "length"}, "nominal_pose"),
+                       ({"low": "2 deg", "high": "5 deg"}, "design.home_height.low")):
+        data["design"] = {"home_height": {"low": "1 mm", "high": "2 mm", **bad}}
+        p.write_text(yaml.safe_dump(data))
+        with pytest.raises(ParameterError, match=match):
+            load_study(p)
