@@ -21,7 +21,9 @@ segment where the set's centre orientation is reachable (inverse kinematics, the
 scanned at ``LEVELS`` equally spaced offsets, then a golden-section search between the best
 level's neighbours runs down to ``TOL_MM``. During the search the margin's
 bisection stops at ``TOL_MM`` (coarser than the 0.01 mm of the reported ``task_margin``,
-which the evaluator then computes at the chosen centre in full).
+which the evaluator then computes at the chosen centre in full), and the sampled method
+(families without radial column intervals) checks only the task's boundary samples, as the
+margin's bisection does; the reported containment is then checked on every sample.
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..workspaces.orientations import OrientationSet
 from .task import TaskRegion, _check, _prepare
 
 __all__ = ["LEVELS", "TOL_MM", "Placement", "place_task"]
@@ -54,7 +57,7 @@ class Placement:
     note: str
 
 
-def _score(mech, oset, task, resolution, cons, cap) -> tuple[tuple, int]:
+def _score(mech, oset, task, resolution, cons, cap, surface) -> tuple[tuple, int]:
     """``((defined, value), checks)``: the position margin to ``TOL_MM`` (``defined`` 1),
     or ``(0, -failures)`` where not even the centre fits."""
     n = 0
@@ -62,9 +65,9 @@ def _score(mech, oset, task, resolution, cons, cap) -> tuple[tuple, int]:
     def fits(g):
         nonlocal n
         n += 1
-        return _check(mech, oset, task, resolution, cons, grow=g).contained
+        return _check(mech, oset, task, resolution, cons, grow=g, surface=surface).contained
 
-    base = _check(mech, oset, task, resolution, cons)
+    base = _check(mech, oset, task, resolution, cons, surface=surface)
     n += 1
     if base.contained:
         lo, hi = 0.0, 1.0
@@ -109,6 +112,10 @@ def place_task(mech, task: TaskRegion, auto: tuple[bool, bool, bool], orientatio
     scores best; ``task.centre`` holds the given values of the other coordinates and the
     middle of the scan of the searched ones."""
     mech, oset, cons = _prepare(mech, orientations, constraints)
+    # the sampled method checks the task's boundary samples only during the search (as the
+    # margin's bisection does); the reported containment is checked in full afterwards
+    surface = _check(mech, OrientationSet.fixed(), TaskRegion("points", points=np.zeros((1, 3))),
+                     resolution, cons).method == "sampled"
     span = float(mech.scale if span is None else span)
     cap = 2.0 * mech.scale
     c = np.array(task.centre, dtype=float)
@@ -120,7 +127,7 @@ def place_task(mech, task: TaskRegion, auto: tuple[bool, bool, bool], orientatio
         key = tuple(np.round(cc, 9))
         if key not in memo:
             t = dataclasses.replace(task, centre=tuple(float(v) for v in cc))
-            memo[key], n = _score(mech, oset, t, resolution, cons, cap)
+            memo[key], n = _score(mech, oset, t, resolution, cons, cap, surface)
             checks += n
         return memo[key]
 
