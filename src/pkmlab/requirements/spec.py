@@ -245,8 +245,10 @@ class MotionSpec(_Model):
     name: str = Field(pattern=r"^[A-Za-z0-9._-]+$")
     file: str | None = Field(None, description="CSV t,x,y,z,theta_x,theta_y,theta_z (s, mm, "
                              "deg) [+ <coord>_dot, <coord>_ddot], relative to the study file")
-    frame: Literal["nominal", "base"] = Field("nominal", description="CSV poses relative to "
-                                              "the nominal pose, or absolute")
+    frame: Literal["nominal", "base", "task"] = Field(
+        "nominal", description="poses relative to the nominal pose, absolute (base, CSV "
+        "only), or relative to the task's centre as placed (task: needs evaluate.task; with "
+        "task.centre auto the centre the search chose) at the nominal orientation")
     smoothing: SmoothingSpec = Field(default_factory=SmoothingSpec)
     sinusoid: SinusoidSpec | None = None
     paper: bool = Field(False, description="Hopkins & Williams' ±2 in / ±30° motion")
@@ -261,11 +263,23 @@ class MotionsPlan:
     recorded: dict                                # name -> Motion (CSV, as recorded)
     source: list
 
-    def motions(self, mech) -> list:
+    def motions(self, mech, task_centre=None) -> list:
         """The motions for one mechanism (generators and 'nominal' frames use its nominal
-        pose)."""
+        pose; 'task' frames the task's centre ``task_centre`` (base frame, mm) at the nominal
+        orientation)."""
         out = []
+        home = mech
+        if task_centre is not None:
+            import dataclasses
+
+            pose = mech.nominal_pose
+            pose[:3] = task_centre
+            home = dataclasses.replace(mech, nominal=pose)
         for s in self.specs:
+            if s.frame == "task" and task_centre is None:
+                raise ParameterError(f"evaluate.motions {s.name!r} frame", "'task' with an "
+                                     "evaluate.task block", s.frame)
+            mech = home if s.frame == "task" else mech
             if s.paper:
                 out.append(paper_motion(mech, segment_time=s.segment_time, rate_hz=s.rate,
                                         name=s.name))
@@ -275,7 +289,7 @@ class MotionsPlan:
                 out.append(mo.sinusoid_motion(mech, a, f, ph, s.duration, s.rate, s.name))
             else:
                 m = self.recorded[s.name]
-                if s.frame == "nominal":
+                if s.frame in ("nominal", "task"):
                     m = mo.Motion(m.name, m.t, m.poses + mech.nominal_pose, m.twist, m.accel,
                                   m.derivatives)
                 out.append(m)

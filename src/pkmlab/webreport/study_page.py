@@ -133,6 +133,8 @@ def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
             if lay:
                 caption += (f", {lay['window_mm']:g} mm window every {lay['spacing_mm']:g} mm "
                             f"({lay['layout']} layout)")
+            if info.get("task_drawing_note"):
+                caption += "; note: " + info["task_drawing_note"]
             card["slices"].append({"uri": png_uri(folder / name), "caption": caption})
     fig, colours = None, []
     mech = None
@@ -223,10 +225,17 @@ def write_study_page(out: Path, study: Study, records: list[dict], *, progress=N
     step("Pareto charts")
     figures = {"fig-pareto-matrix": figure_json(pareto_matrix(axes, _points(study, rows)))}
     has_parcoords = len(axes) > 2
+    parcoords_title = "feasible candidates; Pareto set in red"
     if has_parcoords:
+        # nothing feasible: the least-violating designs instead of an empty box
+        least = set() if front else {r["seq"] for r in least_violating(
+            study, records, max(study.top, 1) * 4)}
+        if least:
+            parcoords_title = (f"no feasible candidate: the {len(least)} least-violating "
+                               "designs (fewest violations, then smallest), in red")
         pc = [{"values": {a["key"]: r["metrics"][a["key"]] for a in axes},
-               "pareto": bool(r["pareto_rank"])} for r in rows
-              if r["role"] == "candidate" and r["feasible"]
+               "pareto": bool(r["pareto_rank"]) or r["seq"] in least} for r in rows
+              if r["role"] == "candidate" and (r["feasible"] or r["seq"] in least)
               and all(isinstance(r["metrics"].get(a["key"]), int | float) and
                       math.isfinite(r["metrics"][a["key"]]) for a in axes)]
         figures["fig-pareto-parcoords"] = figure_json(pareto_parcoords(axes, pc))
@@ -265,7 +274,7 @@ def write_study_page(out: Path, study: Study, records: list[dict], *, progress=N
         data=data, figures=figures, description=study.description, axes=axes, cards=cards,
         n_evaluations=len(records), counts=counts, reasons=reasons,
         n_feasible=sum(r["feasible"] for r in rows if r["role"] == "candidate"),
-        n_pareto=len(front), has_parcoords=has_parcoords,
+        n_pareto=len(front), has_parcoords=has_parcoords, parcoords_title=parcoords_title,
         constraints_text=", ".join(c.describe() for c in study.constraints) or "none",
         export_problems=index["problems"], why_fail=why_fail, variables=_variables(study),
         flags=flags,

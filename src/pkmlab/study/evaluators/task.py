@@ -78,6 +78,7 @@ class Task(Evaluator):
             for c, a in zip("xyz", plan.auto):
                 if a:
                     ctx.notes[f"task_centre_{c}"] = placed.note
+        ctx.task_centre = np.asarray(region.centre, dtype=float) + region.offset(mech)
         m = task_margins(mech, region, plan.orientations, plan.resolution)
         chk = m["check"]
         if chk.note:
@@ -86,7 +87,7 @@ class Task(Evaluator):
         kappa, _, knote = task_kappa(mech, region, plan.orientations)
         ctx.notes["sampled_task_kappa"] = knote
         if not kappa <= TASK_KAPPA_WARN:
-            log.warning("poor conditioning at the task: κ %.3g above %g (%s)", kappa,
+            log.debug("poor conditioning at the task: κ %.3g above %g (%s)", kappa,
                         TASK_KAPPA_WARN, knote)
         out = {"task_contained": float(chk.contained), "task_margin": m["margin_mm"],
                "task_orientation_margin": m["orientation_margin_deg"],
