@@ -152,3 +152,61 @@ def test_home_height_is_a_design_variable_with_units(tmp_path):
         p.write_text(yaml.safe_dump(data))
         with pytest.raises(ParameterError, match=match):
             load_study(p)
+
+
+def test_motions_in_the_task_frame_follow_the_placed_centre(tmp_path):
+    """frame: task: a sinusoid oscillates about the task's centre as placed (here 30 mm
+    below the nominal pose), at the nominal orientation; without a task block it is
+    refused."""
+    from pkmlab.requirements.spec import build_motions
+
+    mech = load_mechanism(HW)
+    plan = build_motions([{"name": "h", "frame": "task", "duration": "1 s", "rate": "100 Hz",
+                           "sinusoid": {"amplitude": {"z": "5 mm"},
+                                        "frequency": {"z": "1 Hz"}}}], tmp_path)
+    centre = np.asarray(mech.nominal_pose[:3]) + [0.0, 0.0, -30.0]
+    m = plan.motions(mech, centre)[0]
+    np.testing.assert_allclose(m.poses[:, :2], np.tile(centre[:2], (len(m.poses), 1)),
+                               atol=1e-12)
+    assert m.poses[:, 2].min() == pytest.approx(centre[2] - 5.0, abs=0.01)
+    assert m.poses[:, 2].max() == pytest.approx(centre[2] + 5.0, abs=0.01)
+    np.testing.assert_allclose(m.poses[:, 3:], np.tile(mech.nominal_pose[3:],
+                                                       (len(m.poses), 1)), atol=1e-12)
+    with pytest.raises(ParameterError, match="task"):
+        plan.motions(mech)
+
+
+def test_a_task_wider_than_the_workspace_drawn_is_said_so():
+    """The ±30° task over a ±15° workspace's slices gets a note (slices legend, design.json,
+    the card's caption); a task within the workspace's orientations gets none."""
+    import types
+
+    from pkmlab.study.export import _task_overlay, _wider
+
+    mech = load_mechanism(HW)
+    t = TaskRegion("box", size=(10.0, 10.0, 10.0))
+    plan = types.SimpleNamespace(region=t, orientations=OrientationSet.box(
+        np.radians([30, 30, 0]), samples=3))
+    ws = {"orientations": OrientationSet.box(np.radians([15, 15, 15]), samples=3)}
+    ev = types.SimpleNamespace(workspace=object(), request=ws)
+    text = _wider(plan, ev)
+    assert "reach beyond the workspace drawn" in text and "±30, ±30, ±0° Euler box" in text
+    info: dict = {}
+    ov = _task_overlay(mech, plan, info, ev)
+    assert "note:" in ov["overlay_label"] and info["task_drawing_note"] == text
+    narrow = types.SimpleNamespace(region=t, orientations=OrientationSet.box(
+        np.radians([10, 10, 0]), samples=3))
+    assert _wider(narrow, ev) == ""
+
+
+def test_actuators_fit_names_the_exceeded_margin():
+    import types
+
+    from pkmlab.requirements.actuators import ActuatorSpec, fit
+
+    spec = ActuatorSpec("slow", kind="rotary", force=2000.0, speed=1.0, stroke=3.0)
+    r = types.SimpleNamespace(ok=np.ones(3, bool), force=np.full((3, 6), 100.0),
+                              qdot=np.full((3, 6), 2.0), q=np.zeros((3, 6)),
+                              first_problem=lambda: "")
+    f = fit(spec, [r])
+    assert not f.fits and f.notes["actuators_fit"] == "slow exceeded: speed margin -100 %"
