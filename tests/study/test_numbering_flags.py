@@ -18,7 +18,7 @@ from pkmlab.study import load_study
 from pkmlab.study.flags import BOUND_SHARE, on_bound
 
 
-def test_one_numbering_and_on_bound_flags(tmp_path, capsys, caplog):
+def test_one_numbering_and_on_bound_flags(tmp_path, capsys, caplog, monkeypatch):
     path = small_study(tmp_path, objectives=[{"maximize": "constant_volume"},
                                              {"minimize": "base_outer_radius"}],
                        design={"link_length": {"low": "200 mm", "high": "260 mm", "levels": 3}},
@@ -38,10 +38,18 @@ def test_one_numbering_and_on_bound_flags(tmp_path, capsys, caplog):
     titles = re.findall(r"<h2>Design (#\d+) ", html)
     assert titles and set(titles) <= {f"#{s}" for s in seqs}
     assert "Pareto rank" not in html and "<h2>Design 1 " not in html
+    import sys
+
+    import pytest
+
     from pkmlab.results import open_results
 
+    monkeypatch.setitem(sys.modules, "pandas", None)     # open_results needs no pandas
     res = open_results(out)
     assert {d.label for d in res.designs} == set(titles)
+    assert {str(r["seq"]) for r in res.evaluations.records()} >= set(seqs)
+    with pytest.raises(ImportError, match="needs pandas"):
+        res.evaluations.to_pandas()
     # the grid samples the box's ends: the best volume sits on link_length's upper bound
     assert "lies on a bound of the design box" in summary
     assert re.search(r"link_length 260 of ≤ 260 mm", summary)
