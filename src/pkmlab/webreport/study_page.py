@@ -32,6 +32,10 @@ _FILES = {
     "mechanism.yaml": "mechanism file (pkmlab inspect / workspace / compare read it)",
     "design.json": "why it was chosen, values, slice layout",
     "slices.png": "horizontal sections",
+    "actuators.json": "the actuator values, torques or forces and speeds drawn in "
+                      "actuators-*.png, with the chosen actuator's limits",
+    "task.stl": "the task region (mm, base frame, placed where the evaluation put it)",
+    "workspace_task.glb": "the workspace hull and the task region in one scene (glTF, m)",
 }
 
 
@@ -45,6 +49,8 @@ def _what(name: str) -> str:
     for mex in exporters("mechanism").values():      # mechanism.mjcf.xml, .urdf, ...
         if any(name == "mechanism" + sfx for sfx in mex.files or (mex.suffix,)):
             return f"mechanism, {mex.format.upper()}: {mex.description}"
+    if name.startswith("actuators-") and name.endswith(".png"):
+        return "actuator torques or forces and speeds over the motion, limits dashed"
     return _FILES.get(name, "slices coloured by the metric" if name.endswith("_slices.png")
                       else "")
 
@@ -127,7 +133,9 @@ def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
                           "design.json", "what": _FILES["design.json"]})
     lay = info.get("slice_layout")
     for name in sorted(info["files"], key=lambda s: (s == "slices.png", s)):
-        if name.endswith(".png") and (folder / name).is_file():
+        # the sections only (actuators-*.png are in the file list, not sections)
+        if (name == "slices.png" or name.endswith("_slices.png")) and \
+                (folder / name).is_file():
             caption = ("sections" if name == "slices.png" else
                        f"sections coloured by {name.replace('_slices.png', '')}")
             if lay:
@@ -254,8 +262,8 @@ def write_study_page(out: Path, study: Study, records: list[dict], *, progress=N
     counts, reasons = D.failure_counts(records)
     why_fail = [{"what": w, "count": n, "of": of} for w, n, of in tally(study, records) if n]
     shown = front[:max(study.top, 1) * 2] or least_violating(study, records, max(study.top, 1))
-    flags = [f[2:] for f in design_flags(study, shown, lambda r: D.params_of(study, r),
-                                         quiet=True)]
+    flags = [{"text": f[2:], "warn": "task centre placed" not in f}
+             for f in design_flags(study, shown, lambda r: D.params_of(study, r), quiet=True)]
     resolved = out / "study.resolved.yaml"
     resolved_text = (resolved.read_text() if resolved.is_file() else
                      yaml.safe_dump(json.loads(json.dumps(study.resolved(), default=float)),
