@@ -133,9 +133,12 @@ def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
                           "design.json", "what": _FILES["design.json"]})
     lay = info.get("slice_layout")
     for name in sorted(info["files"], key=lambda s: (s == "slices.png", s)):
-        # the sections only (actuators-*.png are in the file list, not sections)
-        if (name == "slices.png" or name.endswith("_slices.png")) and \
-                (folder / name).is_file():
+        if name.endswith(".png") and (folder / name).is_file():
+            if name.startswith("actuators-"):       # not a section: its own caption
+                card["slices"].append({"uri": png_uri(folder / name), "caption": (
+                    f"actuators over the motion {name[len('actuators-'):-4]}: "
+                    + _what(name))})
+                continue
             caption = ("sections" if name == "slices.png" else
                        f"sections coloured by {name.replace('_slices.png', '')}")
             if lay:
