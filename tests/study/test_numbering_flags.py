@@ -50,6 +50,9 @@ def test_one_numbering_and_on_bound_flags(tmp_path, capsys, caplog, monkeypatch)
     assert {str(r["seq"]) for r in res.evaluations.records()} >= set(seqs)
     with pytest.raises(ImportError, match="needs pandas"):
         res.evaluations.to_pandas()
+    # compare takes the same numbers: --designs names evaluations by seq
+    code, _, err = cli(capsys, "compare", "--pareto", out / "pareto.csv", "--designs", "999")
+    assert code == 2 and "--designs" in err and "evaluation numbers (seq)" in err
     # the grid samples the box's ends: the best volume sits on link_length's upper bound
     assert "lies on a bound of the design box" in summary
     assert re.search(r"link_length 260 of ≤ 260 mm", summary)
