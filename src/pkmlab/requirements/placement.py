@@ -147,7 +147,7 @@ def place_task(mech, task: TaskRegion, auto: tuple[bool, bool, bool], orientatio
             a, b = levels[max(i - 1, 0)], levels[min(i + 1, LEVELS - 1)]
             g = (math.sqrt(5) - 1) / 2
 
-            def f(v):
+            def f(v, k=k):
                 cc = c.copy()
                 cc[k] = v
                 return score(cc)

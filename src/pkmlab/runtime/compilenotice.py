@@ -96,7 +96,8 @@ class _Listener(_event.Listener):
 @contextlib.contextmanager
 def compile_notice(say, what: str = "", kind: str = "study", every: float = EVERY_S):
     """Within ``with``: ``say(line)`` when numba first compiles (``what``: e.g. the family's
-    name and a space, or ''), every ``every`` s while it goes on, and once at the end (see the module notes)."""
+    name and a space, or ''), every ``every`` s while it goes on, and once at the end (see
+    the module notes)."""
     lis = _Listener(say, what, kind, every)
     with _event.install_listener("numba:compile", lis):
         try:

@@ -15,8 +15,8 @@ import yaml
 from ..export import exporters
 from ..study.definition import Study
 from ..study.export import read_index
-from ..study.metrics import METRICS
 from ..study.flags import design_flags
+from ..study.metrics import METRICS
 from ..study.violations import least_violating, tally, violated_text
 from . import data as D
 from .figures import design_scene, pareto_matrix, pareto_parcoords
