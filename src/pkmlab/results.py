@@ -106,6 +106,12 @@ class Design:
     folder: Path
     _results: Results = field(repr=False)
 
+    @property
+    def label(self) -> str:
+        """Its one name in the summary, report, compare and here: ``#seq``, its evaluation
+        number (``number`` and ``pareto_rank`` are positions, not names)."""
+        return f"#{self.seq}"
+
     @cached_property
     def mechanism(self):
         """Its mechanism (:class:`pkmlab.Mechanism`)."""

@@ -512,7 +512,7 @@ def test_exported_design_draws_task_and_actuator_limits(tmp_path):
     write_report(tmp_path, s, front)
     text = (tmp_path / "summary.md").read_text()
     assert "Requirement margins" in text
-    row = next(ln for ln in text.splitlines() if ln.startswith("| Pareto 1") and
+    row = next(ln for ln in text.splitlines() if ln.startswith("| #1 ") and
                "task_margin" not in ln and ln.count("|") > 8)
     assert f"{rec['metrics']['task_margin']:.4g}" in row
     assert f"{rec['metrics']['actuator_force_margin']:.4g}" in row

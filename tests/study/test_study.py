@@ -282,11 +282,12 @@ def test_compare_files_and_pareto_rows(tmp_path, serial_run):
                                  "--out", str(tmp_path / "cmp"), "--json"])
     assert r.exit_code == 0, r.output
     d = json.loads(r.stdout)["designs"]
-    assert [x["label"] for x in d] == ["hopkins-williams-6psu", "tiny #1"]
+    front = pareto_records(res, records)
+    # the one numbering: the design is named by its evaluation number #seq (not its row)
+    assert [x["label"] for x in d] == ["hopkins-williams-6psu", f"tiny #{front[0]['seq']}"]
     # the Pareto row is the study's rank-1 candidate, evaluated with the compare protocol
     from pkmlab import OrientationSet, workspace
 
-    front = pareto_records(res, records)
     mech = res.space.decode(front[0]["params"])
     ref = workspace(mech, "dexterous", OrientationSet.box(np.radians([10.0] * 3), samples=5),
                     5.0)

@@ -142,7 +142,7 @@ def test_clicking_a_pareto_point_opens_its_card(report, tmp_path):
     x, y = _point(pg, "Pareto front", {"seq": other})
     pg.mouse.click(x, y)
     pg.wait_for_selector("#candidate-card", state="visible", timeout=10_000)
-    assert pg.locator("#candidate-title").inner_text() == f"Candidate {other}"
+    assert pg.locator("#candidate-title").inner_text() == f"Design #{other}"
     assert pg.locator("#candidate-params tr").count() == 1 + 3
     assert report.problems == []
 

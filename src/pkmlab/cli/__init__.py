@@ -131,7 +131,8 @@ def run_cli() -> None:
     # module teardown when not ended by main) cannot be interrupted halfway
     atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
     try:
-        code = app(standalone_mode=False)      # click returns an Exit's code in this mode
+        with _compile_notice(sys.argv[1:]):
+            code = app(standalone_mode=False)  # click returns an Exit's code in this mode
         if code == 130:                        # typer turns Ctrl-C into Exit(130), silently
             sys.stderr.write("interrupted\n")
             _INTERRUPTED["said"] = True
@@ -183,6 +184,59 @@ def run_cli() -> None:
         # pools, a second or more after a study's report) ends it at once with status 130
         # instead of a signal death or a traceback from a library's exit handler
         signal.signal(signal.SIGINT, _interrupted_at_exit)
+
+
+#: the kind of compile each command makes (:data:`pkmlab.runtime.compilenotice.ESTIMATES`)
+_KINDS = {"ik": "kinematics", "fk": "kinematics", "inspect": "kinematics",
+          "validate": "study", "run": "study", "report": "study"}
+
+
+def _compile_notice(argv: list[str]):
+    """``pkmlab: compiling <family> kernels, one-off, about …`` on stderr when the command
+    compiles numba kernels (none when they load from the cache)."""
+    from ..runtime.compilenotice import compile_notice
+
+    command = next((a for a in argv if not a.startswith("-")), "")
+    family = _family_of(argv)
+
+    def say(line: str) -> None:
+        sys.stderr.write(f"pkmlab: {line}\n")
+        sys.stderr.flush()
+
+    return compile_notice(say, f"{family} " if family else "",
+                          _KINDS.get(command, "analysis")) if command else _nothing()
+
+
+def _nothing():
+    import contextlib
+
+    return contextlib.nullcontext()
+
+
+def _family_of(argv: list[str]) -> str:
+    """The family of the first mechanism or study file on the command line ('' if none)."""
+    from pathlib import Path
+
+    import yaml
+
+    for a in argv:
+        p = Path(a)
+        if p.suffix not in (".yaml", ".yml") or not p.is_file():
+            continue
+        try:
+            data = yaml.safe_load(p.read_text())
+            if isinstance(data, dict) and isinstance(data.get("mechanism"), dict):
+                m = data["mechanism"]
+                if isinstance(m.get("inline"), dict):
+                    data = m["inline"]
+                elif isinstance(m.get("file"), str):
+                    data = yaml.safe_load((p.parent / m["file"]).read_text())
+            fam = data.get("family") if isinstance(data, dict) else None
+            if isinstance(fam, str) and fam.isidentifier():
+                return fam
+        except (OSError, yaml.YAMLError):
+            continue
+    return ""
 
 
 def _interrupted_at_exit(signum, frame) -> None:

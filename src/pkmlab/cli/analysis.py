@@ -389,7 +389,10 @@ def compare(
     = None,
     pareto: Annotated[Path | None, typer.Option(
         help="a study's pareto.csv: compare its rows (with --rows)")] = None,
-    rows: Annotated[str | None, typer.Option(help='Pareto ranks, e.g. "1,3"')] = None,
+    rows: Annotated[str | None, typer.Option(help='rows of pareto.csv, e.g. "1,3"')] = None,
+    designs_opt: Annotated[str | None, typer.Option(
+        "--designs", help='designs by their evaluation number #seq (the one numbering of '
+        'the summary, report and pareto.csv\'s seq column), e.g. "12,40"')] = None,
     box: Annotated[float, typer.Option(help="dexterous set: ±box° simultaneous")] = 15.0,
     samples: SamplesOpt = 7,
     resolution: ResolutionOpt = "2.5",
@@ -419,17 +422,29 @@ def compare(
                                  "evaluations.sqlite", str(pareto)))
         with open(pareto) as fh:
             table = list(csv_mod.DictReader(fh))
-        wanted = [r.strip() for r in (rows or "1").split(",")]
         study, all_records = _open_results(pareto.parent)
         records = {str(r["seq"]): r for r in all_records}
-        by_rank = {row["rank"]: row for row in table}
-        for w in wanted:
-            if w not in by_rank:
-                _fail(ParameterError("--rows", f"ranks present in {pareto.name} "
-                                     f"(1..{len(table)})", w))
-            rec = records[by_rank[w]["seq"]]
+        if designs_opt is not None and rows is not None:
+            _fail(ParameterError("--designs", "not given with --rows (one way to choose)",
+                                 designs_opt))
+        if designs_opt is not None:
+            seqs = [s.strip() for s in designs_opt.split(",")]
+            for s in seqs:
+                if s not in records or records[s]["role"] != "candidate":
+                    _fail(ParameterError("--designs", "evaluation numbers (seq) of "
+                                         "candidates in evaluations.csv", s))
+        else:
+            wanted = [r.strip() for r in (rows or "1").split(",")]
+            by_rank = {row["rank"]: row for row in table}
+            for w in wanted:
+                if w not in by_rank:
+                    _fail(ParameterError("--rows", f"ranks present in {pareto.name} "
+                                         f"(1..{len(table)})", w))
+            seqs = [by_rank[w]["seq"] for w in wanted]
+        for s in seqs:
+            rec = records[s]
             try:
-                designs.append((f"{study.name} #{w}", study.space.decode(rec["params"])))
+                designs.append((f"{study.name} #{s}", study.space.decode(rec["params"])))
             except ParameterError as exc:
                 _fail(exc)
     if len(designs) < 1:

@@ -131,4 +131,12 @@ def fit(spec: ActuatorSpec, results) -> ActuatorFit:
         notes["actuator_stroke_margin"] = f"{spec.name}: no stroke given"
     margins = [m for m in (fm, sm, tm, stm) if m is not None]
     fits = not bad and fm is not None and all(m >= 0 for m in margins)
+    if not fits and not bad:
+        rotary = spec.kind == "rotary"
+        named = (("torque" if rotary else "force", fm, "%"), ("speed", sm, "%"),
+                 ("torque–speed", tm, "%"), ("angle" if rotary else "stroke", stm,
+                                             "deg" if rotary else "mm"))
+        over = [f"{n} margin {m:.3g} {u}" for n, m, u in named if m is not None and m < 0]
+        notes["actuators_fit"] = f"{spec.name} exceeded: " + (", ".join(over) or
+                                                               "force margin undefined")
     return ActuatorFit(bool(fits), fm, sm, tm, stm, notes)

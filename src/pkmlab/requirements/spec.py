@@ -109,7 +109,10 @@ class TaskSpec(_Model):
     shape: Literal["box", "cylinder", "points"]
     frame: Literal["nominal", "base"] = Field("nominal", description="positions relative to "
                                               "the nominal pose's position, or the base frame")
-    centre: list[Length] = Field([0.0, 0.0, 0.0], min_length=3, max_length=3)
+    centre: Literal["auto"] | list[Length | Literal["auto"]] = Field(
+        [0.0, 0.0, 0.0], description="box / cylinder centre [x, y, z] in the frame; 'auto' "
+        "(or 'auto' for some coordinates): placed per candidate where the task fits best, "
+        "a search (pkmlab.requirements.placement)")
     size: list[NonNegLength] | None = Field(None, min_length=3, max_length=3,
                                             description="box: full edges [x, y, z]")
     radius: NonNegLength | None = None
@@ -135,6 +138,8 @@ class TaskPlan:
     orientations: OrientationSet
     resolution: float
     source: dict
+    #: coordinates of the centre placed per candidate (``centre: auto``)
+    auto: tuple[bool, bool, bool] = (False, False, False)
 
 
 def _read_points(path: Path, field: str) -> np.ndarray:
@@ -170,7 +175,17 @@ def build_task(data: Any, base: Path) -> TaskPlan:
             points = np.array(t.points)
             if len(points) == 0:
                 raise ParameterError(f"{f}.points", "at least one point", [])
-    region = TaskRegion(t.shape, t.frame, tuple(t.centre), tuple(t.size or (0, 0, 0)),
+    centre = ["auto"] * 3 if t.centre == "auto" else list(t.centre)
+    if len(centre) != 3:
+        raise ParameterError(f"{f}.centre", "three coordinates [x, y, z] or 'auto'", t.centre)
+    auto = tuple(c == "auto" for c in centre)
+    if any(auto) and t.shape == "points":
+        raise ParameterError(f"{f}.centre", "a fixed centre for a point set (a point set "
+                             "has no centre; give frame: nominal and shift the points)",
+                             t.centre)
+    region = TaskRegion(t.shape, t.frame, tuple(0.0 if a else float(c) for a, c in
+                                                zip(auto, centre)),
+                        tuple(t.size or (0, 0, 0)),
                         t.radius or 0.0, t.height or 0.0, points)
     given = [k for k in ("orientation", "box", "tilt") if getattr(t, k) is not None]
     if len(given) > 1:
@@ -196,7 +211,7 @@ def build_task(data: Any, base: Path) -> TaskPlan:
     for k in ("tilt", "torsion"):
         if k in source:
             source[k] = f"{math.degrees(source[k]):.12g} deg"
-    return TaskPlan(region, oset, t.resolution, source)
+    return TaskPlan(region, oset, t.resolution, source, auto)
 
 
 # ---- motions ---------------------------------------------------------------------------------
@@ -230,8 +245,10 @@ class MotionSpec(_Model):
     name: str = Field(pattern=r"^[A-Za-z0-9._-]+$")
     file: str | None = Field(None, description="CSV t,x,y,z,theta_x,theta_y,theta_z (s, mm, "
                              "deg) [+ <coord>_dot, <coord>_ddot], relative to the study file")
-    frame: Literal["nominal", "base"] = Field("nominal", description="CSV poses relative to "
-                                              "the nominal pose, or absolute")
+    frame: Literal["nominal", "base", "task"] = Field(
+        "nominal", description="poses relative to the nominal pose, absolute (base, CSV "
+        "only), or relative to the task's centre as placed (task: needs evaluate.task; with "
+        "task.centre auto the centre the search chose) at the nominal orientation")
     smoothing: SmoothingSpec = Field(default_factory=SmoothingSpec)
     sinusoid: SinusoidSpec | None = None
     paper: bool = Field(False, description="Hopkins & Williams' ±2 in / ±30° motion")
@@ -246,11 +263,23 @@ class MotionsPlan:
     recorded: dict                                # name -> Motion (CSV, as recorded)
     source: list
 
-    def motions(self, mech) -> list:
+    def motions(self, mech, task_centre=None) -> list:
         """The motions for one mechanism (generators and 'nominal' frames use its nominal
-        pose)."""
+        pose; 'task' frames the task's centre ``task_centre`` (base frame, mm) at the nominal
+        orientation)."""
         out = []
+        home = mech
+        if task_centre is not None:
+            import dataclasses
+
+            pose = mech.nominal_pose
+            pose[:3] = task_centre
+            home = dataclasses.replace(mech, nominal=pose)
         for s in self.specs:
+            if s.frame == "task" and task_centre is None:
+                raise ParameterError(f"evaluate.motions {s.name!r} frame", "'task' with an "
+                                     "evaluate.task block", s.frame)
+            mech = home if s.frame == "task" else mech
             if s.paper:
                 out.append(paper_motion(mech, segment_time=s.segment_time, rate_hz=s.rate,
                                         name=s.name))
@@ -260,7 +289,7 @@ class MotionsPlan:
                 out.append(mo.sinusoid_motion(mech, a, f, ph, s.duration, s.rate, s.name))
             else:
                 m = self.recorded[s.name]
-                if s.frame == "nominal":
+                if s.frame in ("nominal", "task"):
                     m = mo.Motion(m.name, m.t, m.poses + mech.nominal_pose, m.twist, m.accel,
                                   m.derivatives)
                 out.append(m)

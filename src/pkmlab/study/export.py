@@ -24,6 +24,7 @@ actuator's limits dashed, and its torque–speed curve with the required points)
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import json
 import logging
@@ -102,7 +103,7 @@ def export_designs(out: Path, study: Study, front: list[dict], *, maps=("kappa",
             if progress:
                 progress(i, len(chosen), message)
 
-        step(f"Pareto rank {rank} ({why})" if rank else why)
+        step(f"design #{r['seq']}: {why}")
         try:
             info = _export_one(d, study, r, i + 1, rank, why, maps, step)
             folders.append(d)
@@ -110,9 +111,8 @@ def export_designs(out: Path, study: Study, front: list[dict], *, maps=("kappa",
                             "why": why, "seq": r["seq"], "key": r["key"],
                             "files": info["files"]})
         except (ParameterError, NumericalError, ValueError, OSError) as exc:
-            log.warning("export of design %d (Pareto rank %d) failed: %s", i + 1, rank, exc)
-            problems.append(f"design {i + 1} (Pareto rank {rank}): {type(exc).__name__}: "
-                            f"{exc}")
+            log.warning("export of design #%s failed: %s", r["seq"], exc)
+            problems.append(f"design #{r['seq']}: {type(exc).__name__}: {exc}")
     keep = {d.name for d in folders}
     for stale in root.iterdir():
         if stale.is_dir() and DESIGN_FOLDER.match(stale.name) and stale.name not in keep:
@@ -156,9 +156,10 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
     d.mkdir(parents=True, exist_ok=True)
     params = study.space.baseline_values() if r["params"] == BASELINE else r["params"]
     spec = study.space.spec_of(r["params"] if r["params"] != BASELINE else None)
-    spec = spec.model_copy(update={"name": f"{study.name}-design-{number}"})
+    spec = spec.model_copy(update={"name": f"{study.name}-design-{r['seq']}"})
     atomic.write_text(d / "mechanism.yaml",
-                      f"# Design {number} of study {study.name}: Pareto rank {rank}, {why} "
+                      f"# Design #{r['seq']} of study {study.name} (its evaluation number, "
+                      f"the seq column of evaluations.csv): {why} "
                       f"(candidate {r['key']}). Lengths in mm, angles in degrees.\n"
                       + yaml.safe_dump(_plain(to_display(spec)), sort_keys=False,
                                        allow_unicode=True))
@@ -171,10 +172,13 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
     ev = study.evaluation
     mech = spec.build() if (ev.workspace is not None or ev.task is not None
                             or ev.motions is not None) else None
-    overlay = _task_overlay(mech, ev.task, info)
+    task = _placed_task(ev.task, r["metrics"])
+    overlay = _task_overlay(mech, task, info, ev)
     if ev.motions is not None:
         step("actuator plots over the required motions")
-        _actuator_plots(d, study, mech, r, info, files)
+        centre = None if task is None else np.asarray(task.region.centre) + \
+            task.region.offset(mech)
+        _actuator_plots(d, study, mech, r, info, files, centre)
     if ev.workspace is not None or ev.task is not None:
         force_limit = ev.dexterity.force_limit if ev.dexterity is not None else 150.0
         step("workspace")
@@ -201,7 +205,7 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
                                              "cuts it (see task.stl)")
         if ev.task is not None:
             step("task mesh")
-            _task_meshes(d, mech, ev.task, res, files, info)
+            _task_meshes(d, mech, task, res, files, info)
         if res.mesh_problem is not None:
             info["mesh"] = res.mesh_problem
         else:
@@ -264,15 +268,61 @@ def _mechanism_formats(d: Path, study: Study, mech, files: list, info: dict) -> 
 # ---- requirement outputs (task region, actuators over the motions) ---------------------------
 
 
-def _task_overlay(mech, task, info: dict) -> dict:
+def _placed_task(task, metrics: dict):
+    """The task plan with its centre where the evaluation placed it (``task.centre: auto``:
+    the ``task_centre_*`` metrics), so that drawings and motions use that centre."""
+    if task is None or not any(task.auto):
+        return task
+    c = [metrics.get(f"task_centre_{a}") for a in "xyz"]
+    if any(v is None for v in c):
+        return task
+    return dataclasses.replace(task, region=dataclasses.replace(
+        task.region, centre=tuple(float(v) for v in c)))
+
+
+def _wider(task, ev) -> str:
+    """Why the task's outline on the workspace slices is not a containment picture: its
+    orientation set reaches further than the workspace's ('' when it does not)."""
+    req = getattr(ev, "request", None) or {}
+    oset = req.get("orientations")
+    if ev.workspace is None or oset is None:
+        return ""
+    t, w = task.orientations, oset
+
+    def text(o):
+        if o.kind == "box":
+            return "±" + ", ±".join(f"{np.degrees(a):.4g}" for a in o.angles) + "° Euler box"
+        if o.kind == "tilt-torsion":
+            return f"tilt ≤ {np.degrees(o.tilt):.4g}°, torsion ±{np.degrees(o.torsion):.4g}°"
+        return "one orientation"
+
+    def reach(o):
+        return (np.asarray(o.angles) if o.kind == "box" else
+                np.array([o.tilt, o.tilt, o.torsion]) if o.kind == "tilt-torsion" else
+                np.zeros(3))
+
+    if t.kind == "fixed" and w.kind != "fixed":
+        return ""
+    if t.kind != w.kind or np.any(reach(t) > reach(w) + 1e-9):
+        return (f"the task's orientations ({text(t)}) reach beyond the workspace drawn "
+                f"({text(w)}): the outline is not a containment check on these slices "
+                "(task_contained is)")
+    return ""
+
+
+def _task_overlay(mech, task, info: dict, ev=None) -> dict:
     """``slice_figure`` keywords that draw the task's sections in red (none without a task)."""
     if task is None:
         return {}
     from ..requirements.task import task_outline
 
     info["task"] = {**task.region.describe(), "orientations": task.orientations.describe()}
+    wider = _wider(task, ev) if ev is not None else ""
+    if wider:
+        info["task_drawing_note"] = wider
     return {"overlay": lambda z: task_outline(mech, task.region, z),
-            "overlay_label": "the task region (required positions)"}
+            "overlay_label": "the task region (required positions)" + (
+                f"\nnote: {wider}" if wider else "")}
 
 
 def _task_drawing_resolution(mech, task) -> float:
@@ -300,7 +350,8 @@ def _task_meshes(d: Path, mech, task, res, files: list, info: dict) -> None:
         files.append("workspace_task.glb")
 
 
-def _actuator_plots(d: Path, study: Study, mech, r: dict, info: dict, files: list) -> None:
+def _actuator_plots(d: Path, study: Study, mech, r: dict, info: dict, files: list,
+                    task_centre=None) -> None:
     """``actuators-<motion>.png`` per required motion (forces or torques, speeds, the
     torque–speed curve, the chosen actuator's limits) and ``actuators.json`` (the numbers
     drawn)."""
@@ -315,7 +366,7 @@ def _actuator_plots(d: Path, study: Study, mech, r: dict, info: dict, files: lis
                                                 else r["params"])
         spec = ev.actuators.catalogue[choice.get("actuator", ev.actuators.default)]
     data = {"actuator": None if spec is None else spec.describe(), "motions": []}
-    for m in ev.motions.motions(mech):
+    for m in ev.motions.motions(mech, task_centre):
         res = inverse_dynamics(mech, m, body)
         fig = actuator_figure(res, spec)
         name = f"actuators-{m.name}.png"

@@ -21,6 +21,8 @@ Kinds of number (``statistic``):
 * ``sampled`` — a Monte-Carlo statistic over random poses (its name says so, or it carries a
   standard error);
 * ``flag`` — 1 or 0;
+* ``search`` — the best value a stated search found (a scan and a local refinement), not a
+  proven optimum (``task_centre_*`` with ``task.centre: auto``);
 * ``guaranteed`` — a proven bound over the *continuous* orientation set and x-y plane
   (:mod:`pkmlab.workspaces.bracket.columns`): ``*_volume_lower`` never exceeds the true volume,
   ``*_volume_upper`` never falls below it. An objective that maximises a volume should use
@@ -34,7 +36,8 @@ from dataclasses import dataclass
 
 __all__ = ["Metric", "METRICS", "KIND_VOLUMES", "metric", "metrics_of", "STATISTICS"]
 
-STATISTICS = ("exact", "grid", "worst-case", "bound", "sampled", "flag", "guaranteed")
+STATISTICS = ("exact", "grid", "worst-case", "bound", "sampled", "flag", "guaranteed",
+              "search")
 
 
 @dataclass(frozen=True)

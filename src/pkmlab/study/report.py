@@ -19,6 +19,8 @@ import yaml
 from ..runtime import atomic
 from .definition import Study
 from .export import export_designs
+from .flags import design_flags
+from .flags import label as design_label
 from .metrics import METRICS
 from .run import BASELINE, feasible, objective_matrix, provenance
 from .selection import non_dominated
@@ -150,8 +152,10 @@ def _plot(path: Path, study: Study, records, front) -> None:
     if len(objs) > 2:
         ax = axes[0, 1]
         names = [o.metric for o in objs]
+        # nothing feasible: the least-violating designs instead of an empty box
+        shown = front or least_violating(study, records, max(study.top, 1) * 4)
         data = np.array([[np.nan if r["metrics"].get(m) is None else r["metrics"][m]
-                          for m in names] for r in front], dtype=float)
+                          for m in names] for r in shown], dtype=float)
         if len(data):
             lo, hi = np.nanmin(data, axis=0), np.nanmax(data, axis=0)
             norm = (data - lo) / np.where(hi > lo, hi - lo, 1.0)
@@ -159,8 +163,10 @@ def _plot(path: Path, study: Study, records, front) -> None:
                 ax.plot(range(len(names)), row, c="tab:red", alpha=0.5)
         ax.set_xticks(range(len(names)), [label(o).replace(", ", "\n") for o in objs],
                       fontsize=8)
-        ax.set_ylabel("normalised over the Pareto set")
-        ax.set_title("Pareto set, parallel coordinates", fontsize=9)
+        what = "Pareto set" if front else f"{len(shown)} least-violating designs"
+        ax.set_ylabel(f"normalised over the {what}")
+        ax.set_title(f"{what}, parallel coordinates" + ("" if front else
+                     " (no feasible design)"), fontsize=9)
     fig.suptitle(f"{study.name}: {len(cand)} candidates, {len(front)} Pareto")
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110)
@@ -198,20 +204,32 @@ def _summary(study: Study, records, front, baseline) -> str:
         vals = [_fmt(None if p.get(v.name) is None else v.display(p[v.name]))
                 for v in study.variables]
         ms = [_fmt(r["metrics"].get(m)) for m in metrics]
+        for v in study.variables:
+            if p.get(v.name) is None:
+                notes.append(f"- {label}, {v.name}: a free parameter, which the baseline "
+                             "mechanism file has no value for")
         for k, why in r.get("notes", {}).items():
             if k in metrics:
                 notes.append(f"- {label}, {k}: {why}")
+        for k in metrics:
+            if r["metrics"].get(k) is None and k not in r.get("notes", {}):
+                notes.append(f"- {label}, {k}: {_no_value(r, k)}")
         return f"| {label} | " + " | ".join(vals + ms) + " |"
 
     if baseline is not None:
         label = "baseline" + ("" if baseline["status"] == "ok" else
                               f" ({baseline['status']}: {baseline['reason'].splitlines()[0]})")
         lines.append(row(label, baseline))
-    for i, r in enumerate(front[:max(study.top, 1) * 2]):
-        lines.append(row(f"Pareto {i + 1}", r))
-    lines += _requirement_margins(study, baseline, front[:max(study.top, 1) * 2], metrics)
+    for r in front[:max(study.top, 1) * 2]:
+        lines.append(row(design_label(r), r))
+    shown = front[:max(study.top, 1) * 2] or least_violating(study, records, max(study.top, 1))
+    lines += _requirement_margins(study, baseline, shown, metrics, notes)
     lines += _catalogue_fits(study, records)
     lines += _why_they_fail(study, records, front)
+    flags = design_flags(study, shown, lambda r: _params(study, r))
+    if flags:
+        lines += ["", "Flags (" + ("Pareto" if front else "least-violating") + " designs; "
+                  "designs are named by their evaluation number, the `seq` column):", *flags]
     if notes:
         lines += ["", "Notes (a value shown as — is undefined for the reason given):", *notes]
     lines += ["", "Lengths in mm, angles in degrees, volumes in cm³, forces in N; "
@@ -230,11 +248,12 @@ REQUIREMENT_MARGINS = ("task_contained", "task_margin", "task_orientation_margin
                        "actuator_stroke_margin", "actuator_angle_margin")
 
 
-def _requirement_margins(study: Study, baseline, front, shown) -> list[str]:
-    """The task and actuator margins of the baseline and the Pareto designs listed above
-    (markdown lines; none when the study has no requirement blocks)."""
+def _requirement_margins(study: Study, baseline, front, shown, notes: list) -> list[str]:
+    """The task and actuator margins of the baseline and the Pareto designs listed above, or
+    the least-violating ones when nothing is feasible (markdown lines; none when the study
+    has no requirement blocks). Every "—" gets its reason in ``notes``."""
     rows = ([("baseline", baseline)] if baseline is not None else []) + \
-        [(f"Pareto {i + 1}", r) for i, r in enumerate(front)]
+        [(design_label(r), r) for r in front]
     names = [m for m in REQUIREMENT_MARGINS if any(m in r["metrics"] for _, r in rows)
              and not all(_other_kind(r, m) for _, r in rows)]
     if not names:
@@ -246,7 +265,20 @@ def _requirement_margins(study: Study, baseline, front, shown) -> list[str]:
     for label, r in rows:
         out.append(f"| {label} | " + " | ".join(_fmt(r["metrics"].get(m)) for m in names)
                    + " |")
+        for m in names:
+            if r["metrics"].get(m) is None and m not in shown:
+                why = r.get("notes", {}).get(m) or _no_value(r, m)
+                notes.append(f"- {label}, {m}: {why}")
     return out
+
+
+def _no_value(record: dict, name: str) -> str:
+    """The reason for a "—" when the evaluation left no note for it."""
+    if record["status"] != "ok":
+        return f"the evaluation {record['status']}: {(record['reason'] or '').splitlines()[0]}"
+    if name not in record["metrics"]:
+        return "not computed for this design (an earlier run without this block)"
+    return "undefined for this design (no note was recorded)"
 
 
 def _why_they_fail(study: Study, records, front) -> list[str]:
@@ -264,8 +296,8 @@ def _why_they_fail(study: Study, records, front) -> list[str]:
         if least:
             out += ["", f"No feasible design. The {len(least)} least violating (fewest "
                     "violations, then smallest; exported under designs/):", "",
-                    "| candidate | violated |", "|---|---|"]
-            out += [f"| {r['seq']} | {violated_text(study, r)} |" for r in least]
+                    "| design | violated |", "|---|---|"]
+            out += [f"| {design_label(r)} | {violated_text(study, r)} |" for r in least]
     return out
 
 

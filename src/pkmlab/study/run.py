@@ -141,6 +141,10 @@ def run_study(study: Study, runner, *, resume: bool = False, overwrite: bool = F
     return store
 
 
+#: a first evaluation longer than this (s) is timed once more, warm, for the time estimate
+WARM_RETIME_S = 1.0
+
+
 def compile_baseline(space, evaluation, seed: int) -> dict:
     """Evaluate the baseline design in this process and log (INFO) what numba compiled.
 
@@ -210,8 +214,16 @@ def _run(study: Study, runner, store: Store, fp: str, progress) -> None:
         result = compile_baseline(space, ev, seed)
         commit(base_key, "baseline", BASELINE, result)
         compiling = float(result.get("compile_seconds", 0.0))
-    # the estimate leaves out the one-off kernel compilation of the first evaluation
+    # the estimate leaves out the one-off kernel compilation of the first evaluation, and the
+    # other first-call costs (kernels loaded from numba's cache, plain njit compiles, lazy
+    # imports): a first evaluation over WARM_RETIME_S is timed once more, warm
     seconds = store.get(base_key)["seconds"]
-    _check_time(study, runner, store, max(seconds - compiling, 0.05 * seconds))
+    seconds = max(seconds - compiling, 0.05 * seconds)
+    if seconds > WARM_RETIME_S:
+        again = evaluate_design(space, None, ev, seed)["seconds"]
+        log.info("baseline timed again for the estimate: %.3g s (first evaluation %.3g s "
+                 "without compiling)", again, seconds)
+        seconds = min(seconds, again)
+    _check_time(study, runner, store, seconds)
     OPTIMISERS[study.optimizer.method](space, evaluate_batch, study.optimizer, seed)
     store.set_meta("complete", True)

@@ -277,12 +277,16 @@ class DesignSpace:
         spec = self.base_spec
         if design is None:
             return spec
-        for v in self.variables:
-            if v.target is not None:
-                x = design[v.name]
-                spec = with_path(spec, v.target, int(x) if v.kind == "integer" else x)
-        for d in self.derived:
-            spec = with_path(spec, d.target, d.expression(design))
+        sets = [(v.target, int(design[v.name]) if v.kind == "integer" else design[v.name])
+                for v in self.variables if v.target is not None]
+        sets += [(d.target, d.expression(design)) for d in self.derived]
+        # the nominal pose's coordinates last: a missing nominal pose is first filled with the
+        # candidate's default (level, centred), then the coordinate is set
+        for target, x in sorted(sets, key=lambda s: s[0][0] == "nominal_pose"):
+            if target[0] == "nominal_pose" and getattr(spec, "nominal_pose", 0) is None:
+                spec = spec.model_copy(update={"nominal_pose": [
+                    float(c) for c in spec.build().nominal_pose]})
+            spec = with_path(spec, target, x)
         return spec
 
     def decode(self, design: dict | None) -> Mechanism:
@@ -292,9 +296,14 @@ class DesignSpace:
 
     def baseline_values(self) -> dict:
         """Each variable's value in the baseline design (``None`` for free parameters)."""
+        def value(v):
+            if v.target[0] == "nominal_pose" and getattr(self.base_spec, "nominal_pose",
+                                                         0) is None:
+                return float(self.base_spec.build().nominal_pose[v.target[1]])
+            return get_path(self.base_spec, v.target)
+
         return {v.name: v.baseline if v.role != "mechanism" else
-                None if v.target is None else get_path(self.base_spec, v.target)
-                for v in self.variables}
+                None if v.target is None else value(v) for v in self.variables}
 
     def evaluation_choices(self, design: dict | None) -> dict:
         """``{role: value}`` of the variables that choose for the evaluation (``actuator``)

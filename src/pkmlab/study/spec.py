@@ -29,7 +29,13 @@ __all__ = ["load_study", "study_from_mapping", "StudySpec", "study_schema", "fam
 def family_aliases(family: str) -> dict[str, tuple[str, str]]:
     """Named design variables of a family: its class's ``design_aliases`` (path in the YAML
     model, quantity), built-in or plugin alike."""
-    return dict(getattr(REGISTRY.get(family), "design_aliases", None) or {})
+    cls = REGISTRY.get(family)
+    out = dict(getattr(cls, "design_aliases", None) or {})
+    mob = getattr(cls, "mobility", None)
+    if mob is not None and "z" in getattr(mob, "coordinates", ()) and "home_height" not in out:
+        # the nominal (home) pose's height: the frame of the task and the motions
+        out["home_height"] = ("nominal_pose[2]", "length")
+    return out
 
 
 class _Model(BaseModel):
@@ -150,6 +156,13 @@ def _target(name: str, where: str, path: str | None, family: str, spec) -> tuple
     if parts and parts[0] in IDENTITY:
         raise ParameterError(where, "a geometry field (the mechanism's family and name are "
                              "fixed by the study: give another mechanism file instead)", text)
+    if parts and parts[0] == "nominal_pose" and getattr(spec, "nominal_pose", 0) is None:
+        # no nominal pose in the file: the family's default (level, centred) is filled in
+        # per candidate before this coordinate is set (DesignSpace.spec_of)
+        if len(parts) != 2 or not isinstance(parts[1], int) or not 0 <= parts[1] < 6:
+            raise ParameterError(where, "one coordinate of the nominal pose: nominal_pose[0] "
+                                 "… nominal_pose[5] (x, y, z in mm, θx, θy, θz)", text)
+        return parts
     try:
         if parts is None:
             raise KeyError(text)

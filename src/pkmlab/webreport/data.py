@@ -58,8 +58,13 @@ def difference(value, base) -> tuple[str, str]:
     return ("0" if d == 0 else f"{d:+.4g}"), pct
 
 
+def params_of(study: Study, record: dict) -> dict:
+    """A record's design values (internal units; the baseline's from the mechanism spec)."""
+    return study.space.baseline_values() if record["params"] == BASELINE else record["params"]
+
+
 def _display_params(study: Study, record: dict) -> dict:
-    p = study.space.baseline_values() if record["params"] == BASELINE else record["params"]
+    p = params_of(study, record)
     return {v.name: None if p.get(v.name) is None else v.display(p[v.name])
             for v in study.variables}
 
@@ -75,12 +80,12 @@ def objective_axes(study: Study) -> list[dict]:
 
 
 def _hover(study: Study, row: dict, status: str) -> str:
-    lines = [f"<b>{'baseline' if row['role'] == 'baseline' else 'candidate ' + str(row['seq'])}"
+    lines = [f"<b>{'baseline' if row['role'] == 'baseline' else '#' + str(row['seq'])}"
              f"</b> · {status}"]
     if row.get("pareto_rank"):
-        lines[0] += f" · Pareto rank {row['pareto_rank']}"
+        lines[0] += " · on the Pareto front"
     if row.get("design"):
-        lines[0] += f" · design {row['design']}"
+        lines[0] += " · exported (card)"
     for v in study.variables:          # user strings are escaped for plotly's markup
         x = row["params"].get(v.name)
         x = x if isinstance(x, int | float) or x is None else plotly_text(x)

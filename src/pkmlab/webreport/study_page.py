@@ -15,8 +15,9 @@ import yaml
 from ..export import exporters
 from ..study.definition import Study
 from ..study.export import read_index
+from ..study.flags import design_flags
 from ..study.metrics import METRICS
-from ..study.violations import tally, violated_text
+from ..study.violations import least_violating, tally, violated_text
 from . import data as D
 from .figures import design_scene, pareto_matrix, pareto_parcoords
 from .page import colour_option, figure_json, hull_of_ply, png_uri, render_page
@@ -31,6 +32,10 @@ _FILES = {
     "mechanism.yaml": "mechanism file (pkmlab inspect / workspace / compare read it)",
     "design.json": "why it was chosen, values, slice layout",
     "slices.png": "horizontal sections",
+    "actuators.json": "the actuator values, torques or forces and speeds drawn in "
+                      "actuators-*.png, with the chosen actuator's limits",
+    "task.stl": "the task region (mm, base frame, placed where the evaluation put it)",
+    "workspace_task.glb": "the workspace hull and the task region in one scene (glTF, m)",
 }
 
 
@@ -44,6 +49,8 @@ def _what(name: str) -> str:
     for mex in exporters("mechanism").values():      # mechanism.mjcf.xml, .urdf, ...
         if any(name == "mechanism" + sfx for sfx in mex.files or (mex.suffix,)):
             return f"mechanism, {mex.format.upper()}: {mex.description}"
+    if name.startswith("actuators-") and name.endswith(".png"):
+        return "actuator torques or forces and speeds over the motion, limits dashed"
     return _FILES.get(name, "slices coloured by the metric" if name.endswith("_slices.png")
                       else "")
 
@@ -71,7 +78,7 @@ def _points(study: Study, rows: list[dict]) -> list[dict]:
                     "hover": r["hover"]})
         if r["design"]:
             pts.append({"seq": r["seq"], "group": "exported", "values": values,
-                        "hover": r["hover"], "text": str(r["design"])})
+                        "hover": r["hover"], "text": f"#{r['seq']}"})
     return pts
 
 
@@ -127,11 +134,18 @@ def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
     lay = info.get("slice_layout")
     for name in sorted(info["files"], key=lambda s: (s == "slices.png", s)):
         if name.endswith(".png") and (folder / name).is_file():
+            if name.startswith("actuators-"):       # not a section: its own caption
+                card["slices"].append({"uri": png_uri(folder / name), "caption": (
+                    f"actuators over the motion {name[len('actuators-'):-4]}: "
+                    + _what(name))})
+                continue
             caption = ("sections" if name == "slices.png" else
                        f"sections coloured by {name.replace('_slices.png', '')}")
             if lay:
                 caption += (f", {lay['window_mm']:g} mm window every {lay['spacing_mm']:g} mm "
                             f"({lay['layout']} layout)")
+            if info.get("task_drawing_note"):
+                caption += "; note: " + info["task_drawing_note"]
             card["slices"].append({"uri": png_uri(folder / name), "caption": caption})
     fig, colours = None, []
     mech = None
@@ -222,10 +236,17 @@ def write_study_page(out: Path, study: Study, records: list[dict], *, progress=N
     step("Pareto charts")
     figures = {"fig-pareto-matrix": figure_json(pareto_matrix(axes, _points(study, rows)))}
     has_parcoords = len(axes) > 2
+    parcoords_title = "feasible candidates; Pareto set in red"
     if has_parcoords:
+        # nothing feasible: the least-violating designs instead of an empty box
+        least = set() if front else {r["seq"] for r in least_violating(
+            study, records, max(study.top, 1) * 4)}
+        if least:
+            parcoords_title = (f"no feasible candidate: the {len(least)} least-violating "
+                               "designs (fewest violations, then smallest), in red")
         pc = [{"values": {a["key"]: r["metrics"][a["key"]] for a in axes},
-               "pareto": bool(r["pareto_rank"])} for r in rows
-              if r["role"] == "candidate" and r["feasible"]
+               "pareto": bool(r["pareto_rank"]) or r["seq"] in least} for r in rows
+              if r["role"] == "candidate" and (r["feasible"] or r["seq"] in least)
               and all(isinstance(r["metrics"].get(a["key"]), int | float) and
                       math.isfinite(r["metrics"][a["key"]]) for a in axes)]
         figures["fig-pareto-parcoords"] = figure_json(pareto_parcoords(axes, pc))
@@ -243,6 +264,9 @@ def write_study_page(out: Path, study: Study, records: list[dict], *, progress=N
     metrics = [m for m in METRICS if any(m in r["metrics"] for r in rows)]
     counts, reasons = D.failure_counts(records)
     why_fail = [{"what": w, "count": n, "of": of} for w, n, of in tally(study, records) if n]
+    shown = front[:max(study.top, 1) * 2] or least_violating(study, records, max(study.top, 1))
+    flags = [{"text": f[2:], "warn": "task centre placed" not in f}
+             for f in design_flags(study, shown, lambda r: D.params_of(study, r), quiet=True)]
     resolved = out / "study.resolved.yaml"
     resolved_text = (resolved.read_text() if resolved.is_file() else
                      yaml.safe_dump(json.loads(json.dumps(study.resolved(), default=float)),
@@ -261,9 +285,10 @@ def write_study_page(out: Path, study: Study, records: list[dict], *, progress=N
         data=data, figures=figures, description=study.description, axes=axes, cards=cards,
         n_evaluations=len(records), counts=counts, reasons=reasons,
         n_feasible=sum(r["feasible"] for r in rows if r["role"] == "candidate"),
-        n_pareto=len(front), has_parcoords=has_parcoords,
+        n_pareto=len(front), has_parcoords=has_parcoords, parcoords_title=parcoords_title,
         constraints_text=", ".join(c.describe() for c in study.constraints) or "none",
         export_problems=index["problems"], why_fail=why_fail, variables=_variables(study),
+        flags=flags,
         optimizer=_optimizer_text(study),
         seed=study.seed, resolved_yaml=resolved_text, runs=_runs(out),
         length_step=D.LENGTH_STEP_MM, angle_step=D.ANGLE_STEP_DEG,

@@ -67,6 +67,11 @@ class Motions(Evaluator):
             raise ParameterError("evaluate.payload", "given with evaluate.motions (the mass "
                                  "the motions move: payload and platform)", None)
         plan.check_mobility(mech)
+        for s in plan.specs:
+            if s.frame == "task" and evaluation.task is None:
+                raise ParameterError(f"evaluate.motions.{s.name}.frame", "'task' given with "
+                                     "an evaluate.task block (the centre it is relative to)",
+                                     s.frame)
 
     def cost(self, plan, evaluation, mech) -> list[Cost]:
         """Every motion and its inverse dynamics are kept for ``actuators``: memory and time
@@ -91,7 +96,8 @@ class Motions(Evaluator):
     def compute(self, mech, ctx) -> dict:
         ev = ctx.evaluation
         body = ev.payload.for_mechanism(mech)
-        ctx.dynamics = [inverse_dynamics(mech, m, body) for m in ev.motions.motions(mech)]
+        ctx.dynamics = [inverse_dynamics(mech, m, body) for m in
+                        ev.motions.motions(mech, getattr(ctx, "task_centre", None))]
         bad = [r.first_problem() for r in ctx.dynamics if not np.all(r.ok)]
         out = {"motions_feasible": float(not bad)}
         if bad:

@@ -76,6 +76,7 @@ class Context:
     notes: dict = field(default_factory=dict)
     choices: dict = field(default_factory=dict)   # evaluation choices: {"actuator": name}
     dynamics: list = field(default_factory=list)  # DynamicsResult per required motion
+    task_centre: object = None  # the task's centre as placed (base frame, mm), once computed
 
 
 @dataclass(frozen=True)

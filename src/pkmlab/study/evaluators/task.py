@@ -3,8 +3,12 @@ far it is contained (:mod:`pkmlab.requirements.task`)."""
 
 from __future__ import annotations
 
+import dataclasses
+import logging
+
 import numpy as np
 
+from ...requirements.placement import TASK_KAPPA_WARN, place_task, task_kappa
 from ...requirements.spec import TaskSpec, build_task
 from ...requirements.task import task_margins
 from .registry import Cost, Evaluator, metric, register_evaluator
@@ -13,6 +17,8 @@ from .registry import Cost, Evaluator, metric, register_evaluator
 TASK_BYTES_PER_ORIENTATION = 4096.0
 TASK_SECONDS_PER_ORIENTATION = 4e-4
 TASK_SECONDS = 1.0
+
+log = logging.getLogger(__name__)
 
 
 class Task(Evaluator):
@@ -33,6 +39,14 @@ class Task(Evaluator):
         metric("task_orientation_margin", "deg", "bound",
                "largest widening of the task's orientation set that stays contained (bracket "
                "0.01°); negative: the narrowing needed"),
+        *(metric(f"task_centre_{c}", "mm", "search",
+                 f"{c} of the task's centre in its frame: the given value, or with "
+                 "task.centre: auto the best a search found (pkmlab.requirements.placement; "
+                 "the position margin maximised, not a proven optimum)") for c in "xyz"),
+        metric("sampled_task_kappa", "", "sampled",
+               "worst κ (Jacobian homogenised with Angeles' length) at the task's corners "
+               f"and centre × its orientation samples; above {TASK_KAPPA_WARN:g} the summary "
+               "and report flag poor conditioning at the task"),
     )
 
     def plan(self, data, base):
@@ -57,13 +71,32 @@ class Task(Evaluator):
 
     def compute(self, mech, ctx) -> dict:
         plan = ctx.evaluation.task
-        m = task_margins(mech, plan.region, plan.orientations, plan.resolution)
+        region = plan.region
+        if any(plan.auto):
+            placed = place_task(mech, region, plan.auto, plan.orientations, plan.resolution)
+            region = dataclasses.replace(region, centre=placed.centre)
+            for c, a in zip("xyz", plan.auto):
+                if a:
+                    ctx.notes[f"task_centre_{c}"] = placed.note
+        ctx.task_centre = np.asarray(region.centre, dtype=float) + region.offset(mech)
+        m = task_margins(mech, region, plan.orientations, plan.resolution)
         chk = m["check"]
         if chk.note:
             ctx.notes["task_contained"] = chk.note
         ctx.notes.update(m["notes"])
-        return {"task_contained": float(chk.contained), "task_margin": m["margin_mm"],
-                "task_orientation_margin": m["orientation_margin_deg"]}
+        kappa, _, knote = task_kappa(mech, region, plan.orientations)
+        ctx.notes["sampled_task_kappa"] = knote
+        if not kappa <= TASK_KAPPA_WARN:
+            log.debug("poor conditioning at the task: κ %.3g above %g (%s)", kappa,
+                        TASK_KAPPA_WARN, knote)
+        out = {"task_contained": float(chk.contained), "task_margin": m["margin_mm"],
+               "task_orientation_margin": m["orientation_margin_deg"],
+               "sampled_task_kappa": kappa if np.isfinite(kappa) else None}
+        if not np.isfinite(kappa):
+            ctx.notes["sampled_task_kappa"] = ("singular at a probe pose of the task; "
+                                               if kappa == np.inf else "") + knote
+        out.update({f"task_centre_{c}": float(v) for c, v in zip("xyz", region.centre)})
+        return out
 
 
 register_evaluator(Task())

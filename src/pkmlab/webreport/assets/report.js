@@ -98,9 +98,9 @@
     if (!card) { return; }
     var base = DATA.candidates.find(function (r) { return r.role === "baseline"; });
     text(document.getElementById("candidate-title"),
-         c.role === "baseline" ? "Baseline" : "Candidate " + c.seq);
+         c.role === "baseline" ? "Baseline" : "Design #" + c.seq);
     var status = c.status + (c.status === "ok" ? (c.feasible ? ", feasible" : ", infeasible") : "");
-    if (c.pareto_rank) { status += " · Pareto rank " + c.pareto_rank; }
+    if (c.pareto_rank) { status += " · on the Pareto front"; }
     if (c.reason) { status += " · " + c.reason; }
     text(document.getElementById("candidate-status"), status);
     var pt = document.getElementById("candidate-params"), mt = document.getElementById("candidate-metrics");
@@ -116,7 +116,7 @@
       row(mt, [m.name, m.unit, fmt(x), fmt(b), d[0], d[1]]);
     });
     text(document.getElementById("candidate-note"), c.pareto_rank
-      ? "Not exported in full: evaluate it with `pkmlab compare --pareto pareto.csv --rows " + c.pareto_rank + "`."
+      ? "Not exported in full: evaluate it with `pkmlab compare --pareto pareto.csv --designs " + c.seq + "`."
       : "Not on the Pareto front: no design files were written for it.");
     card.hidden = false;
     card.scrollIntoView({ behavior: "smooth", block: "start" });
