@@ -230,8 +230,10 @@ class MotionSpec(_Model):
     name: str = Field(pattern=r"^[A-Za-z0-9._-]+$")
     file: str | None = Field(None, description="CSV t,x,y,z,theta_x,theta_y,theta_z (s, mm, "
                              "deg) [+ <coord>_dot, <coord>_ddot], relative to the study file")
-    frame: Literal["nominal", "base"] = Field("nominal", description="CSV poses relative to "
-                                              "the nominal pose, or absolute")
+    frame: Literal["nominal", "base"] | None = Field(
+        None, description="a file's frame, required with 'file': 'nominal' (poses relative to "
+        "the nominal pose, as `pkmlab trajectory --csv F --relative`) or 'base' (absolute, "
+        "as `pkmlab trajectory --csv F`)")
     smoothing: SmoothingSpec = Field(default_factory=SmoothingSpec)
     sinusoid: SinusoidSpec | None = None
     paper: bool = Field(False, description="Hopkins & Williams' ±2 in / ±30° motion")
@@ -314,6 +316,11 @@ def build_motions(data: Any, base: Path) -> MotionsPlan:
             raise ParameterError(f"{fi}.name", "a name no other motion has", s.name)
         raw = dict(d)
         if s.file is not None:
+            if s.frame is None:         # one CSV, one meaning: the study states the frame
+                raise ParameterError(f"{fi}.frame", "'nominal' (the CSV's poses are offsets "
+                                     "from the nominal pose, as `pkmlab trajectory --csv FILE "
+                                     "--relative`) or 'base' (absolute base-frame poses, as "
+                                     "`pkmlab trajectory --csv FILE`)", "missing")
             path = (base / s.file).resolve()
             recorded[s.name] = load_motion_csv(path, s.name, s.smoothing.window,
                                                s.smoothing.polyorder, field=f"{fi}.file")

@@ -174,11 +174,41 @@ def panel_model(mech, shapes=()) -> dict:
 
     model = pose_model(mech)
     d = drawing(mech)
+    model["scene"] = _scene_box(mech, d, shapes, model["range_mm"])
     base = go.Scatter3d(x=d.base[:, 0], y=d.base[:, 1], z=d.base[:, 2], mode="lines+markers",
                         name="base", line=dict(color="#7f7f7f", width=6),
                         marker=dict(size=3, color="#7f7f7f"), hoverinfo="name")
     model["fixed_traces"] = [t.to_plotly_json() for t in [base, *task_traces(shapes)]]
     return model
+
+
+def _scene_box(mech, d, shapes, reach: float) -> dict:
+    """Fixed axis ranges for the panel's view (so jogging does not rescale it): the nominal
+    drawing and the task, grown by the slider reach along free translations; a flat drawing
+    (planar) keeps a thin z box seen from above, as the card's own view."""
+    pts = [np.concatenate(d.chains), d.base.reshape(-1, 3), d.tool.reshape(1, 3)]
+    pts += [_outline(s)[1] for s in shapes]
+    P = np.concatenate([p for p in pts if len(p)])
+    lo, hi = P.min(axis=0), P.max(axis=0)
+    free = set(mech.mobility.coordinates) | set(getattr(mech.mobility, "dependent", ()))
+    span = float(max(hi - lo))
+    for k, c in enumerate(("x", "y", "z")):
+        grow = 0.5 * reach if c in free or mech.mobility.rotations else 0.0
+        lo[k] -= grow
+        hi[k] += grow
+        if hi[k] - lo[k] < 0.1 * span:               # flat: a thin box around the plane
+            mid = 0.5 * (lo[k] + hi[k])
+            lo[k], hi[k] = mid - 0.05 * span, mid + 0.05 * span
+    ext = hi - lo
+    flat = ext[2] <= 0.1 * span + 1e-9
+    ax = dict(showbackground=True, backgroundcolor="#f7f7f7", gridcolor="#dddddd")
+    return {"aspectmode": "manual",
+            "aspectratio": dict(zip("xyz", (ext / ext.max()).tolist())),
+            **{f"{c}axis": dict(range=[float(lo[k]), float(hi[k])],
+                                title=dict(text=f"{c} (mm)"), **ax)
+               for k, c in enumerate("xyz")},
+            "camera": dict(eye=dict(x=0.5, y=-0.9, z=1.4) if flat
+                           else dict(x=1.6, y=-1.6, z=0.9))}
 
 
 # ---- the task region --------------------------------------------------------------------------

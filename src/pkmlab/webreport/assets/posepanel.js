@@ -261,7 +261,7 @@
       sliders.hidden = true;
       return;
     }
-    var inputs = [], drawn = false, rad = m.unit === "rad";
+    var inputs = [], last = null, rad = m.unit === "rad";
     m.coordinates.forEach(function (c, i) {
       var ang = c.indexOf("theta") === 0, span = ang ? m.range_deg : m.range_mm;
       var row = document.createElement("label");
@@ -308,17 +308,26 @@
         ". " + (bad ? bad + " of " + m.legs.length + " legs not ok." : "All legs ok.") +
         (dep.length ? " Dependent: " + dep.join(", ") + "." : "");
       panel.dataset.kappa = res.kappa;
-      var data = traces(m, res).concat(m.fixed_traces || []);
-      if (window.Plotly && view) {
+      last = res;
+      draw();
+    }
+    function draw() {            /* the 3-D view, once it is on screen (cards start hidden) */
+      if (!last || !window.Plotly || !view || !view.getClientRects().length) { return; }
+      var data = traces(m, last).concat(m.fixed_traces || []);
+      {
         var layout = {margin: {l: 0, r: 0, t: 0, b: 0}, height: 420, showlegend: true,
                       legend: {orientation: "h", x: 0, y: 0}, uirevision: "keep",
-                      scene: {aspectmode: "data", xaxis: {title: "x (mm)"}, yaxis: {title: "y (mm)"}, zaxis: {title: "z (mm)"}}};
+                      scene: m.scene || {aspectmode: "data"}};
         Plotly.react(view, data, layout, {displaylogo: false, responsive: true});
-        drawn = true;
+        panel.dataset.drawn = "true";
       }
-      return drawn;
     }
     update();
+    if (window.IntersectionObserver && view) {
+      new IntersectionObserver(function (es) {
+        if (es.some(function (e) { return e.isIntersecting; })) { draw(); }
+      }).observe(view);
+    }
   }
   document.querySelectorAll("[data-pose-panel]").forEach(init);
 })();
