@@ -193,7 +193,9 @@ def _scene_box(mech, d, shapes, reach: float) -> dict:
     free = set(mech.mobility.coordinates) | set(getattr(mech.mobility, "dependent", ()))
     span = float(max(hi - lo))
     for k, c in enumerate(("x", "y", "z")):
-        grow = 0.5 * reach if c in free or mech.mobility.rotations else 0.0
+        moves = (c in free or bool({"theta_x", "theta_y"} & free)
+                 or (c != "z" and "theta_z" in free))      # a turn about z stays in its plane
+        grow = 0.5 * reach if moves else 0.0
         lo[k] -= grow
         hi[k] += grow
         if hi[k] - lo[k] < 0.1 * span:               # flat: a thin box around the plane
@@ -269,6 +271,7 @@ def task_traces(shapes: list[dict]) -> list:
     traces = []
     for k, s in enumerate(shapes):
         lines, pts = _outline(s)
+        lines = [seg for seg in lines if np.ptp(seg, axis=0).max() > 0.0]   # a point: none
         label = "task region" + (f" {k + 1}" if len(shapes) > 1 else "") + f" ({s['kind']})"
         if lines:
             xs, ys, zs = [], [], []
@@ -285,7 +288,8 @@ def task_traces(shapes: list[dict]) -> list:
                                        line=dict(color="#009E73", width=4, dash="dash"),
                                        hoverinfo="name"))
         traces.append(go.Scatter3d(
-            x=pts[:, 0], y=pts[:, 1], z=pts[:, 2], mode="markers", name=f"{label}: points",
+            x=pts[:, 0].tolist(), y=pts[:, 1].tolist(), z=pts[:, 2].tolist(), mode="markers",
+            name=f"{label}: points",
             legendgroup=f"task{k}", showlegend=not lines,
             marker=dict(size=4, color="#009E73", symbol="circle-open"),
             hovertemplate="task (%{x:.1f}, %{y:.1f}, %{z:.1f}) mm<extra></extra>"))
