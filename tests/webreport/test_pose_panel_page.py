@@ -67,7 +67,8 @@ def test_panel_jogs_and_draws_a_point_task(report):
         pg.wait_for_selector("body[data-ready=true]", timeout=60_000)
         pg.click("[data-show-design='1']")
         sel = "#design-1 .pose-panel"
-        labels = pg.eval_on_selector_all(sel + " .pose-slider span", "e => e.map(x => x.textContent)")
+        labels = pg.eval_on_selector_all(sel + " .pose-slider span",
+                                         "e => e.map(x => x.textContent)")
         assert labels == ["Δx (mm)", "Δy (mm)", "Δz (mm)", "Δθx (deg)", "Δθy (deg)", "Δθz (deg)"]
         got = _values(pg.inner_text(sel + " .pose-legs tbody"))
         assert np.allclose(got, mech.inverse(mech.nominal_pose).q[0], atol=0.006)

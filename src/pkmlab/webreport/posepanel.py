@@ -209,8 +209,8 @@ def _scene_box(mech, d, shapes, reach: float) -> dict:
             **{f"{c}axis": dict(range=[float(lo[k]), float(hi[k])],
                                 title=dict(text=f"{c} (mm)"), **ax)
                for k, c in enumerate("xyz")},
-            "camera": dict(eye=dict(x=0.5, y=-0.9, z=1.4) if flat
-                           else dict(x=1.6, y=-1.6, z=0.9))}
+            "camera": dict(eye=dict(x=0.3, y=-0.6, z=0.95) if flat
+                           else dict(x=1.0, y=-1.0, z=0.6))}
 
 
 # ---- the task region --------------------------------------------------------------------------
