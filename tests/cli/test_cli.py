@@ -60,8 +60,10 @@ def test_ik_json_in_mm_and_degrees():
 
 
 def test_ik_unreachable_is_data_not_error():
+    """An unreachable pose is reported as data, and the exit status says it failed (1; a bad
+    input is 2)."""
     r = runner.invoke(app, ["ik", HOPKINS, "--pose", "0,0,900,0,0,0", "--json"])
-    assert r.exit_code == 0
+    assert r.exit_code == 1
     d = json.loads(r.stdout)
     assert d["valid"] is False and d["reason"] == "stroke above maximum"
     r = runner.invoke(app, ["ik", HOPKINS, "--pose", "0,0,900,0,0,0"])

@@ -106,7 +106,7 @@ def test_trajectory_cli_reports_the_first_violation(tmp_path):
     out = tmp_path / "tr"
     r = CliRunner().invoke(app, ["trajectory", str(HOPKINS), "--csv", str(csv), "--out", str(out),
                                  "--json"])
-    assert r.exit_code == 0, r.output
+    assert r.exit_code == 1, r.output          # a failed sample: reported, exit status 1
     d = json.loads(r.stdout)
     assert d["fits"] is False
     assert d["violations"]["stroke"]["index"] == first

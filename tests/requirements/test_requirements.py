@@ -364,7 +364,8 @@ def test_validate_rejects_bad_requirements(tmp_path, evaluate, expect):
 ])
 def test_validate_rejects_bad_motion_csv(tmp_path, text, expect):
     name = _csv(tmp_path, text)
-    data = _study(tmp_path, motions=[{"name": "rec", "file": name}], payload={"mass": 10})
+    data = _study(tmp_path, motions=[{"name": "rec", "file": name, "frame": "nominal"}],
+                  payload={"mass": 10})
     _one_line(tmp_path, data, expect)
 
 

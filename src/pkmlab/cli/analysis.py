@@ -245,7 +245,12 @@ def _print_dexterity(rep, force_limit, well_conditioned, force_required, written
 def trajectory(
     mech_file: MechArg,
     csv: Annotated[Path | None, typer.Option(
-        help="CSV with t,x,y,z,theta_x,theta_y,theta_z (s, mm, deg)")] = None,
+        help="CSV with t,x,y,z,theta_x,theta_y,theta_z (s, mm, deg): absolute poses in the "
+        "base frame, or offsets from the nominal pose with --relative (a study's motions "
+        "say the same with frame: base / frame: nominal)")] = None,
+    relative: Annotated[bool, typer.Option(
+        "--relative", help="the --csv poses are offsets from the mechanism's nominal pose "
+        "(added coordinate by coordinate), as a study motion's frame: nominal")] = False,
     paper_motion: Annotated[bool, typer.Option(
         "--paper-motion", help="Hopkins & Williams' motion: ±2 in in x, y, z then ±30° in "
         "θz, θy, θx, one after the other")] = False,
@@ -266,7 +271,9 @@ def trajectory(
 ) -> None:
     """Actuator values, rates and forces along a trajectory, checked against the limits.
 
-    Writes trajectory.json, trajectory.csv and actuators.png into --out.
+    Writes trajectory.json, trajectory.csv and actuators.png into --out. Exits with status 1
+    when a sample fails (no solution, out of stroke, over a limit, singular), after writing
+    and printing why.
     """
     import shutil
     import tempfile
@@ -279,9 +286,15 @@ def trajectory(
     if (csv is None) == (not paper_motion):
         _fail(ParameterError("--csv / --paper-motion", "exactly one of them", "both"
                              if paper_motion else "neither"))
+    if relative and csv is None:
+        _fail(ParameterError("--relative", "only with --csv (the paper motion is always about "
+                             "the nominal pose)", "--paper-motion"))
     try:
         if csv is not None:
             motion = tr.load_motion_csv(csv, field="--csv", derivatives=False)
+            if relative:
+                motion = tr.Motion(motion.name, motion.t, motion.poses + mech.nominal_pose,
+                                   motion.twist, motion.accel, motion.derivatives)
         else:
             motion = tr.paper_motion(mech, segment_time=segment_time)
         t = motion.t
@@ -317,6 +330,8 @@ def trajectory(
     if as_json:
         summary["files"] = [str(p) for p in written]
         _emit(summary)
+        if not rep.fits:
+            raise typer.Exit(1)
         return
     verdict = "[bold green]fits[/]" if rep.fits else "[bold red]does not fit[/]"
     out.print(f"{escape(mech.name or mech.family)}: {len(t)} samples over {t[-1] - t[0]:.2f} s "
@@ -341,6 +356,8 @@ def trajectory(
               + ("" if rep.max_force is not None else f" (no {d.effort} limit given)"))
     for p in written:
         out.print(f"  wrote {escape(str(p))}")
+    if not rep.fits:
+        raise typer.Exit(1)
 
 
 def _limit_text(mech, force_limit) -> str:

@@ -74,10 +74,12 @@ def _parse_csv(text: str, field: str, n: int) -> list[str]:
     return parts
 
 
-def _parse_pose(text: str, field: str = "--pose", mech: Mechanism | None = None) -> np.ndarray:
+def _parse_pose(text: str, field: str = "--pose", mech: Mechanism | None = None,
+                relative: bool = False) -> np.ndarray:
     """A pose in the mechanism's free coordinates (``x,y,z`` for a translational one, ``x,y,θz``
     for a planar one; mm and deg unless units are given) or all six; returns six coordinates
-    (the others at the nominal pose)."""
+    (the others at the nominal pose). ``relative``: the values are offsets from the nominal
+    pose, added coordinate by coordinate (the Euler angles too)."""
     mob = SPATIAL if mech is None else mech.mobility
     parts = [p.strip() for p in text.split(",")]
     coords = POSE if len(parts) == len(POSE) else mob.coordinates
@@ -90,6 +92,8 @@ def _parse_pose(text: str, field: str = "--pose", mech: Mechanism | None = None)
             p, f"{field}[{i}]") for i, (c, p) in enumerate(zip(coords, parts))])
     except ParameterError as exc:
         _fail(exc)
+    if relative:
+        values = values + np.asarray(mech.nominal_pose)[[POSE.index(c) for c in coords]]
     return values if len(coords) == len(POSE) else mob.full(values, mech.nominal_pose)[0]
 
 

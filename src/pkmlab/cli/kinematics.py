@@ -82,13 +82,20 @@ def ik(mech_file: MechArg,
        pose: Annotated[str, typer.Option(help='Tool pose in the mechanism\'s free coordinates, '
                                               'mm and deg: "x,y,z,θx,θy,θz" (six-DOF), "x,y,z" '
                                               '(translational), "x,y,θz" (planar); all six are '
-                                              'accepted too; units may be given, e.g. "2 in".')],
+                                              'accepted too; units may be given, e.g. "2 in". '
+                                              'Base frame unless --relative.')],
+       relative: Annotated[bool, typer.Option(
+           "--relative", help="--pose is an offset from the mechanism's nominal pose (added "
+           "coordinate by coordinate, mm and deg), not a base-frame pose")] = False,
        as_json: JsonOpt = False) -> None:
-    """Inverse kinematics: actuator values of one pose, with validity, reason and κ."""
+    """Inverse kinematics: actuator values of one pose, with validity, reason and κ.
+
+    Exits with status 1 when the pose is not valid (a leg without a solution, out of its
+    stroke or beyond a joint limit), after printing why."""
     from ..dexterity.report import pose_report
 
     mech = _load(mech_file)
-    X = _parse_pose(pose, mech=mech)
+    X = _parse_pose(pose, mech=mech, relative=relative)
     rep = pose_report(mech, X)
     legs = [rep["reason"]] if rep["valid"] else [
         f"{n}: {st}" for n, st in rep["leg_status"].items() if st != "ok"]
@@ -103,6 +110,8 @@ def ik(mech_file: MechArg,
                              for c, v in zip(dep, par)}
     if as_json:
         _emit(data)
+        if not rep["valid"]:
+            raise typer.Exit(1)
         return
     out.print(f"pose: {_pose_str(X, mech)}")
     if dep:
@@ -113,6 +122,8 @@ def ik(mech_file: MechArg,
     out.print(("[green]valid[/]" if rep["valid"] else "[red]invalid[/]") + ": "
               + escape("; ".join(legs)))
     out.print(escape(_kappa_text(rep)), highlight=False)
+    if not rep["valid"]:
+        raise typer.Exit(1)
 
 
 def mech_status(code: int) -> str:

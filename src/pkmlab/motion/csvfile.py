@@ -4,8 +4,11 @@
 with the same meaning:
 
 * columns ``t, x, y, z, theta_x, theta_y, theta_z`` in any order: time in s, the tool position
-  in mm and its Z-Y-X Euler angles in deg, in the base frame (the same absolute frame as every
-  pose of pkmlab, not relative to the nominal pose);
+  in mm and its Z-Y-X Euler angles in deg. The reader returns them as written; their frame is
+  stated where the file is used, with the same two choices and the same meaning: absolute
+  base-frame poses (``pkmlab trajectory --csv F``; a study's ``frame: base``) or offsets from
+  the nominal pose, added coordinate by coordinate (``--csv F --relative``; ``frame:
+  nominal``). A study must state its file's frame;
 * optionally all six ``<coordinate>_dot`` columns (mm/s, deg/s), and with them all six
   ``<coordinate>_ddot`` columns (mm/s², deg/s²); acceleration columns without velocity columns
   are refused, not ignored;

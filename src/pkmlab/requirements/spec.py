@@ -245,10 +245,12 @@ class MotionSpec(_Model):
     name: str = Field(pattern=r"^[A-Za-z0-9._-]+$")
     file: str | None = Field(None, description="CSV t,x,y,z,theta_x,theta_y,theta_z (s, mm, "
                              "deg) [+ <coord>_dot, <coord>_ddot], relative to the study file")
-    frame: Literal["nominal", "base", "task"] = Field(
-        "nominal", description="poses relative to the nominal pose, absolute (base, CSV "
-        "only), or relative to the task's centre as placed (task: needs evaluate.task; with "
-        "task.centre auto the centre the search chose) at the nominal orientation")
+    frame: Literal["nominal", "base", "task"] | None = Field(
+        None, description="a file's frame, required with 'file': 'nominal' (poses relative to "
+        "the nominal pose, as `pkmlab trajectory --csv F --relative`), 'base' (absolute, as "
+        "`pkmlab trajectory --csv F`) or 'task' (relative to the task's centre as placed: "
+        "needs evaluate.task; with task.centre auto the centre the search chose); generated "
+        "motions are about the nominal pose, or the task's centre with 'task'")
     smoothing: SmoothingSpec = Field(default_factory=SmoothingSpec)
     sinusoid: SinusoidSpec | None = None
     paper: bool = Field(False, description="Hopkins & Williams' ±2 in / ±30° motion")
@@ -343,6 +345,12 @@ def build_motions(data: Any, base: Path) -> MotionsPlan:
             raise ParameterError(f"{fi}.name", "a name no other motion has", s.name)
         raw = dict(d)
         if s.file is not None:
+            if s.frame is None:         # one CSV, one meaning: the study states the frame
+                raise ParameterError(f"{fi}.frame", "'nominal' (the CSV's poses are offsets "
+                                     "from the nominal pose, as `pkmlab trajectory --csv FILE "
+                                     "--relative`), 'base' (absolute base-frame poses, as "
+                                     "`pkmlab trajectory --csv FILE`) or 'task' (offsets from "
+                                     "the task's centre)", "missing")
             path = (base / s.file).resolve()
             recorded[s.name] = load_motion_csv(path, s.name, s.smoothing.window,
                                                s.smoothing.polyorder, field=f"{fi}.file")

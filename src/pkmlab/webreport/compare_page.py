@@ -12,7 +12,8 @@ from pathlib import Path
 from ..escaping import plotly_text
 from . import data as D
 from .figures import overlay_scene
-from .page import figure_json, render_page
+from .page import data_json, figure_json, render_page
+from .posepanel import panel_model
 
 log = logging.getLogger(__name__)
 
@@ -101,11 +102,20 @@ def compare_html(rows: list[dict], path: str | Path, *, box_deg: float | None = 
             fig = overlay_figure([res for _, res in ok], [lab for lab, _ in ok],
                                  title=f"{name} workspaces")
             images.append({"uri": _png(fig), "caption": f"{name} sections, overlaid"})
+    poses = []
+    for i, r in enumerate(rows):
+        if r.get("mechanism") is None:
+            continue
+        try:
+            figures[f"pose-model-{i}"] = data_json(panel_model(r["mechanism"]))
+            poses.append({"model_id": f"pose-model-{i}", "label": labels[i]})
+        except Exception as exc:  # noqa: BLE001 - a panel problem never stops the page
+            log.warning("compare page: no pose panel for %s: %s", labels[i], exc)
     data = {"designs": [{"label": r["label"],
                          **{k: r.get(k) for k, _, _ in columns if k in r}} for r in rows],
             "scenes": [{"div": s["div"], "figure": s["figure"]} for s in scenes]}
     path = render_page(Path(path), "compare.html.j2", title=title, kind="design comparison",
                        data=data, figures=figures, labels=labels, table=table,
-                       scenes=scenes, images=images, box_deg=box_deg)
+                       scenes=scenes, images=images, box_deg=box_deg, poses=poses)
     log.info("compare page written in %.1f s", time.perf_counter() - t0)
     return path

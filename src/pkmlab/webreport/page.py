@@ -124,5 +124,6 @@ def render_page(path: Path, template: str, *, title: str, kind: str, data: dict,
         built=time.strftime("%Y-%m-%d %H:%M:%S %z"), machine=platform.node(),
         python=platform.python_version(), platform_name=platform.platform(),
         css=_asset("report.css"), js=_asset("report.js"), plotly_js=js,
+        pose_css=_asset("posepanel.css"), pose_js=_asset("posepanel.js"),
         data_json=data_json(data), figures=figures, **context)
     return atomic.write_text(Path(path), html)

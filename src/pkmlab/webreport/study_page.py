@@ -20,7 +20,8 @@ from ..study.metrics import METRICS
 from ..study.violations import least_violating, tally, violated_text
 from . import data as D
 from .figures import design_scene, pareto_matrix, pareto_parcoords
-from .page import colour_option, figure_json, hull_of_ply, png_uri, render_page
+from .page import colour_option, data_json, figure_json, hull_of_ply, png_uri, render_page
+from .posepanel import panel_model, task_shapes, task_traces
 
 log = logging.getLogger(__name__)
 
@@ -176,6 +177,7 @@ def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
                                   if info.get("workspace", {}).get("empty")
                                   else "the study evaluates no workspace."))
         fig = design_scene(mech, hull)
+        _pose_panel(card, fig, study, mech, n)
         if hull is not None:
             fig.data[0].update(cmin=colours[0]["cmin"], cmax=colours[0]["cmax"])
         card["has_scene"] = True
@@ -183,6 +185,19 @@ def _card(out: Path, study: Study, entry: dict, baseline: dict | None,
     else:
         card["scene_note"] = "The mechanism could not be drawn (see the log)."
     return card, fig, colours
+
+
+def _pose_panel(card: dict, fig, study: Study, mech, n: int) -> None:
+    """The card's pose panel (its model as ``card["pose_json"]``) and the task region in its
+    3-D view; a problem here never stops the report."""
+    try:
+        shapes = task_shapes(study, mech)
+        fig.add_traces(task_traces(shapes))
+        card["pose_model"] = f"pose-model-{n}"
+        card["pose_json"] = data_json(panel_model(mech, shapes))
+    except Exception as exc:  # noqa: BLE001 - a panel problem never stops the report
+        log.warning("design %d: no pose panel: %s", n, exc)
+        card.pop("pose_model", None)
 
 
 def _variables(study: Study) -> list[dict]:
@@ -259,6 +274,8 @@ def write_study_page(out: Path, study: Study, records: list[dict], *, progress=N
         cards.append(card)
         if fig is not None:
             figures[f"fig-design-{card['number']}"] = figure_json(fig)
+        if card.get("pose_model"):
+            figures[card["pose_model"]] = card.pop("pose_json")
         if opts:
             colours[card["number"]] = opts
     metrics = [m for m in METRICS if any(m in r["metrics"] for r in rows)]
