@@ -128,7 +128,9 @@ def _point(pg, trace_name: str, which) -> tuple[float, float]:
 
 def test_clicking_a_pareto_point_opens_its_card(report, tmp_path):
     pg = report.page
-    x, y = _point(pg, "exported design (card)", {"text": "2"})
+    # points are labelled by their evaluation number, "#seq" (one numbering everywhere)
+    seq2 = pg.evaluate("window.pkmlab.data")["designs"][1]["seq"]
+    x, y = _point(pg, "exported design (card)", {"text": f"#{seq2}"})
     pg.mouse.click(x, y)
     pg.wait_for_selector("#design-2", state="visible", timeout=10_000)
     assert not pg.locator("#design-1").is_visible()
