@@ -48,7 +48,7 @@ def test_motions_within_the_budget_validate(capsys, tmp_path):
 
 
 @pytest.mark.parametrize("value, fragment", [("abc", "PKMLAB_MEMORY_LIMIT"),
-                                             ("10KiB", "evaluate.workspace.resolution")])
+                                             ("10KiB", "run alone needs")])
 def test_a_bad_or_tight_memory_limit_refuses_the_run_before_it_starts(capsys, tmp_path,
                                                                       monkeypatch, value,
                                                                       fragment):
