@@ -38,7 +38,7 @@ OUTPUT_BYTES = 8 * 2**20
 #: a command not listed counts :data:`OUTPUT_BYTES`. The first run after an install also
 #: compiles the kernels (up to 0.75 GB once): not counted, as it does not depend on the input.
 COMMAND_BYTES = {
-    "inspect": 72 * 2**20, "ik": 72 * 2**20, "fk": 64 * 2**20, "demo": 64 * 2**20,
+    "inspect": 72 * 2**20, "ik": 72 * 2**20, "fk": 64 * 2**20, "demo": 96 * 2**20,
     "validate": 96 * 2**20, "run": 480 * 2**20, "report": 180 * 2**20,
     "workspace": 120 * 2**20, "workspaces": 160 * 2**20, "dexterity": 160 * 2**20,
     "trajectory": 112 * 2**20, "compare": 320 * 2**20, "export": 64 * 2**20,
