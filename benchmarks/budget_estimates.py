@@ -99,7 +99,7 @@ def main() -> int:
         if "--no-warm" not in sys.argv:     # the kernels already in the cache: skip it
             warm([_coarse(argv) for _, argv in todo])
         for label, argv in todo:
-            r = measure(argv)
+            r = measure(argv, timeout=1800.0)
             est, rise = r["estimate"], r["rise"]
             rows.append(f"| {label} | {est / 2**20:.1f} | {r['field'] or '—'} | "
                         f"{rise / 2**20:.1f} | {est / max(rise, 1):.2f} | "
