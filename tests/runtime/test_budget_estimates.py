@@ -7,8 +7,10 @@ first); the peak resident set's rise over the resident set after the import is c
 the largest need the command checked against the budget (its fixed memory,
 ``COMMAND_BYTES``, plus its largest array request). The inputs are small — not the defaults
 of ``benchmarks/budget_estimates.py``, on which the constants were measured — and where a
-command has an array model they are large enough that the arrays are at least a third of the
-estimate, so an array model off by 2× moves the ratio. About 40-60 s on two loaded cores."""
+command has an array model that runs in seconds at a size where its arrays weigh (the Luzi
+workspace), they are at least a third of the estimate, so an array model off by 2× moves the
+ratio; elsewhere the fixed memory dominates and the test checks it. Slow on a loaded machine:
+22 min at load 18 on two cores (the warm-up and nine fresh interpreters)."""
 
 from __future__ import annotations
 
@@ -42,7 +44,7 @@ def _cases(tmp, study):
         ("workspace Luzi 10 mm", ["workspace", LUZI, "--resolution", "10", "--out", tmp / "w"],
          0.33),
         ("trajectory 10 s segments", ["trajectory", HW, "--paper-motion", "--segment-time",
-                                      "10", "--out", tmp / "t"], 0.33),
+                                      "10", "--out", tmp / "t"], 0.0),
         ("dexterity 6-PSU 5 mm", ["dexterity", HW, "--resolution", "5", "--out", tmp / "d"],
          0.0),
         ("compare 10 mm", ["compare", HW, "--resolution", "10", "--box", "5", "--samples", "3",
