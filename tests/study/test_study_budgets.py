@@ -134,9 +134,9 @@ def test_validate_checks_what_run_will_need(capsys, tmp_path, monkeypatch):
     (["--paper-motion", "--segment-time", "80000"], "--segment-time"),
 ])
 def test_the_trajectory_command_checks_its_cost_model(capsys, tmp_path, args, field):
-    """The trajectory command's cost model (1 kB and 0.44 ms per sample): segments of a day at
-    100 Hz (80,000 s) are 1.9e8 samples, refused before the motion is built, with a setting that fits
-    (before: the command checked nothing and allocated)."""
+    """The trajectory command's cost model (1 kB and 0.44 ms per sample): 80,000 s segments
+    at 100 Hz are 1.9e8 samples, refused before the motion is built, with a setting that
+    fits (before: the command checked nothing and allocated)."""
     from clihelp import HW
 
     code, _, err = cli(capsys, "trajectory", HW, *args, "--out", tmp_path / "t")
