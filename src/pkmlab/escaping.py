@@ -12,7 +12,12 @@ import re
 
 __all__ = ["plotly_text", "markdown_text"]
 
-_MD = re.compile(r"([\\`*_{}\[\]()#+!|~>-])")
+#: characters that make markup anywhere in a line (links and images need ``[``, autolinks and
+#: HTML ``<``, which html.escape turns into an entity first)
+_MD = re.compile(r"([\\`*_\[\]!|~])")
+#: what makes a block only at the start of a line (a heading, a list item; a quote's ``>`` is
+#: an entity already): the text is one line, so only at its start
+_MD_START = re.compile(r"^(\s*)([-+#=]|\d+(?=[.)]))")
 
 
 def plotly_text(value) -> str:
@@ -21,7 +26,11 @@ def plotly_text(value) -> str:
 
 
 def markdown_text(value) -> str:
-    """``value`` as literal text in a Markdown table cell: no link, emphasis, code, cell
-    boundary or raw HTML; line breaks become spaces."""
-    text = " ".join(str(value).split())
-    return _MD.sub(r"\\\1", html.escape(text, quote=False))
+    """``value`` as literal text in Markdown (a table cell, a heading, a paragraph): no link,
+    image, emphasis, code, cell boundary, raw HTML, or (at its start) heading, list or quote;
+    line breaks become spaces. Characters that are markup only in pairs or at a line's start
+    (``-``, ``#``, ``(``) are left alone elsewhere, so ``EC-S-1k`` stays readable."""
+    text = _MD.sub(r"\\\1", " ".join(str(value).split()))
+    text = _MD_START.sub(lambda m: m.group(1) + (m.group(2) + "\\" if m.group(2)[0].isdigit()
+                                                 else "\\" + m.group(2)), text)
+    return html.escape(text, quote=False)

@@ -27,9 +27,13 @@ def test_a_grid_over_the_memory_budget_is_refused_with_a_coarser_suggestion(caps
 
 
 def test_memory_limit_env_applies_to_every_grid(capsys, tmp_path, monkeypatch):
+    code, _, err = cli(capsys, "workspace", LUZI, "--resolution", "2.5", "--out", tmp_path,
+                       env={"PKMLAB_MEMORY_LIMIT": "1GiB"}, monkeypatch=monkeypatch)
+    one_line(code, err, "resolution", "fit in 1 GiB", "try >=")
+    # a budget below the command's own fixed memory: no resolution would do (issue 27)
     code, _, err = cli(capsys, "workspace", HW, "--resolution", "2.5", "--out", tmp_path,
                        env={"PKMLAB_MEMORY_LIMIT": "1MiB"}, monkeypatch=monkeypatch)
-    one_line(code, err, "resolution", "fit in 1 MiB", "try >=")
+    one_line(code, err, "PKMLAB_MEMORY_LIMIT", "fit in 1 MiB", "workspace alone needs")
     code, _, err = cli(capsys, "workspace", HW, "--out", tmp_path,
                        env={"PKMLAB_MEMORY_LIMIT": "lots"}, monkeypatch=monkeypatch)
     one_line(code, err, "PKMLAB_MEMORY_LIMIT")

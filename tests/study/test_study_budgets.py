@@ -48,7 +48,7 @@ def test_motions_within_the_budget_validate(capsys, tmp_path):
 
 
 @pytest.mark.parametrize("value, fragment", [("abc", "PKMLAB_MEMORY_LIMIT"),
-                                             ("10KiB", "evaluate.workspace.resolution")])
+                                             ("10KiB", "run alone needs")])
 def test_a_bad_or_tight_memory_limit_refuses_the_run_before_it_starts(capsys, tmp_path,
                                                                       monkeypatch, value,
                                                                       fragment):
@@ -115,3 +115,30 @@ def test_dexterity_over_the_memory_budget_is_refused_before_it_allocates(capsys,
                        "--resolution", "10", "--out", tmp_path / "d",
                        env={"PKMLAB_MEMORY_LIMIT": "1GiB"}, monkeypatch=monkeypatch)
     one_line(code, err, "resolution", "voxel × orientation arrays", "fit in 1 GiB", "try >=")
+
+
+def test_validate_checks_what_run_will_need(capsys, tmp_path, monkeypatch):
+    """Whatever validates, runs: under a budget that holds ``validate``'s own memory but not
+    ``run``'s, validate refuses as run would (before: it passed, then run was refused)."""
+    from pkmlab.runtime.memory import COMMAND_BYTES
+
+    limit = str((COMMAND_BYTES["validate"] + COMMAND_BYTES["run"]) // 2)
+    p = small_study(tmp_path)
+    for command in ("validate", "run"):
+        code, _, err = cli(capsys, command, p, env={"PKMLAB_MEMORY_LIMIT": limit},
+                           monkeypatch=monkeypatch)
+        one_line(code, err, "PKMLAB_MEMORY_LIMIT", "run alone needs")
+
+
+@pytest.mark.parametrize("args, field", [
+    (["--paper-motion", "--segment-time", "80000"], "--segment-time"),
+])
+def test_the_trajectory_command_checks_its_cost_model(capsys, tmp_path, args, field):
+    """The trajectory command's cost model (1 kB and 0.44 ms per sample): 80,000 s segments
+    at 100 Hz are 1.9e8 samples, refused before the motion is built, with a setting that
+    fits (before: the command checked nothing and allocated)."""
+    from clihelp import HW
+
+    code, _, err = cli(capsys, "trajectory", HW, *args, "--out", tmp_path / "t")
+    one_line(code, err, field, "try <=", "samples")
+    assert not (tmp_path / "t").exists()

@@ -16,7 +16,8 @@ EVIL = '<a href="https://evil.example/x">click</a><b>bold</b>[md](https://evil.e
 def test_escapes_are_literal_text():
     assert "<" not in plotly_text(EVIL) and "&lt;a href=" in plotly_text(EVIL)
     md = markdown_text(EVIL + " | cell")
-    assert "](" not in md and "\\[" in md and "\\|" in md and "<a" not in md
+    assert "](" not in md.replace("\\](", "") and "\\[" in md and "\\|" in md
+    assert "<a" not in md
 
 
 @pytest.mark.skipif(CHROMIUM is None or sync_playwright is None, reason="needs Chromium")

@@ -51,6 +51,7 @@ def _version(value: bool) -> None:
 
 @app.callback()
 def _root(
+    ctx: typer.Context,
     debug: Annotated[bool, typer.Option(
         "--debug", help="show the full traceback of an unexpected error")] = False,
     version: Annotated[bool | None, typer.Option(
@@ -58,7 +59,13 @@ def _root(
     = None,
 ) -> None:
     """pkmlab: design-optimisation workbench for parallel manipulators."""
+    from ..runtime.memory import COMMAND_BYTES, require_command, set_command
+
     _DEBUG["on"] = debug
+    name = ctx.invoked_subcommand
+    set_command(name)               # its fixed memory joins every budget check it makes
+    if name in COMMAND_BYTES and "--help" not in sys.argv[2:]:
+        require_command(f"pkmlab {name}")   # the command alone must fit the budget
 
 
 def main() -> None:
@@ -180,6 +187,9 @@ def run_cli() -> None:
                          "with --debug for the traceback)\n")
         raise SystemExit(1) from None
     finally:
+        from ..runtime.memory import set_command
+
+        set_command(None)       # library calls after the command count no command memory
         # the command is over; a Ctrl-C while the interpreter shuts down (joining worker
         # pools, a second or more after a study's report) ends it at once with status 130
         # instead of a signal death or a traceback from a library's exit handler

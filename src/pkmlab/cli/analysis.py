@@ -13,6 +13,7 @@ from rich.markup import escape
 
 from ..errors import ParameterError
 from ..export import exporters
+from ..motion import costs
 from ..runtime.progress import log_lines
 from ..units import parse_length
 from .common import (
@@ -292,11 +293,14 @@ def trajectory(
     try:
         if csv is not None:
             motion = tr.load_motion_csv(csv, field="--csv", derivatives=False)
+            _trajectory_budget("--csv", len(motion.t), 1.0, "rows")
             if relative:
                 motion = tr.Motion(motion.name, motion.t, motion.poses + mech.nominal_pose,
                                    motion.twist, motion.accel, motion.derivatives)
         else:
-            motion = tr.paper_motion(mech, segment_time=segment_time)
+            _trajectory_budget("--segment-time", costs.paper_samples(segment_time, 100.0),
+                               segment_time, "s")
+            motion = tr.paper_motion(mech, segment_time=segment_time, rate_hz=100.0)
         t = motion.t
         rep = tr.check_trajectory(mech, t, motion.poses, payload_mass_kg=payload,
                                   max_speed=max_speed, max_force=max_force)
@@ -358,6 +362,17 @@ def trajectory(
         out.print(f"  wrote {escape(str(p))}")
     if not rep.fits:
         raise typer.Exit(1)
+
+
+def _trajectory_budget(field: str, n: float, value: float, unit: str) -> None:
+    """The ``trajectory`` command's cost model against the budgets: memory and time per
+    sample (:mod:`pkmlab.motion.costs`), driven by ``field`` = ``value`` ``unit``."""
+    from ..study.evaluators.registry import Cost, check_costs
+
+    check_costs([Cost(field, value, unit, 1.0, n * costs.TRAJECTORY_COMMAND_BYTES_PER_SAMPLE,
+                      n * costs.DYNAMICS_SECONDS_PER_SAMPLE
+                      + n * costs.TRAJECTORY_SECONDS_PER_SAMPLE, f"{n:.6g} samples",
+                      integer=unit == "rows")])
 
 
 def _limit_text(mech, force_limit) -> str:

@@ -27,7 +27,11 @@ def export_cmd(
 ) -> None:
     """Write a mechanism (or a study's candidate) as MJCF, URDF, joint frames or STEP."""
     from ..export import export_mechanism
+    from ..runtime.memory import FORMAT_BYTES, format_bytes, require
 
+    # the CAD kernel (OCP) that writes STEP: the bulk of a step export's memory
+    require("--format", FORMAT_BYTES.get(fmt, 0), "an export whose memory would",
+            f"{fmt} ({format_bytes(FORMAT_BYTES.get(fmt, 0))} beside the command's own)")
     mass, stem, extra = None, None, []
     if source.is_dir():
         from ..study.candidates import candidate, candidate_mechanism, mass_model

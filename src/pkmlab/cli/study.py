@@ -40,9 +40,12 @@ def validate(study_file: StudyArg, as_json: JsonOpt = False,
                  help="designs sampled to estimate how much of the design box is "
                       "geometrically invalid (0: skip)", min=0, max=4096)] = 128) -> None:
     """Check a study file (exit 2 with the offending field on error; writes nothing)."""
+    from ..runtime.memory import checking_for, require_command
     from ..study.optimisers import expected_evaluations
 
-    study = _load_study(study_file)
+    with checking_for("run"):           # the budgets `pkmlab run` will check
+        require_command("pkmlab run")
+        study = _load_study(study_file)
     info = {"study": study.name, "file": str(study_file), "valid": True,
             "variables": [v.name for v in study.variables],
             "derived": [d.name for d in study.space.derived],

@@ -1,10 +1,14 @@
 """Measured memory peaks, to check the budgets' cost models against (tests, benchmarks).
 
-:func:`measure` runs one ``pkmlab`` command line in a fresh interpreter, after importing the
-CLI and loading the compiled kernels, and returns the rise of the peak resident set over the
-resident set before the command (Linux: ``/proc/self/clear_refs`` resets ``VmHWM``), together
-with the estimate the command logged through :func:`pkmlab.runtime.memory.require` (the
-largest one). Linux only; elsewhere :func:`available` is False.
+What is measured (issue 27): the **rise of the peak resident set of a fresh ``pkmlab``
+process over its resident set once the CLI is imported** (``import pkmlab.cli``: the
+interpreter, numpy, scipy, numba, typer, rich — :data:`pkmlab.runtime.memory.PROCESS_BYTES`),
+with the kernels already compiled in the on-disk cache (:func:`warm` compiles them in another
+process first). That rise is what the command itself adds — loading its kernels from the
+cache, importing its late modules, its arrays, plots and files — and what its estimate
+(:func:`pkmlab.runtime.memory.largest_checked`: the command's fixed memory plus the largest
+array request it checked against the budget) is meant to cover. Linux only:
+``/proc/self/clear_refs`` resets ``VmHWM``; elsewhere :func:`available` is False.
 """
 
 from __future__ import annotations
@@ -14,31 +18,15 @@ import os
 import subprocess
 import sys
 
-__all__ = ["available", "measure"]
+__all__ = ["available", "measure", "warm"]
 
 _CHILD = r"""
-import json, logging, os, re, sys
+import json, re, sys
 def status(key):
     return int(re.search(key + r':\s+(\d+)', open('/proc/self/status').read()).group(1)) * 1024
-ARGV, WARM = json.loads(sys.argv[1]), json.loads(sys.argv[2])
+ARGV = json.loads(sys.argv[1])
 from pkmlab.cli import run_cli
-import pkmlab.runtime.memory as mem
-seen = []
-_require = mem.require
-def spy(field, need, *a, **k):
-    seen.append((field, float(need)))
-    return _require(field, need, *a, **k)
-mem.require = spy
-for warm in WARM:
-    sys.argv = ['pkmlab', *warm]
-    try:
-        run_cli()
-    except SystemExit:
-        pass
-for m in list(sys.modules.values()):     # every module that imported require by name
-    if getattr(m, '__name__', '').startswith('pkmlab') and getattr(m, 'require', None) is _require:
-        m.require = spy
-seen.clear()
+from pkmlab.runtime import memory
 import gc; gc.collect()
 open('/proc/self/clear_refs', 'w').write('5')
 base = status('VmRSS')
@@ -48,8 +36,21 @@ try:
     run_cli()
 except SystemExit as exc:
     code = exc.code
+field, est = memory.largest_checked()
 sys.__stderr__.write('PEAK ' + json.dumps({'code': code, 'rise': status('VmHWM') - base,
-                                            'base': base, 'estimates': seen}) + chr(10))
+                                            'base': base, 'estimate': est,
+                                            'field': field}) + chr(10))
+"""
+
+_WARM = r"""
+import json, sys
+from pkmlab.cli import run_cli
+for argv in json.loads(sys.argv[1]):
+    sys.argv = ['pkmlab', *argv]
+    try:
+        run_cli()
+    except SystemExit:
+        pass
 """
 
 
@@ -63,20 +64,30 @@ def available() -> bool:
         return False
 
 
-def measure(argv: list[str], warm: list[list[str]] = (), env: dict | None = None,
-            timeout: float = 600.0) -> dict:
-    """Run ``pkmlab <argv>`` in a fresh interpreter (after the command lines ``warm``, which
-    compile or load the kernels) → ``{"code", "rise", "base", "estimates": [(field, bytes)]}``
-    (``rise``: bytes the peak resident set rose over the resident set before the command)."""
+def _env(env: dict | None) -> dict:
     e = dict(os.environ)
     e.update(env or {})
-    p = subprocess.run([sys.executable, "-c", _CHILD, json.dumps(list(map(str, argv))),
-                        json.dumps([list(map(str, w)) for w in warm])],
-                       capture_output=True, text=True, env=e, timeout=timeout)
+    return e
+
+
+def warm(commands: list[list], env: dict | None = None, timeout: float = 1800.0) -> None:
+    """Run the command lines ``commands`` in one other interpreter, so that the kernels they
+    use are compiled into the on-disk cache before :func:`measure`."""
+    subprocess.run([sys.executable, "-c", _WARM,
+                    json.dumps([list(map(str, a)) for a in commands])],
+                   capture_output=True, text=True, env=_env(env), timeout=timeout)
+
+
+def measure(argv: list, env: dict | None = None, timeout: float = 600.0) -> dict:
+    """Run ``pkmlab <argv>`` in a fresh interpreter → ``{"code", "rise", "base", "estimate",
+    "field", "stderr"}``: ``rise``, the bytes the peak resident set rose over the resident
+    set once the CLI was imported; ``estimate``, the largest need the command checked against
+    the memory budget (its fixed memory included; 0 if it checked none) and its ``field``."""
+    p = subprocess.run([sys.executable, "-c", _CHILD, json.dumps(list(map(str, argv)))],
+                       capture_output=True, text=True, env=_env(env), timeout=timeout)
     for line in p.stderr.splitlines():
         if line.startswith("PEAK "):
             out = json.loads(line[5:])
-            out["estimates"] = [tuple(x) for x in out["estimates"]]
             out["stderr"] = p.stderr
             return out
     raise RuntimeError(f"pkmlab {' '.join(map(str, argv))} did not report its peak:\n"

@@ -51,15 +51,16 @@ def on_bound(study: Study, params: dict) -> list[str]:
     return out
 
 
-def design_flags(study: Study, designs: list[dict], params_of, quiet: bool = False
-                 ) -> list[str]:
+def design_flags(study: Study, designs: list[dict], params_of, quiet: bool = False,
+                 text=str) -> list[str]:
     """Markdown bullet lines (and a log line each) for ``designs`` (the Pareto designs, or the
     least-violating ones): on-bound variables, poor conditioning at the task, the placed
-    task centre. ``params_of(record)`` gives a record's design values."""
+    task centre. ``params_of(record)`` gives a record's design values; ``text`` escapes the
+    user's strings (variable names) for the renderer (Markdown: ``markdown_text``)."""
     out, info = [], []
     for r in designs:
         name = label(r)
-        b = on_bound(study, params_of(r))
+        b = [text(t) for t in on_bound(study, params_of(r))]
         if b:
             out.append(f"- {name} lies on a bound of the design box (within "
                        f"{BOUND_SHARE:.0%} of the range): {', '.join(b)}; the best design may "

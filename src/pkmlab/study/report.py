@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from ..escaping import markdown_text
 from ..runtime import atomic
 from .definition import Study
 from .export import export_designs
@@ -174,11 +175,12 @@ def _plot(path: Path, study: Study, records, front) -> None:
 
 
 def _fmt(v) -> str:
+    """A summary.md cell: numbers formatted, text (a choice, a catalogue name) escaped."""
     if v is None:
         return "—"
     if isinstance(v, float):
         return f"{v:.4g}"
-    return str(v)
+    return v if isinstance(v, int) else markdown_text(v)
 
 
 def _summary(study: Study, records, front, baseline) -> str:
@@ -188,13 +190,14 @@ def _summary(study: Study, records, front, baseline) -> str:
     for r in records:
         counts[r["status"]] = counts.get(r["status"], 0) + 1
     status = ", ".join(f"{n} {s}" for s, n in sorted(counts.items()))
-    lines = [f"# {study.name}", "", study.description, "",
+    md = markdown_text
+    lines = [f"# {md(study.name)}", "", md(study.description), "",
              f"{len(records)} evaluations ({status}; reasons in evaluations.csv); "
              f"{len(front)} designs on the Pareto front.", "",
              "Objectives: " + ", ".join(f"{o.sense} {o.metric}" for o in study.objectives),
              "Constraints: " + (", ".join(c.describe() for c in study.constraints) or "none"),
              "", "| design | " + " | ".join(
-                 [f"{v.name} ({v.unit})" if v.unit else v.name for v in study.variables]
+                 [f"{md(v.name)} ({v.unit})" if v.unit else md(v.name) for v in study.variables]
                  + [METRICS[m].label for m in metrics]) + " |",
              "|---" * (1 + len(study.variables) + len(metrics)) + "|"]
     notes = []
@@ -206,19 +209,19 @@ def _summary(study: Study, records, front, baseline) -> str:
         ms = [_fmt(r["metrics"].get(m)) for m in metrics]
         for v in study.variables:
             if p.get(v.name) is None:
-                notes.append(f"- {label}, {v.name}: a free parameter, which the baseline "
+                notes.append(f"- {label}, {md(v.name)}: a free parameter, which the baseline "
                              "mechanism file has no value for")
         for k, why in r.get("notes", {}).items():
             if k in metrics:
-                notes.append(f"- {label}, {k}: {why}")
+                notes.append(f"- {label}, {md(k)}: {md(why)}")
         for k in metrics:
             if r["metrics"].get(k) is None and k not in r.get("notes", {}):
-                notes.append(f"- {label}, {k}: {_no_value(r, k)}")
+                notes.append(f"- {label}, {md(k)}: {md(_no_value(r, k))}")
         return f"| {label} | " + " | ".join(vals + ms) + " |"
 
     if baseline is not None:
         label = "baseline" + ("" if baseline["status"] == "ok" else
-                              f" ({baseline['status']}: {baseline['reason'].splitlines()[0]})")
+                              f" ({baseline['status']}: {md(baseline['reason'].splitlines()[0])})")
         lines.append(row(label, baseline))
     for r in front[:max(study.top, 1) * 2]:
         lines.append(row(design_label(r), r))
@@ -226,7 +229,7 @@ def _summary(study: Study, records, front, baseline) -> str:
     lines += _requirement_margins(study, baseline, shown, metrics, notes)
     lines += _catalogue_fits(study, records)
     lines += _why_they_fail(study, records, front)
-    flags = design_flags(study, shown, lambda r: _params(study, r))
+    flags = design_flags(study, shown, lambda r: _params(study, r), text=markdown_text)
     if flags:
         lines += ["", "Flags (" + ("Pareto" if front else "least-violating") + " designs; "
                   "designs are named by their evaluation number, the `seq` column):", *flags]
@@ -290,14 +293,15 @@ def _why_they_fail(study: Study, records, front) -> list[str]:
     out = ["", "Why candidates fail (violations per constraint; a candidate can violate "
            "several; column `violated` of evaluations.csv):", "",
            "| constraint | violated | of |", "|---|---|---|"]
-    out += [f"| {w} | {n} | {of} |" for w, n, of in counts]
+    out += [f"| {markdown_text(w)} | {n} | {of} |" for w, n, of in counts]
     if not front:
         least = least_violating(study, records, max(study.top, 1))
         if least:
             out += ["", f"No feasible design. The {len(least)} least violating (fewest "
                     "violations, then smallest; exported under designs/):", "",
                     "| design | violated |", "|---|---|"]
-            out += [f"| {design_label(r)} | {violated_text(study, r)} |" for r in least]
+            out += [f"| {design_label(r)} | {markdown_text(violated_text(study, r))} |"
+                    for r in least]
     return out
 
 
@@ -321,6 +325,6 @@ def _catalogue_fits(study: Study, records) -> list[str]:
         with_it = [r for r in records if r["status"] == "ok"
                    and _params(study, r).get(var.name) == name]
         fits = sum(r["metrics"].get("actuators_fit") == 1.0 for r in with_it)
-        parts.append(f"{name} fits {fits} of {len(with_it)}")
+        parts.append(f"{markdown_text(name)} fits {fits} of {len(with_it)}")
     return ["", "Catalogue actuators (designs evaluated with each, on which it meets force, "
             "speed, torque–speed and stroke along every motion): " + "; ".join(parts) + "."]

@@ -323,12 +323,18 @@ def check_budget(evaluation, mech) -> list[Cost]:
     """Refuse (:class:`~pkmlab.runtime.memory.BudgetError`, naming the field and a setting
     that fits) a block whose cost model on ``mech`` exceeds the memory or time budget; log a
     long estimate. Returns every evaluator's costs."""
-    from ...runtime.memory import memory_limit, require
-    from ...runtime.time_budget import require_time, time_limit
-
     costs = [c for ev in EVALUATORS.values() if ev.runs(evaluation)
              for c in ev.cost(evaluation.plan(ev.name), evaluation, mech)]
-    mem, secs = memory_limit(), time_limit()
+    return check_costs(costs)
+
+
+def check_costs(costs: list[Cost]) -> list[Cost]:
+    """Refuse the first of ``costs`` over the memory (the running command's fixed memory
+    added) or time budget, naming its field and a setting that fits; log long estimates."""
+    from ...runtime.memory import command_bytes, memory_limit, require
+    from ...runtime.time_budget import require_time, time_limit
+
+    mem, secs = memory_limit() - command_bytes(), time_limit()   # what the arrays may take
     for c in costs:
         require(c.field, c.bytes, "a request whose arrays", c.got, c.fits(c.bytes, mem))
         require_time(c.field, c.seconds, "a request", c.got, c.fits(c.seconds, secs))
