@@ -14,7 +14,7 @@ applies a servo's ``kv`` after the constraint solver has sized the loop forces w
 undamped mass matrix, so ``timestep * kv * (M^-1)_ii`` (the factor by which it divides the
 response to a force on the actuated joint ``i``) must stay well below the loop's margin. It
 was 3.7 on the hexaglide design (1.086 spectral radius of one step's linearisation) and
-0.91-4.1 on the families' files; the rule is asserted at 1 and the step map's spectral
+0.73-4.1 on the families' files; the rule is asserted at 1 and the step map's spectral
 radius below 1.
 """
 
