@@ -31,8 +31,8 @@ Conventions (MuJoCo XML reference, mujoco.readthedocs.io/en/stable/XMLreference.
   it the tree inertia of an actuated joint is only its own body's (a 46 g slider carriage on a
   10 kg Hexaglide), MuJoCo's ``dampratio`` sizes ``kv`` on that, and the implicit integrator
   applies ``kv`` after the constraint solver sized the loop forces with the undamped mass
-  matrix (MuJoCo's documented limitation); with ``timestep·kv`` 3.7–5.9 times that inertia the
-  closed loops went unstable (docs/validation.md, "the hexaglide instability");
+  matrix (MuJoCo's documented limitation); with ``timestep·kv·(M⁻¹)ᵢᵢ`` at 3.7 the closed
+  loops went unstable (docs/validation.md, "the hexaglide instability");
 * contacts are excluded between every two bodies of one leg's chain (base and platform
   included) and between two bodies whose shapes already touch at the exported pose (links
   meeting at neighbouring joints); legs can still touch each other elsewhere;
