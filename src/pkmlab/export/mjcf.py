@@ -23,8 +23,16 @@ Conventions (MuJoCo XML reference, mujoco.readthedocs.io/en/stable/XMLreference.
   orientation-only equality; a delta's parallelogram forearms are declared as S–S rods, which
   alone would let the platform turn);
 * actuators are ``position`` servos named after pkmlab's actuators, ``ctrlrange`` and the
-  joint's ``range`` the stroke or servo window, ``kp`` giving a 20 Hz servo on an equal share
-  of the moving mass, critically damped (``dampratio="1"``);
+  joint's ``range`` the stroke or servo window, ``kp`` giving a :data:`SERVO_HZ` servo on its
+  *design inertia* (an equal share of the moving mass; for a crank, that share at the crank's
+  arm), damped with ``dampratio="1"``;
+* each actuated joint carries the drive's reflected inertia as ``armature``:
+  :data:`DRIVE_INERTIA_SHARE` × the servo's design inertia (an inertia-matched drive). Without
+  it the tree inertia of an actuated joint is only its own body's (a 46 g slider carriage on a
+  10 kg Hexaglide), MuJoCo's ``dampratio`` sizes ``kv`` on that, and the implicit integrator
+  applies ``kv`` after the constraint solver sized the loop forces with the undamped mass
+  matrix (MuJoCo's documented limitation); with ``timestep·kv·(M⁻¹)ᵢᵢ`` at 3.7 the closed
+  loops went unstable (docs/validation.md, "the hexaglide instability");
 * contacts are excluded between every two bodies of one leg's chain (base and platform
   included) and between two bodies whose shapes already touch at the exported pose (links
   meeting at neighbouring joints); legs can still touch each other elsewhere;
@@ -42,7 +50,7 @@ import numpy as np
 from ..tolerances import TOL
 from .model import MassModel, build_model, orientation_guide, relative, segments
 
-__all__ = ["mjcf_text", "quat", "GRAVITY", "SERVO_HZ", "M"]
+__all__ = ["mjcf_text", "quat", "GRAVITY", "SERVO_HZ", "DRIVE_INERTIA_SHARE", "M"]
 
 #: metres per mm
 M = 1e-3
@@ -55,6 +63,9 @@ SERVO_HZ = 50.0
 EQ_TIMECONST = 0.002
 #: kg: the orientation guide's mass (MuJoCo needs a positive one for a body with joints)
 GUIDE_MASS = 1e-6
+#: the actuated joints' armature (the drive's reflected inertia) as a multiple of the inertia
+#: their servo is tuned for (module docstring)
+DRIVE_INERTIA_SHARE = 1.0
 
 
 def quat(R: np.ndarray) -> np.ndarray:
@@ -183,8 +194,9 @@ def mjcf_text(mech, pose=None, mass: MassModel | None = None) -> str:
                 if tj.actuated:
                     lo, hi = mech.stroke
                     f = M if tj.kind == "slide" else 1.0
+                    drive = DRIVE_INERTIA_SHARE * _design_inertia(model, tj, share)
                     kw = dict(ref=_f(tj.value * f), range_=_v([lo * f, hi * f]),
-                              damping="0")
+                              damping="0", armature=_f(drive))
                 lines.append(_tag(pad + "  ", "joint", name=tj.name, type=tj.kind, pos=_v(loc),
                                   axis=_v(axis), **kw))
                 qpos0.append(tj.value * (M if tj.kind == "slide" else 1.0) if tj.actuated
@@ -279,11 +291,7 @@ def mjcf_text(mech, pose=None, mass: MassModel | None = None) -> str:
     w = 2 * math.pi * SERVO_HZ
     for tj in model.actuated:
         lo, hi = mech.stroke
-        if tj.kind == "slide":
-            kp, f = share * w * w, M
-        else:                    # a crank: the share of the mass at the next joint's centre
-            arm = _arm(model, tj) * M
-            kp, f = share * arm * arm * w * w, 1.0
+        kp, f = _design_inertia(model, tj, share) * w * w, (M if tj.kind == "slide" else 1.0)
         out.append(_tag("    ", "position", name=tj.actuator, joint=tj.name, kp=_f(kp),
                         dampratio="1", ctrlrange=_v([lo * f, hi * f])))
     out.append("  </actuator>")
@@ -317,6 +325,15 @@ def _regular_inertia(pm, link_diameter: float) -> np.ndarray:
     if np.linalg.eigvalsh(J)[0] <= TOL.symmetric_rel * max(1.0, float(np.abs(J).max())):
         J = J + 0.4 * float(pm.mass) * (0.5 * link_diameter) ** 2 * np.eye(3)
     return J
+
+
+def _design_inertia(model, tj, share: float) -> float:
+    """The inertia an actuated joint's servo is tuned for: ``share`` kg for a slide, that mass
+    at the crank's arm (kg·m²) for a hinge."""
+    if tj.kind == "slide":
+        return share
+    arm = _arm(model, tj) * M       # a crank: the share of the mass at the next joint's centre
+    return share * arm * arm
 
 
 def _arm(model, tj) -> float:
