@@ -148,3 +148,23 @@ def test_templates_validate_and_run(tmp_path, name, evaluator):
         if evaluator == "tripod_workspace":      # (printer: an infinite speed ratio is null)
             assert all(v is not None or k in r["notes"] for k, v in r["metrics"].items()
                        if k in metrics_of(evaluator)), (r["metrics"], r["notes"])
+    if evaluator == "tripod_workspace":    # open_results gives the tripod's workspace
+        from pkmlab import open_results
+
+        ws = open_results(tmp_path / "out").workspace(rows[0]["seq"])
+        m = rows[0]["metrics"]
+        assert ws.volume * DEG2 == pytest.approx(m["sampled_tripod_volume"], rel=1e-12)
+        assert ws.bracket.lower * DEG2 == pytest.approx(m["tripod_volume_lower"], rel=1e-12)
+
+
+def test_exported_design_draws_the_tripod_sections(mech, tmp_path):
+    from pkmlab.study.export import _tripod_slices
+
+    plan = TripodWorkspaceSpec(tilt="10 deg", resolution_z="20 mm", resolution_angle="5 deg")
+    files, info = [], {}
+    _tripod_slices(tmp_path, mech, plan, files, info)
+    assert files == ["parasitic_slices.png"]
+    assert (tmp_path / files[0]).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    grid = info["tripod_workspace"]
+    assert grid["points"] > 0 and "bracket" not in grid
+    assert grid["parasitic_x_max_mm"] > 0
