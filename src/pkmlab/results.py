@@ -239,11 +239,19 @@ class Results:
 
         req = self.study.evaluation.request
         plan = getattr(self.study.evaluation, "planar_workspace", None)
-        if req is None and not plan:
+        tri = getattr(self.study.evaluation, "tripod_workspace", None)
+        if req is None and not plan and not tri:
             raise ParameterError("evaluate.workspace", "given in the study (it evaluates no "
-                                 "workspace; a planar study: evaluate.planar_workspace)", None)
+                                 "workspace; a planar study: evaluate.planar_workspace; a "
+                                 "tripod: evaluate.tripod_workspace)", None)
         if key not in self._workspaces:
-            if req is None:   # a planar study: its PlanarWorkspace, with the study's request
+            if req is None and tri:   # a tripod study: its grid and bracket
+                from .workspaces.tripod import tripod_workspace
+
+                self._workspaces[key] = tripod_workspace(
+                    mech, tri.tilt, z_range=tri.z_range, resolution_z=tri.resolution_z,
+                    resolution_angle=tri.resolution_angle, bracket_target=tri.target)
+            elif req is None:   # a planar study: its PlanarWorkspace, with the study's request
                 from .study.evaluators.planar_workspace import _phi
                 from .workspaces.planar import planar_workspace
 

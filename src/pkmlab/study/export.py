@@ -170,6 +170,9 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
     step("simulator and CAD formats")
     _mechanism_formats(d, study, spec.build(), files, info)
     ev = study.evaluation
+    if ev.tripod_workspace is not None:
+        step("tripod workspace slices")
+        _tripod_slices(d, spec.build(), ev.tripod_workspace, files, info)
     mech = spec.build() if (ev.workspace is not None or ev.task is not None
                             or ev.motions is not None) else None
     task = _placed_task(ev.task, r["metrics"])
@@ -246,6 +249,27 @@ def _export_one(d: Path, study: Study, r: dict, number: int, rank: int, why: str
         files += [pic.path.name for pic in pictures]
     atomic.write_text(d / "design.json", json.dumps(_plain(info), indent=2) + "\n")
     return info
+
+
+def _tripod_slices(d: Path, mech, plan, files: list, info: dict) -> None:
+    """``parasitic_slices.png``: the (θx, θy) sections of a tripod study's workspace grid at
+    several heights, coloured by the parasitic |(x, y)| (:func:`~pkmlab.workspaces.tripod.
+    plot_tripod`); its grid numbers in ``info["tripod_workspace"]``."""
+    from ..workspaces.tripod import plot_tripod, tripod_workspace
+
+    res = tripod_workspace(mech, plan.tilt, z_range=plan.z_range,
+                           resolution_z=plan.resolution_z,
+                           resolution_angle=plan.resolution_angle, bracket_target=None)
+    info["tripod_workspace"] = {k: v for k, v in res.metrics().items()
+                                if k not in ("bracket", "volume_bracket_mm_deg2",
+                                             "volume_bracket_mm_rad2")}
+    if res.empty:
+        info["tripod_workspace"]["picture"] = "no feasible grid point: nothing to draw"
+        return
+    plot_tripod(res, d / "parasitic_slices.png",
+                title=f"{mech.family}: feasible (θx, θy) sections, "
+                      f"|θx|, |θy| <= {np.degrees(plan.tilt):g}°")
+    files.append("parasitic_slices.png")
 
 
 def _mechanism_formats(d: Path, study: Study, mech, files: list, info: dict) -> None:

@@ -39,7 +39,8 @@ import numpy as np
 
 from ..kernels.interval_arith import Iv, hull
 
-__all__ = ["classify_boxes", "column_bounds", "vertical_rails", "box_constants"]
+__all__ = ["classify_boxes", "column_bounds", "vertical_rails", "box_constants",
+           "parasitic_enclosure"]
 
 
 def box_constants(mech) -> dict:
@@ -77,11 +78,9 @@ def _phi(a: Iv, b: Iv):
     return Iv(lo, hi), bounded
 
 
-def _enclose(mech, z: Iv, ax: Iv, ay: Iv):
-    """The chain of the module docstring over boxes: ``(sure, never, q, disc)`` with ``sure``
-    (the constraint proved solvable, its root choice bounded), ``never`` (proved unsolvable)
-    and per leg the enclosures of ``q_i`` and of its discriminant."""
-    c = box_constants(mech)
+def _dependent(mech, c, ax: Iv, ay: Iv):
+    """Steps 1-3 of the module docstring over boxes of ``(θx, θy)`` (z does not enter):
+    ``(sure, never, legs, x, y, g)``, ``g`` the enclosure of θz (not wrapped)."""
     sa, ca, sb, cb = ax.sin(), ax.cos(), ay.sin(), ay.cos()
     legs = [_leg_w(c, i, mech, sa, ca, sb, cb) for i in range(3)]
     k = [float(v) for v in c["k"]]
@@ -105,6 +104,29 @@ def _enclose(mech, z: Iv, ax: Iv, ay: Iv):
     P = c["P"]
     x = r[0] * float(P[0, 0]) + r[1] * float(P[0, 1]) + r[2] * float(P[0, 2])
     y = r[0] * float(P[1, 0]) + r[1] * float(P[1, 1]) + r[2] * float(P[1, 2])
+    return sure, never, legs, x, y, g
+
+
+def parasitic_enclosure(mech, lo: np.ndarray, hi: np.ndarray):
+    """Enclosures of the dependent coordinates over cells ``[lo, hi]`` ``(N, 2)`` of ``(θx,
+    θy)`` (rad): ``(never, x, y, θz)``, ``never`` (N,) bool where the constraint is proved
+    unsolvable (no feasible point), ``x, y`` (mm) and ``θz`` (rad, not wrapped to ±π: its
+    magnitude bounds that of the wrapped value) as :class:`Iv` (outward rounding). The
+    parasitic motions do not depend on z."""
+    lo = np.asarray(lo, dtype=float).reshape(-1, 2)
+    hi = np.asarray(hi, dtype=float).reshape(-1, 2)
+    _, never, _, x, y, g = _dependent(mech, box_constants(mech), Iv(lo[:, 0], hi[:, 0]),
+                                      Iv(lo[:, 1], hi[:, 1]))
+    return never, x, y, g
+
+
+def _enclose(mech, z: Iv, ax: Iv, ay: Iv):
+    """The chain of the module docstring over boxes: ``(sure, never, q, disc)`` with ``sure``
+    (the constraint proved solvable, its root choice bounded), ``never`` (proved unsolvable)
+    and per leg the enclosures of ``q_i`` and of its discriminant."""
+    c = box_constants(mech)
+    sure, never, legs, x, y, g = _dependent(mech, c, ax, ay)
+    cg, sg = g.cos(), g.sin()
     qs, discs = [], []
     for i in range(3):
         wx, wy, wz = legs[i][:3]

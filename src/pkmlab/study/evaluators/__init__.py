@@ -53,7 +53,7 @@ from .registry import (
 #: dependencies first); each registers itself exactly as a plugin would
 BUILTINS = ("geometry", "workspace", "inscribed", "orientation_capability", "needed_stroke",
             "volume_bracket", "dexterity", "payload", "trajectory", "task", "motions",
-            "actuators", "planar_workspace", "printer", "delta_task")
+            "actuators", "planar_workspace", "printer", "delta_task", "tripod_workspace")
 for _module in BUILTINS:
     importlib.import_module(f"{__name__}.{_module}")
 
