@@ -314,6 +314,11 @@ class DeltaFamily(Mechanism):
         else:               # the shared set-leg kernel, one orientation
             make_set_column_kernel(type(self).column_set_leg, "all")(
                 xs, ys, _kernels.carray(W[None]), P, lo, hi, count)
+        used = int(count.max(initial=0))
+        if 0 < used < K:
+            # only as many slots as a column uses (the rotary delta's sets have 1-2 pieces
+            # against 8 slots): the engine's components, crop and z range scan every slot
+            lo, hi = np.ascontiguousarray(lo[..., :used]), np.ascontiguousarray(hi[..., :used])
         if allowed is not None:
             off = ~np.asarray(allowed, dtype=bool).reshape(len(xs), len(ys), -1)[..., 0]
             lo[off], hi[off] = np.inf, -np.inf
