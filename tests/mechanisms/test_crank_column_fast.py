@@ -113,3 +113,28 @@ def test_leg_sets_against_ik_samples():
     n /= np.linalg.norm(n)
     _leg_set_vs_samples(tuple(u), tuple(np.cross(n, u)), 120.0, 300.0,
                         (-math.radians(150), math.radians(170)), rng)
+
+
+def test_delta_columns_two_slot_pass_falls_back(monkeypatch):
+    """The rotary delta's columns are computed with COLUMN_SLOTS slots first and again with
+    all K when a column needs more: forcing the fallback (one slot, where many columns hold
+    two pieces) gives the same sets as the 8-slot pass, and no overflow."""
+    import pkmlab
+    from conftest import MECH_DIR
+    from pkmlab.mechanisms.families import _delta
+
+    m = pkmlab.load_mechanism(MECH_DIR / "clavel-delta3.yaml")
+    xs, ys = np.arange(-450.0, 451.0, 30.0), np.arange(-520.0, 521.0, 30.0)
+    R = np.eye(3)[None]
+    lo2, hi2, over2 = m.column_intervals(xs, ys, R, "all")
+    monkeypatch.setattr(_delta, "COLUMN_SLOTS", 1)
+    lo1, hi1, over1 = m.column_intervals(xs, ys, R, "all")
+    monkeypatch.setattr(_delta, "COLUMN_SLOTS", 8)
+    lo8, hi8, over8 = m.column_intervals(xs, ys, R, "all")
+    assert over1 == over2 == over8 == 0
+    assert lo2.shape[-1] == 2 and lo1.shape[-1] == 8
+    assert np.any(np.sum(lo8 <= hi8, axis=-1) == 2)          # two-piece columns exist
+    for lo, hi in ((lo1, hi1), (lo2, hi2)):
+        k = lo.shape[-1]
+        assert np.array_equal(lo, lo8[..., :k]) and np.array_equal(hi, hi8[..., :k])
+        assert not np.any(lo8[..., k:] <= hi8[..., k:])
