@@ -8,8 +8,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from conftest import MECH_DIR
 from numba import njit
 
+import pkmlab
+from pkmlab.mechanisms.families import _delta
 from pkmlab.mechanisms.legs import crank
 
 
@@ -119,10 +122,6 @@ def test_delta_columns_two_slot_pass_falls_back(monkeypatch):
     """The rotary delta's columns are computed with COLUMN_SLOTS slots first and again with
     all K when a column needs more: forcing the fallback (one slot, where many columns hold
     two pieces) gives the same sets as the 8-slot pass, and no overflow."""
-    import pkmlab
-    from conftest import MECH_DIR
-    from pkmlab.mechanisms.families import _delta
-
     m = pkmlab.load_mechanism(MECH_DIR / "clavel-delta3.yaml")
     xs, ys = np.arange(-450.0, 451.0, 30.0), np.arange(-520.0, 521.0, 30.0)
     R = np.eye(3)[None]
