@@ -4,8 +4,8 @@ circles). Target: each lower-mobility family within 2× of the slowest six-DOF p
 rate (actuator values per second: poses/s × actuators).
 
 The "driver floor" line runs a five-bar whose per-pose function does nothing: the shared
-drivers' per-pose cost (Euler sines and cosines, buffers) alone. A family with few actuators
-cannot beat that floor × its actuator count, whatever its kernel.
+drivers' per-pose cost (loading the free coordinates, buffers, storing) alone. A family with
+few actuators cannot beat that floor × its actuator count, whatever its kernel.
 
 Run: .venv/bin/python benchmarks/bench_lowmob_planar.py   (exit 1 when a family misses it)
 """
@@ -46,12 +46,14 @@ class _Floor(FiveBar):
 
 
 def poses(mech, rng, n):
-    """``n`` Euler poses around the nominal one, moved in the free coordinates only."""
+    """``n`` poses around the nominal one, moved in and given as the free coordinates."""
     move = np.zeros(6)
     move[mech.mobility.index] = 1.0
     span = np.array([40, 40, 40, *np.radians([15] * 3)])
     X = mech.nominal_pose + move * rng.uniform(-1, 1, (n, 6)) * span
-    return X
+    # in the free coordinates, as the family's users give them (``inverse`` then runs the
+    # free-coordinate driver, :mod:`pkmlab.mechanisms.kernels.ik_free`)
+    return np.ascontiguousarray(mech.mobility.free(X))
 
 
 def rate(mech, X, rounds: int = 5):

@@ -77,8 +77,7 @@ contract suite in ``tests/mechanisms/test_contract.py`` then runs on it):
   ``base_points``, ``platform_points``, ``stroke_window`` and ``tool_offset``
   (:class:`.joints.ParamField`); optionally the column hooks above.
 
-Forward kinematics, the assembly-mode search and the nominal-pose search are generic and live
-here and in :mod:`.solvers`.
+Forward kinematics, the assembly-mode and nominal-pose searches: generic, here and :mod:`.solvers`.
 """
 
 from __future__ import annotations
@@ -97,6 +96,7 @@ from ..tolerances import TOL
 from .joints import JointsMixin, base_joint_axes_of, link_segments_of
 from .kernels import columns as column_kernels
 from .kernels import ik as _kernels
+from .kernels import ik_free as _ik_free
 from .kernels import tiles as _tiles
 from .mobility import SPATIAL, Mobility
 from .results import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult
@@ -374,7 +374,9 @@ class Mechanism(JointsMixin):
         if isinstance(poses, tuple):
             p, R = _frames_tuple(poses)
             return self._run_ik(p, R, lo, hi)
-        X = self._free_to_full(np.asarray(poses, dtype=float))
+        X = np.asarray(poses, dtype=float)
+        if (free := _ik_free.free_rows(self.mobility, X)) is not None:
+            return _ik_free.inverse_free(self, free, lo, hi)    # not expanded to six
         if X.ndim <= 2 and X.shape[-1] == POSE_SIZE:
             return self._run_ik(np.ascontiguousarray(X.reshape(-1, POSE_SIZE)), None, lo, hi)
         p, R = as_frames(X)
@@ -382,10 +384,8 @@ class Mechanism(JointsMixin):
 
     def _free_to_full(self, X: np.ndarray) -> np.ndarray:
         """Poses given in a non-spatial mobility's free coordinates → six coordinates."""
-        mob = self.mobility
-        if mob.is_spatial or X.ndim == 0 or X.ndim > 2 or X.shape[-1] != mob.width:
-            return X
-        return mob.full(X, self.nominal_pose)
+        free = _ik_free.free_rows(self.mobility, X)
+        return X if free is None else self.mobility.full(free, self.nominal_pose)
 
     def _frames(self, poses) -> tuple[np.ndarray, np.ndarray]:
         if isinstance(poses, tuple):

@@ -59,6 +59,9 @@ __all__ = ["trilaterate", "DeltaFamily", "Singularities", "make_columns"]
 #: which :meth:`DeltaFamily.singularities` calls a pose singular (algorithm constants)
 PARALLEL_TOL = 1e-6
 SERIAL_TOL = 1e-6
+#: interval slots of a column in the first pass of :meth:`DeltaFamily.column_intervals`
+#: (a rotary delta's columns hold one or two pieces; more is rare and triggers a second pass)
+COLUMN_SLOTS = 2
 
 
 def trilaterate(c: np.ndarray, r: np.ndarray):
@@ -305,19 +308,32 @@ class DeltaFamily(Mechanism):
                                  "translates)", f"{len(R)} rotations")
         xs, ys = _kernels.carray(xs), _kernels.carray(ys)
         K = min(K, self.column_pieces)
-        lo, hi = np.empty((len(xs), len(ys), K)), np.empty((len(xs), len(ys), K))
-        count = np.empty((len(xs), len(ys)), dtype=np.int64)
         W = _kernels.carray(self.leg_offsets(R)[0])
         P = _kernels.carray(self.column_params())
         if K == 1:          # every leg's set is one interval: no set machinery
-            make_columns(type(self).column_set_leg)(xs, ys, W, P, lo, hi, count)
-        else:               # the shared set-leg kernel, one orientation
-            make_set_column_kernel(type(self).column_set_leg, "all")(
-                xs, ys, _kernels.carray(W[None]), P, lo, hi, count)
+            lo, hi, count = self._columns(xs, ys, W, P, 1, single=True)
+        else:
+            # the shared set-leg kernel, one orientation, first with the slots most columns
+            # need (COLUMN_SLOTS: the engine's components, crop and z range then scan 2
+            # slots, not 8); again with K only if a column (or an intermediate
+            # intersection) needed more
+            lo, hi, count = self._columns(xs, ys, W, P, min(K, COLUMN_SLOTS))
+            if K > COLUMN_SLOTS and np.any(count > COLUMN_SLOTS):
+                lo, hi, count = self._columns(xs, ys, W, P, K)
         if allowed is not None:
             off = ~np.asarray(allowed, dtype=bool).reshape(len(xs), len(ys), -1)[..., 0]
             lo[off], hi[off] = np.inf, -np.inf
         return lo, hi, int(np.sum(count > K))
+
+    def _columns(self, xs, ys, W, P, K, single=False):
+        lo, hi = np.empty((len(xs), len(ys), K)), np.empty((len(xs), len(ys), K))
+        count = np.empty((len(xs), len(ys)), dtype=np.int64)
+        if single:
+            make_columns(type(self).column_set_leg)(xs, ys, W, P, lo, hi, count)
+        else:
+            make_set_column_kernel(type(self).column_set_leg, "all")(
+                xs, ys, _kernels.carray(W[None]), P, lo, hi, count)
+        return lo, hi, count
 
 
 _F1, _F2, _F3 = nt.float64[::1], nt.float64[:, ::1], nt.float64[:, :, ::1]

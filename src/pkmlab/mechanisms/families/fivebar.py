@@ -58,10 +58,12 @@ def _fivebar_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmi
         dx, dy = px - g[2 * i], py - g[2 * i + 1]
         l1, l2, b = g[4 + i], g[6 + i], g[8 + i]
         d2 = dx * dx + dy * dy
-        c = (l1 * l1 + d2 - l2 * l2) / (2.0 * l1 * math.sqrt(d2))
-        ok = abs(c) <= 1.0
-        c = min(1.0, max(-1.0, c))
-        s = b * math.sqrt(1.0 - c * c)
+        # the elbow angle's cosine and sine times 2·l1·|AP| (atan2 below needs no scale): no
+        # division, one square root; real where |cos| <= 1, i.e. c² <= (2·l1·|AP|)²
+        c = l1 * l1 + d2 - l2 * l2
+        r2 = 4.0 * l1 * l1 * d2
+        ok = c * c <= r2
+        s = b * math.sqrt(max(r2 - c * c, 0.0))
         # the elbow's direction: A→P turned by the elbow angle (cos c, sin s), then measured
         # from the motor window's centre g[10] (cos g[11], sin g[12]): one atan2, no wrap
         vx, vy = dx * c - dy * s, dx * s + dy * c

@@ -93,8 +93,14 @@ def _quad_roots(B, C, out, n):
 
 
 @register_jitable
-def _ok(t, e0, e1, f0, f1, g0, b, eps, amin, amax):
-    """The IK test at ``t``: real, not degenerate, angle within the window."""
+def _ok(t, e0, e1, f0, f1, g0, b, eps, cmin, smin, cmax, smax, wide):
+    """The IK test at ``t``: real, not degenerate, angle within the window. The angle
+    ``α = atan2(Y, X)`` (the IK's) is compared with the window's edge directions by cross
+    products instead of being computed (no atan2): within a window of width <= π, ``α`` is
+    counter-clockwise of ``α_min`` and clockwise of ``α_max``; in a wider one (``wide``), either
+    (the complement of the open cone from ``α_max`` to ``α_min``). The two tests differ only
+    for ``α`` on an edge; the caller tests midpoints of pieces whose ends are the edges'
+    crossings."""
     E = e0 + e1 * t
     F = f0 + f1 * t
     G = t * t + g0
@@ -103,8 +109,11 @@ def _ok(t, e0, e1, f0, f1, g0, b, eps, amin, amax):
     if h2 < 0.0 or rho2 <= eps:
         return False
     h = math.sqrt(h2)
-    al = math.atan2(F * G + b * E * h, E * G - b * F * h)
-    return amin <= al <= amax
+    Y = F * G + b * E * h
+    X = E * G - b * F * h
+    after_min = cmin * Y - smin * X >= 0.0
+    before_max = X * smax - Y * cmax >= 0.0
+    return (after_min or before_max) if wide else (after_min and before_max)
 
 
 @register_jitable
@@ -137,18 +146,33 @@ def _d_roots(e0, e1, f0, f1, g0, A, L, tlo, thi, T):
     p = (2.0 * g0 - A) / L2
     q = -Bq / (L2 * L)
     r = (g0 * g0 - Cq) / (L2 * L2)
-    # resolvent: m³ + p m² + (p²/4 − r) m − q²/8 = 0, largest root (≥ 0 in exact arithmetic)
-    m = _cubic_largest(p, 0.25 * p * p - r, -0.125 * q * q)
-    m = m if m > 0.0 else 0.0
-    s2 = math.sqrt(2.0 * m)
-    c = 0.5 * p + m
-    if m > 1e-6:
-        k = q / (2.0 * s2)
+    if q == 0.0:
+        # biquadratic (no linear term: the crank's zero direction horizontal and its 90°
+        # direction vertical, as the delta3 and rss6 generators build them): u = T² solves
+        # u² + p u + r = 0, T = ±√u, no resolvent cubic; then polished as Ferrari's roots
+        n = 0
+        if _quad_roots(p, r, T, 0) == 2:
+            u1 = T[0]
+            u2 = T[1]
+            for u in (u1, u2):
+                if u >= 0.0:
+                    T[n] = math.sqrt(u)
+                    T[n + 1] = -T[n]
+                    n += 2
     else:
-        kk = c * c - r
-        k = math.copysign(math.sqrt(kk if kk > 0.0 else 0.0), q)
-    n = _quad_roots(-s2, c + k, T, 0)
-    n = _quad_roots(s2, c - k, T, n)
+        # resolvent: m³ + p m² + (p²/4 − r) m − q²/8 = 0, largest root (≥ 0 in exact
+        # arithmetic)
+        m = _cubic_largest(p, 0.25 * p * p - r, -0.125 * q * q)
+        m = m if m > 0.0 else 0.0
+        s2 = math.sqrt(2.0 * m)
+        c = 0.5 * p + m
+        if m > 1e-6:
+            k = q / (2.0 * s2)
+        else:
+            kk = c * c - r
+            k = math.copysign(math.sqrt(kk if kk > 0.0 else 0.0), q)
+        n = _quad_roots(-s2, c + k, T, 0)
+        n = _quad_roots(s2, c - k, T, n)
     for j in range(n):
         t = T[j] * L
         if tlo - 1.0 <= t <= thi + 1.0:
@@ -194,6 +218,7 @@ def crank_leg_set(dx, dy, wz, ux, uy, uz, vx, vy, vz, a, s, b, amin, amax, cmin,
     g0 = dx * dx + dy * dy + a * a - s * s
     eps = 1e-24 * a * a * a * a
     T = out_hi                                     # scratch for the breakpoints
+    wide = amax - amin > math.pi
     tlo = zlo + wz
     thi = zhi + wz
     A = e1 * e1 + f1 * f1
@@ -255,7 +280,7 @@ def crank_leg_set(dx, dy, wz, ux, uy, uz, vx, vy, vz, a, s, b, amin, amax, cmin,
         t1 = T[j + 1]
         if not t1 > t0:
             continue
-        if _ok(0.5 * (t0 + t1), e0, e1, f0, f1, g0, b, eps, amin, amax):
+        if _ok(0.5 * (t0 + t1), e0, e1, f0, f1, g0, b, eps, cmin, smin, cmax, smax, wide):
             # piece cnt <= j: writing out_hi[cnt] never overwrites an unread T[j + 1]
             if open_:
                 out_hi[cnt - 1] = t1 - wz
