@@ -12,14 +12,18 @@ gets certified bounds over all its samples:
   Jacobian at the box centre, so ``‖J(s) - J₀‖₂ <= δ = ‖Δ‖_F`` (``δ_h`` for ``J_h``, the
   angular columns divided by ``L``);
 * from one LU of ``J₀`` (:func:`._linalg.sweep_one`): ``σ̄ >= σmax(J_h₀)`` and
-  ``ι >= ‖J_h₀⁻¹‖₂`` (Gram-trace bounds, :func:`._linalg._gram_lambda_max`), ``ρ >=
-  ‖(J_h₀⁻¹)_{0:3, :}‖₂`` (Frobenius) and the column norms ``g_c = ‖(J_h₀⁻¹)_{0:3, c}‖`` (the
-  first three rows of ``J_h⁻¹`` are those of ``J⁻¹``);
-* where ``ι δ_h < 1`` (Weyl and the Neumann series): ``κ(J_h(s)) <= K = (σ̄ + δ_h) ι /
-  (1 - ι δ_h)``; ``‖(J_h(s)⁻¹ - J_h₀⁻¹)_{0:3, :}‖₂ = ‖(J_h₀⁻¹)_{0:3, :} (J_h(s) - J_h₀)
-  J_h(s)⁻¹‖₂``, and ``‖J_h(s)⁻¹ e_c‖ <= ‖b_c‖ / (1 - ι δ_h)`` (``b_c`` the column of
-  ``J_h₀⁻¹``), so ``‖(J(s)⁻¹)_{0:3, c}‖ <= g_c + ρ δ_h ‖b_c‖ / (1 - ι δ_h)``, which bounds the
-  force ``min_c fmax_c / ‖(J(s)⁻¹)_{0:3, c}‖`` below by ``F``; and ``J_h₀ + t (J_h(s) - J_h₀)`` is non-singular for
+  ``ι >= ‖J_h₀⁻¹‖₂`` (Gram-trace bounds, :func:`._linalg._gram_lambda_max`) and the column
+  norms ``g_c = ‖(J_h₀⁻¹)_{0:3, c}‖`` (the first three rows of ``J_h⁻¹`` are those of
+  ``J⁻¹``);
+* with ``D_h`` the entrywise bound of ``|J_h(s) - J_h₀|``, ``‖J_h₀⁻¹ (J_h(s) - J_h₀)‖₂ <= μ =
+  min(ι δ_h, ‖ |J_h₀⁻¹| D_h ‖_F)`` (``|M Δ x| <= |M| D |x|`` entrywise) and
+  ``‖(J_h₀⁻¹)_{0:3, :} (J_h(s) - J_h₀)‖₂ <= ν``, the Frobenius norm of the first three rows
+  of ``|J_h₀⁻¹| D_h``;
+* where ``μ < 1`` (Weyl and the Neumann series): ``κ(J_h(s)) <= K = (σ̄ + δ_h) ι /
+  (1 - μ)``; ``(J_h(s)⁻¹ - J_h₀⁻¹)_{0:3, c} = -(J_h₀⁻¹)_{0:3, :} (J_h(s) - J_h₀) J_h(s)⁻¹ e_c``
+  and ``‖J_h(s)⁻¹ e_c‖ <= ‖b_c‖ / (1 - μ)`` (``b_c`` the column of ``J_h₀⁻¹``), so
+  ``‖(J(s)⁻¹)_{0:3, c}‖ <= g_c + ν ‖b_c‖ / (1 - μ)``, which bounds the force
+  ``min_c fmax_c / ‖(J(s)⁻¹)_{0:3, c}‖`` below by ``F``; and ``J_h₀ + t (J_h(s) - J_h₀)`` is non-singular for
   ``t ∈ [0, 1]``, so ``det J(s)`` has the sign of ``det J₀``.
 
 Every bound is multiplied (or divided) by ``1 + KAPPA_ROUND`` per rounded quantity, and a cell
@@ -108,31 +112,40 @@ def _bounds_kernel(jac, box, ng: int):
                 if not (la > 0.0 and lb > 0.0 and d0 != 0.0):
                     continue
                 sigma, iota = math.sqrt(la) * r, math.sqrt(lb) * r    # B = J_h0⁻¹
-                rho = 0.0                                   # ‖(J_h0⁻¹)_{0:3, :}‖_F
-                for i in range(3):
-                    for c in range(6):
-                        rho += B[i, c] * B[i, c]
-                rho = math.sqrt(rho) * r
                 dh2 = 0.0
                 for i in range(6):
                     for c in range(6):
                         x = J[0, i, c]
                         e = max(Jhi[i, c] - x, x - Jlo[i, c], 0.0)
-                        dh2 += e * e if c < 3 else (e / L) * (e / L)
+                        e = e if c < 3 else e / L
+                        Jlo[i, c] = e                       # D_h: |J_h(s) - J_h0| <= D_h
+                        dh2 += e * e
                 dh = math.sqrt(dh2) * r
-                if not iota * dh * r < 1.0:
+                mu2 = 0.0                                   # ‖ |J_h0⁻¹| D_h ‖_F², and rows 0:3
+                nu2 = 0.0
+                for i in range(6):
+                    for c in range(6):
+                        v = 0.0
+                        for k in range(6):
+                            v += abs(B[i, k]) * Jlo[k, c]
+                        mu2 += v * v
+                        if i < 3:
+                            nu2 += v * v
+                mu = min(iota * dh, math.sqrt(mu2) * r) * r   # >= ‖J_h0⁻¹ (J_h(s) - J_h0)‖₂
+                nu = math.sqrt(nu2) * r * r
+                if not mu < 1.0:
                     continue
-                kb = (sigma + dh) * iota / (1.0 - iota * dh) * r * r * r
+                kb = (sigma + dh) * iota / (1.0 - mu) * r * r * r
                 if not kb < _KMAX:
                     continue
-                eps = rho * dh / (1.0 - iota * dh) * r * r
                 fb = np.inf
                 for c in range(6):
                     gc = B[0, c] * B[0, c] + B[1, c] * B[1, c] + B[2, c] * B[2, c]
                     bc = gc
                     for i in range(3, 6):
                         bc += B[i, c] * B[i, c]
-                    fb = min(fb, fmax[c] / ((math.sqrt(gc) * r + eps * math.sqrt(bc) * r) * r))
+                    eps = nu * math.sqrt(bc) / (1.0 - mu) * r * r
+                    fb = min(fb, fmax[c] / ((math.sqrt(gc) * r + eps) * r))
                 K[t, m], F[t, m], S[t, m] = kb, fb / r, 1 if d0 > 0.0 else -1
 
     f8, f1, f2, f3 = nt.float64, nt.float64[::1], nt.float64[:, ::1], nt.float64[:, :, ::1]
