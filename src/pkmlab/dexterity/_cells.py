@@ -65,8 +65,13 @@ _KMAX = 1e8
 
 
 def cells_available(mech) -> bool:
-    """True when ``mech`` has a fused Jacobian kernel and a box Jacobian (``_jac_box``)."""
-    return fused_available(mech) and getattr(type(mech), "_jac_box", None) is not None
+    """True when ``mech`` has a fused Jacobian kernel and a box Jacobian (``_jac_box``)
+    declared by the same class as its ``_jac_one`` (a subclass with its own ``_jac_one`` does
+    not inherit the box of another)."""
+    if not fused_available(mech):
+        return False
+    owner = next(c for c in type(mech).__mro__ if "_jac_one" in vars(c))
+    return vars(owner).get("_jac_box") is not None
 
 
 @cache

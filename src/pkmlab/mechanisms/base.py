@@ -145,10 +145,6 @@ class Mechanism(JointsMixin):
     #: values, from the IK without stroke) is computed only when ``_jac_uses_q``.
     _jac_one: ClassVar[Any] = None
     _jac_uses_q: ClassVar[bool] = False
-    #: numba enclosure of ``_jac_one`` over a box of poses, ``jac_box(plo, phi, Rlo, Rhi, g,
-    #: Jlo, Jhi) -> bool`` (optional; :mod:`.kernels.boxes`): the worst case's certified
-    #: bounds over cells of poses (:mod:`pkmlab.dexterity._cells`)
-    _jac_box: ClassVar[Any] = None
     #: ``"linear"`` / ``"quadratic"`` when the family supplies exact column kernels
     #: (``column_leg``) for the workspace engine, ``"crank"`` for rss6's set-valued legs (it
     #: overrides ``column_intervals``, :mod:`._set_columns`), ``None`` for sampled evaluation.

@@ -1,6 +1,9 @@
 """Interval arithmetic for the families' box Jacobians (``_jac_box``, issue 28 item 2).
 
-A family's ``_jac_box(plo, phi, Rlo, Rhi, g, Jlo, Jhi)`` encloses its Jacobian ``J(p, R)``
+A family may set the class attribute ``_jac_box`` (psu6 and ups6 do; read by
+:func:`pkmlab.dexterity._cells.cells_available`, absent means no cell bounds) to a numba
+function ``_jac_box(plo, phi, Rlo, Rhi, g, Jlo, Jhi)``, with ``g`` the IK geometry of its
+``_jac_one``, that encloses its Jacobian ``J(p, R)``
 over every position ``plo <= p <= phi`` and rotation whose entries lie in ``Rlo <= R <= Rhi``
 (entrywise): ``Jlo <= J <= Jhi``. It returns False when it cannot (a link may become
 horizontal in the box, a leg may have no real solution): the caller then evaluates pose by
