@@ -1,12 +1,14 @@
-"""The exact worst case (issue 28 item 1): the fused Jacobian + bounds kernel against the unfused
-path (NumPy Jacobians, then ``sweep_bounds``), on sampled designs of the demo study, in one run.
+"""The exact worst case (issue 28 item 2), on sampled designs of the demo study, in one run:
+the pass of the previous stop (the fused kernel, every sample evaluated, ``worst.CELLS =
+False``) and the branch and bound over cells (:mod:`pkmlab.dexterity._cells`).
 
 For each valid design of a Sobol sample of the demo study's space: its ±15° dexterous
-workspace (the study's request), then ``pkmlab.dexterity.worst_case`` with
-``worst.FUSED = False`` (before) and ``True`` (now), alternately, ``--repeats`` times each.
-Reported: CPU time (``time.process_time``, one numba thread as in a study worker) per design,
-the median ratio, the load average, and whether every output of the two is identical (the
-whole ``WorstCase.as_dict()`` but its wall time, compared with ``==``, NaN equal to NaN).
+workspace (the study's request), then ``pkmlab.dexterity.worst_case`` in the two modes,
+alternately, ``--repeats`` times each. Reported: CPU time (``time.process_time``, one numba
+thread as in a study worker) per design, the median ratios, the load average, and whether the
+outputs are identical (the whole ``WorstCase.as_dict()`` but its wall time, compared with
+``==``, NaN equal to NaN; for the cells also without ``exact``, the count of exact κ
+evaluations, which pruning changes, and its mention in ``method``).
 
     python benchmarks/bench_worst_case.py [--designs N] [--repeats R]
 """
@@ -48,10 +50,20 @@ def same(a, b) -> bool:
     return a == b
 
 
-def summary(wc) -> dict:
+def summary(wc, exact=True) -> dict:
     d = wc.as_dict()
     d.pop("seconds")
+    if not exact:
+        d.pop("exact_kappa_evaluations")
+        d["method"] = d["method"].split("; exact κ at")[0]
     return d
+
+
+MODES = {"before": False, "cells": True}
+
+
+def _mode(name):
+    worst.CELLS = MODES[name]
 
 
 def main() -> None:
@@ -74,38 +86,40 @@ def main() -> None:
         cases.append((res.mechanism, res, dx.resolve_length(res.mechanism)))
     load0 = os.getloadavg()
     mech, res, L = cases[0]
-    for flag in (False, True):                                     # warm-up (compilation)
-        worst.FUSED = flag
+    for name in MODES:                                             # warm-up (compilation)
+        _mode(name)
         dx.worst_case(mech, res, L, 150.0)
-    cpu = {False: [], True: []}
-    identical = 0
+    cpu = {name: [] for name in MODES}
+    identical = {"cells": 0, "cells, every field": 0}
     sizes = []
     for mech, res, L in cases:
-        t = {False: [], True: []}
+        t = {name: [] for name in MODES}
         out = {}
         for _ in range(repeats):
-            for flag in (False, True):
-                worst.FUSED = flag
+            for name in MODES:
+                _mode(name)
                 c0 = time.process_time()
-                out[flag] = dx.worst_case(mech, res, L, 150.0)
-                t[flag].append(time.process_time() - c0)
-        for flag in t:
-            cpu[flag].append(min(t[flag]))
-        identical += same(summary(out[False]), summary(out[True]))
-        sizes.append(out[True].poses)
-    worst.FUSED = True
-    a, b = np.array(cpu[False]), np.array(cpu[True])
+                out[name] = dx.worst_case(mech, res, L, 150.0)
+                t[name].append(time.process_time() - c0)
+        for name in t:
+            cpu[name].append(min(t[name]))
+        identical["cells"] += same(summary(out["before"], False), summary(out["cells"], False))
+        identical["cells, every field"] += same(summary(out["before"]), summary(out["cells"]))
+        sizes.append(out["before"].poses)
+    _mode("cells")
+    a = np.array(cpu["before"])
     print(f"exact worst case, {len(cases)} designs of the demo study (median "
           f"{np.median(sizes):,.0f} poses: units and column ends x orientations), best of "
           f"{repeats} per design, 1 numba thread; load average "
           f"{load0[0]:.2f} -> {os.getloadavg()[0]:.2f} (2 cores)")
-    print(f"  unfused (before): {1e3 * np.median(a):.1f} ms CPU per design (median), "
-          f"{1e3 * a.sum():.0f} ms in all")
-    print(f"  fused   (now):    {1e3 * np.median(b):.1f} ms CPU per design (median), "
-          f"{1e3 * b.sum():.0f} ms in all")
-    print(f"  speed-up: {np.median(a / b):.2f}x per design (median; range "
-          f"{np.min(a / b):.2f}-{np.max(a / b):.2f}), {a.sum() / b.sum():.2f}x in all")
-    print(f"  identical results (every WorstCase field): {identical} of {len(cases)}")
+    for name, label in (("before", "every sample (before)"), ("cells", "cells (now)")):
+        b = np.array(cpu[name])
+        print(f"  {label:28s} {1e3 * np.median(b):6.1f} ms CPU per design (median), "
+              f"{1e3 * b.sum():6.0f} ms in all; speed-up {np.median(a / b):.2f}x per design "
+              f"(median; range {np.min(a / b):.2f}-{np.max(a / b):.2f}), "
+              f"{a.sum() / b.sum():.2f}x in all")
+    for k, v in identical.items():
+        print(f"  identical results, {k}: {v} of {len(cases)}")
 
 
 if __name__ == "__main__":

@@ -30,7 +30,7 @@ from ..runtime.jit import cached_kernel
 from ..runtime.threads import threads_for
 from ._linalg import sweep_one
 
-__all__ = ["fused_available", "fused_sweep"]
+__all__ = ["fused_available", "fused_sweep", "fused_sweep_at"]
 
 #: poses per parallel task (each task has its own scratch matrices)
 _TASK = 512
@@ -77,6 +77,49 @@ def _kernel(jac, ng: int):
                          nt.void(f2, f3, nt.boolean[:, ::1], nt.UniTuple(nt.float64, ng),
                                  f8, f1, f2, f2, f2),
                          parallel=True, error_model="numpy")
+
+
+@cache
+def _kernel_at(jac, ng: int):
+    """:func:`_kernel`'s per-pose loop on a list of poses (flat ``m · U + u``)."""
+
+    def fused_at_loop(P, R, at, g, L, fmax, kup, force, det):
+        U = P.shape[0]
+        n = at.shape[0]
+        for task in prange((n + _TASK - 1) // _TASK):
+            J = np.empty((1, 6, 6))
+            A = np.empty((6, 6))
+            B = np.empty((6, 6))
+            G = np.empty((6, 6))
+            T = np.empty((6, 6))
+            piv = np.empty(6, np.int64)
+            q = np.empty((1, 6))
+            for j in range(task * _TASK, min(n, (task + 1) * _TASK)):
+                i = at[j]
+                m, u = i // U, i % U
+                jac(P[u, 0], P[u, 1], P[u, 2], R[m, 0, 0], R[m, 0, 1], R[m, 0, 2],
+                    R[m, 1, 0], R[m, 1, 1], R[m, 1, 2], R[m, 2, 0], R[m, 2, 1], R[m, 2, 2],
+                    g, q, J, 0)
+                kup[m, u], force[m, u], det[m, u] = sweep_one(J[0], L, fmax, A, B, G, T, piv)
+
+    f8, f1, f2, f3 = nt.float64, nt.float64[::1], nt.float64[:, ::1], nt.float64[:, :, ::1]
+    return cached_kernel(fused_at_loop,
+                         nt.void(f2, f3, nt.int64[::1], nt.UniTuple(nt.float64, ng),
+                                 f8, f1, f2, f2, f2),
+                         parallel=True, error_model="numpy")
+
+
+def fused_sweep_at(mech, P, R, at, L, fmax, kup, force, det) -> None:
+    """:func:`fused_sweep`'s values at the poses ``at`` (flat ``m · U + u`` indices,
+    orientation-major) written into ``kup, force, det (k, U)`` (C-contiguous float64); the
+    other entries are left as they are (the poses :mod:`._cells` does not prune)."""
+    P = np.require(P, np.float64, ("C", "A", "W"))
+    R = np.require(R, np.float64, ("C", "A", "W"))
+    at = np.require(at, np.int64, ("C", "A", "W"))
+    fmax = np.require(np.broadcast_to(fmax, (6,)), np.float64, ("C", "A", "W"))
+    jac, g = mech.jacobian_kernel()
+    with threads_for(len(at)):
+        _kernel_at(jac, len(g))(P, R, at, g, float(L), fmax, kup, force, det)
 
 
 def fused_sweep(mech, P, R, feas, L, fmax):

@@ -266,6 +266,15 @@ def _sweep_pose(J, m, L, fmax, kup, force, det, A, B, G, T, piv):
 def sweep_one(Jm, L, fmax, A, B, G, T, piv):
     """``(kup, force, det)`` of one ``Jm (6, 6)`` (:func:`sweep_bounds`), with scratch
     ``A, B, G, T (6, 6)`` and ``piv (6,)`` int64."""
+    la, lb, fm, d = sweep_core(Jm, L, fmax, A, B, G, T, piv)
+    return (math.sqrt(la * lb) if la > 0.0 and lb > 0.0 else np.inf), fm, d
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def sweep_core(Jm, L, fmax, A, B, G, T, piv):
+    """:func:`sweep_one`'s parts: ``(la, lb, force, det)`` with ``la >= λmax(J_hᵀJ_h)`` and
+    ``lb >= λmax(J_h⁻ᵀJ_h⁻¹)`` (``-1`` for a non-finite or exactly singular ``Jm``); on
+    return ``B`` holds ``J_h⁻¹`` and ``A`` its transpose."""
     finite = True
     for i in range(6):
         for k in range(6):
@@ -274,7 +283,7 @@ def sweep_one(Jm, L, fmax, A, B, G, T, piv):
                 finite = False
             A[i, k] = v
     if not finite:
-        return np.inf, np.nan, np.nan
+        return -1.0, -1.0, np.nan, np.nan
     d = 1.0
     zero = False
     for k in range(6):
@@ -301,7 +310,7 @@ def sweep_one(Jm, L, fmax, A, B, G, T, piv):
             for c in range(k + 1, 6):
                 A[i, c] -= f * A[k, c]
     if zero:
-        return np.inf, 0.0, 0.0
+        return -1.0, -1.0, 0.0, 0.0
     for i in range(6):                    # B = P·I, then forward and back substitution
         for c in range(6):
             B[i, c] = 1.0 if i == c else 0.0
@@ -341,7 +350,7 @@ def sweep_one(Jm, L, fmax, A, B, G, T, piv):
         for c in range(6):
             A[i, c] = B[c, i]
     lb = _gram_lambda_max(A, G, T)
-    return (math.sqrt(la * lb) if la > 0.0 and lb > 0.0 else np.inf), fm, d
+    return la, lb, fm, d
 
 
 #: ``kup / KAPPA_BRACKET`` of :func:`sweep_bounds` is a lower bound on κ (exact arithmetic).

@@ -71,6 +71,7 @@ import numpy as np
 
 from ..poses import POSE_SIZE, matrix_to_euler
 from ._boundary import column_ends
+from ._cells import CellPlan, cells_available
 from ._fused import fused_available, fused_sweep
 from ._linalg import KAPPA_BRACKET, KAPPA_ROUND, kappa_upper
 from .aggregate import _CHUNK, _ik_valid, _units, _voxels, orientation_batches
@@ -91,6 +92,9 @@ _EXACT_BATCH = 256
 #: unfused path (NumPy Jacobians, then :func:`sweep_bounds`) gives the same values bit for bit
 #: and is kept as the reference of the tests and benchmarks
 FUSED = True
+#: prune the per-pose pass by certified bounds over cells of neighbouring units
+#: (:mod:`._cells`) where the family has a box Jacobian; False: every sample is evaluated
+CELLS = True
 _ROUND = KAPPA_ROUND   # relative allowance for rounding in the κ bound of sweep_bounds
 _SINGULAR_BOUND = KAPPA_SINGULAR / KAPPA_BRACKET / (1 + _ROUND) ** 2   # may be singular
 
@@ -355,8 +359,8 @@ def worst_case(mech, result, L: float | CharacteristicLength | None = None,
     for m0, n, p, Rr in (orientation_batches(ends.probe, Rs) if E else ()):
         feas_end[:, m0:m0 + n] = _ik_valid(mech, p, Rr).reshape(n, E).T
 
-    vox = _sweep(mech, unit_pos, Rs, feas, L, fmax)
-    bnd = _sweep(mech, end_pos, Rs, feas_end, L, fmax)
+    vox = _sweep(mech, unit_pos, Rs, feas, L, fmax, result.resolution)
+    bnd = _sweep(mech, end_pos, Rs, feas_end, L, fmax, result.resolution)
     # exact κ where the bound reaches the maximum (decreasing bound, stop once below it)
     kmax, k_arg, exact, n_sing = _exact_max(mech, unit_pos, Rs, vox.cand, vox.up, L)
     bmax, b_arg, b_exact, b_sing = _exact_max(mech, end_pos, Rs, bnd.cand, bnd.up, L)
@@ -477,10 +481,12 @@ class _Sweep:
     f_arg: tuple | None   # its (unit, orientation)
 
 
-def _sweep(mech, unit_pos, Rs, feas, L, fmax) -> _Sweep:
+def _sweep(mech, unit_pos, Rs, feas, L, fmax, h=None) -> _Sweep:
     """One LU per feasible (unit, orientation) pose (:func:`sweep_bounds`): det J's sign, the
     candidates for the largest κ (bound at or above the largest certified lower bound, or
-    possibly singular) and the smallest force."""
+    possibly singular) and the smallest force. With a grid step ``h`` and :data:`CELLS`, the
+    samples that certified cell bounds exclude from both extremes are skipped (:mod:`._cells`:
+    the same extremes, arguments, signs)."""
     U, M = len(unit_pos), len(Rs)
     sign = np.zeros((U, M), dtype=np.int8)
     cand_idx, cand_up = [np.empty(0, dtype=np.int64)], [np.empty(0)]
@@ -488,11 +494,17 @@ def _sweep(mech, unit_pos, Rs, feas, L, fmax) -> _Sweep:
     f_min, f_arg = math.inf, None
     step = max(1, _CHUNK // max(U, 1))
     fused = FUSED and fused_available(mech)
+    plan = None
+    if fused and CELLS and h and U and cells_available(mech):
+        plan = CellPlan(mech, unit_pos, Rs, feas, L, fmax, h, lambda u, m: float(
+            condition_number(mech.jacobian((unit_pos[[u]], Rs[[m]])), L)[0]))
     for m0 in range(0, M if U else 0, step):
         Rm = Rs[m0:m0 + step]
         k = len(Rm)
         fe = feas[:, m0:m0 + k]
-        if fused:       # Jacobian and bounds in one numba loop, infeasible poses skipped
+        if plan is not None:
+            kup, force, det = plan.chunk(m0, k)
+        elif fused:       # Jacobian and bounds in one numba loop, infeasible poses skipped
             kup, force, det = fused_sweep(mech, unit_pos, Rm, fe, L, fmax)
         else:
             J = mech.jacobian((np.tile(unit_pos, (k, 1)), np.repeat(Rm, U, axis=0)))

@@ -28,6 +28,7 @@ from ...quantities import LinkLengths
 from ...specbase import PairedCircles, _Common
 from ..base import NO_STROKE, Mechanism, as_points, as_positive, as_stroke, as_vector3
 from ..joints import DEFAULT_FIELDS, ParamField, kind_arrays, kind_template, platform_joints
+from ..kernels import boxes as _box
 from ..kernels import ik as _kernels
 from ..legs.layout import PAIRED_ALIASES, build_paired
 
@@ -71,6 +72,40 @@ def _psu_jac_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, q, 
         J[k, i, 3] = (ry * az - rz * ay) / az
         J[k, i, 4] = (rz * ax - rx * az) / az
         J[k, i, 5] = (rx * ay - ry * ax) / az
+
+
+@register_jitable(inline="always")
+def _psu_jac_box(plo, phi, Rlo, Rhi, g, Jlo, Jhi):
+    """:func:`_psu_jac_one` enclosed over a box of poses (:mod:`..kernels.boxes`): row i is
+    ``[t_x, t_y, 1, r_y - r_z·t_y, r_z·t_x - r_x, r_x·t_y - r_y·t_x]`` with ``t = a_xy / a_z``
+    (the kernel's row divided out). False where ``a_z`` may fall below 1e-2 of the link."""
+    for i in range(6):
+        ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
+        rx0, rx1 = _box.irot(Rlo, Rhi, 0, ux, uy, uz)
+        ry0, ry1 = _box.irot(Rlo, Rhi, 1, ux, uy, uz)
+        rz0, rz1 = _box.irot(Rlo, Rhi, 2, ux, uy, uz)
+        ax0, ax1 = plo[0] + rx0 - g[3 * i], phi[0] + rx1 - g[3 * i]
+        ay0, ay1 = plo[1] + ry0 - g[3 * i + 1], phi[1] + ry1 - g[3 * i + 1]
+        ll = g[36 + i]
+        sx0, sx1 = _box.isq(ax0, ax1)
+        sy0, sy1 = _box.isq(ay0, ay1)
+        h0, h1 = ll * ll - sx1 - sy1, ll * ll - sx0 - sy0
+        if not h0 >= 1e-4 * ll * ll:
+            return False
+        iz0, iz1 = 1.0 / math.sqrt(h1), 1.0 / math.sqrt(h0)      # 1 / a_z
+        tx0, tx1 = _box.imul(ax0, ax1, iz0, iz1)
+        ty0, ty1 = _box.imul(ay0, ay1, iz0, iz1)
+        a0, a1 = _box.imul(rz0, rz1, ty0, ty1)
+        b0, b1 = _box.imul(rz0, rz1, tx0, tx1)
+        c0, c1 = _box.imul(rx0, rx1, ty0, ty1)
+        d0, d1 = _box.imul(ry0, ry1, tx0, tx1)
+        Jlo[i, 0], Jhi[i, 0] = _box.widen(tx0, tx1)
+        Jlo[i, 1], Jhi[i, 1] = _box.widen(ty0, ty1)
+        Jlo[i, 2], Jhi[i, 2] = 1.0, 1.0                        # a_z / a_z, exact in float
+        Jlo[i, 3], Jhi[i, 3] = _box.widen(ry0 - a1, ry1 - a0)
+        Jlo[i, 4], Jhi[i, 4] = _box.widen(b0 - rx1, b1 - rx0)
+        Jlo[i, 5], Jhi[i, 5] = _box.widen(c0 - d1, c1 - d0)
+    return True
 
 
 @njit(inline="always")
@@ -124,6 +159,7 @@ class PSU6(Mechanism):
 
     _ik_one = _psu_one
     _jac_one = _psu_jac_one
+    _jac_box = _psu_jac_box
 
     def __post_init__(self):
         set_ = object.__setattr__

@@ -24,6 +24,7 @@ from ...poses import euler_to_matrix
 from ...specbase import PairedCircles, _Common
 from ..base import NO_STROKE, Mechanism, as_points, as_stroke, as_vector3
 from ..joints import DEFAULT_FIELDS, ParamField, kind_arrays, kind_template, platform_joints
+from ..kernels import boxes as _box
 from ..kernels import ik as _kernels
 from ..legs.layout import PAIRED_ALIASES, build_paired
 from .psu6 import _radii
@@ -87,6 +88,47 @@ def _ups_jac_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, q, 
         J[k, i, 5] = rx * ny - ry * nx
 
 
+@register_jitable(inline="always")
+def _ups_jac_box(plo, phi, Rlo, Rhi, g, Jlo, Jhi):
+    """:func:`_ups_jac_one` enclosed over a box of poses (:mod:`..kernels.boxes`): ``n = s /
+    |s|`` by intervals (within [-1, 1]), then ``r × n``. False where ``|s|`` may fall below
+    1e-2 of its largest value in the box."""
+    for i in range(6):
+        ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
+        rx0, rx1 = _box.irot(Rlo, Rhi, 0, ux, uy, uz)
+        ry0, ry1 = _box.irot(Rlo, Rhi, 1, ux, uy, uz)
+        rz0, rz1 = _box.irot(Rlo, Rhi, 2, ux, uy, uz)
+        sx0, sx1 = plo[0] + rx0 - g[3 * i], phi[0] + rx1 - g[3 * i]
+        sy0, sy1 = plo[1] + ry0 - g[3 * i + 1], phi[1] + ry1 - g[3 * i + 1]
+        sz0, sz1 = plo[2] + rz0 - g[3 * i + 2], phi[2] + rz1 - g[3 * i + 2]
+        qx0, qx1 = _box.isq(sx0, sx1)
+        qy0, qy1 = _box.isq(sy0, sy1)
+        qz0, qz1 = _box.isq(sz0, sz1)
+        v0, v1 = qx0 + qy0 + qz0, qx1 + qy1 + qz1
+        if not v0 >= 1e-4 * v1:
+            return False
+        iv0, iv1 = 1.0 / math.sqrt(v1), 1.0 / math.sqrt(v0)
+        nx0, nx1 = _box.imul(sx0, sx1, iv0, iv1)
+        ny0, ny1 = _box.imul(sy0, sy1, iv0, iv1)
+        nz0, nz1 = _box.imul(sz0, sz1, iv0, iv1)
+        nx0, nx1 = max(nx0, -1.0), min(nx1, 1.0)
+        ny0, ny1 = max(ny0, -1.0), min(ny1, 1.0)
+        nz0, nz1 = max(nz0, -1.0), min(nz1, 1.0)
+        a0, a1 = _box.imul(ry0, ry1, nz0, nz1)
+        b0, b1 = _box.imul(rz0, rz1, ny0, ny1)
+        c0, c1 = _box.imul(rz0, rz1, nx0, nx1)
+        d0, d1 = _box.imul(rx0, rx1, nz0, nz1)
+        e0, e1 = _box.imul(rx0, rx1, ny0, ny1)
+        f0, f1 = _box.imul(ry0, ry1, nx0, nx1)
+        Jlo[i, 0], Jhi[i, 0] = _box.widen(nx0, nx1)
+        Jlo[i, 1], Jhi[i, 1] = _box.widen(ny0, ny1)
+        Jlo[i, 2], Jhi[i, 2] = _box.widen(nz0, nz1)
+        Jlo[i, 3], Jhi[i, 3] = _box.widen(a0 - b1, a1 - b0)
+        Jlo[i, 4], Jhi[i, 4] = _box.widen(c0 - d1, c1 - d0)
+        Jlo[i, 5], Jhi[i, 5] = _box.widen(e0 - f1, e1 - f0)
+    return True
+
+
 @njit(inline="always")
 def _ups_column_leg(x, y, wx, wy, wz, side, qmin2, qmax2):
     """Along a column q² = d² + (z + w_z)² (d the horizontal leg length): the stroke window
@@ -139,6 +181,7 @@ class UPS6(Mechanism):
 
     _ik_one = _ups_one
     _jac_one = _ups_jac_one
+    _jac_box = _ups_jac_box
 
     def __post_init__(self):
         set_ = object.__setattr__

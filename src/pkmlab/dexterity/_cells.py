@@ -1,0 +1,251 @@
+"""Branch and bound over cells of neighbouring units for the worst case (issue 28 item 2).
+
+:func:`pkmlab.dexterity.worst_case` needs, over every feasible (unit, orientation) sample, the
+largest κ, the smallest all-direction force, and the sign of ``det J`` (for the sign-change
+certificate of a singularity). Most samples are far from both extremes. Here the units (the
+voxels, or the (x, y) columns of a column-invariant family) are grouped into cells of
+:data:`TILE` neighbouring grid units per axis, at one orientation sample each, and every cell
+gets certified bounds over all its samples:
+
+* the family's box Jacobian (``_jac_box``, :mod:`pkmlab.mechanisms.kernels.boxes`) encloses
+  ``J`` over the cell's box of positions: ``|J(s) - J₀| <= Δ`` entrywise, with ``J₀`` the
+  Jacobian at the box centre, so ``‖J(s) - J₀‖₂ <= δ = ‖Δ‖_F`` (``δ_h`` for ``J_h``, the
+  angular columns divided by ``L``);
+* from one LU of ``J₀`` (:func:`._linalg.sweep_one`): ``σ̄ >= σmax(J_h₀)`` and
+  ``ι >= ‖J_h₀⁻¹‖₂`` (Gram-trace bounds, :func:`._linalg._gram_lambda_max`) and the column
+  norms ``g_c = ‖(J_h₀⁻¹)_{0:3, c}‖`` (the first three rows of ``J_h⁻¹`` are those of
+  ``J⁻¹``);
+* with ``D_h`` the entrywise bound of ``|J_h(s) - J_h₀|``, ``‖J_h₀⁻¹ (J_h(s) - J_h₀)‖₂ <= μ =
+  min(ι δ_h, ‖ |J_h₀⁻¹| D_h ‖_F)`` (``|M Δ x| <= |M| D |x|`` entrywise) and
+  ``‖(J_h₀⁻¹)_{0:3, :} (J_h(s) - J_h₀)‖₂ <= ν``, the Frobenius norm of the first three rows
+  of ``|J_h₀⁻¹| D_h``;
+* where ``μ < 1`` (Weyl and the Neumann series): ``κ(J_h(s)) <= K = (σ̄ + δ_h) ι /
+  (1 - μ)``; ``(J_h(s)⁻¹ - J_h₀⁻¹)_{0:3, c} = -(J_h₀⁻¹)_{0:3, :} (J_h(s) - J_h₀) J_h(s)⁻¹ e_c``
+  and ``‖J_h(s)⁻¹ e_c‖ <= ‖b_c‖ / (1 - μ)`` (``b_c`` the column of ``J_h₀⁻¹``), so
+  ``‖(J(s)⁻¹)_{0:3, c}‖ <= g_c + ν ‖b_c‖ / (1 - μ)``, which bounds the force
+  ``min_c fmax_c / ‖(J(s)⁻¹)_{0:3, c}‖`` below by ``F``; and ``J_h₀ + t (J_h(s) - J_h₀)`` is non-singular for
+  ``t ∈ [0, 1]``, so ``det J(s)`` has the sign of ``det J₀``.
+
+Every bound is multiplied (or divided) by ``1 + KAPPA_ROUND`` per rounded quantity, and a cell
+with ``K >= 1e8`` is never pruned (:func:`._linalg.kappa_upper`'s range). The box Jacobians'
+own allowance covers the round-off of the enclosure and of the per-pose kernel's ``J``.
+
+A cell's samples are evaluated one by one (:func:`._fused.fused_sweep_at`) unless it is
+certified (``K``, ``F`` finite, the sign known) **and** ``K`` is below a certified lower bound
+on the largest κ **and** ``F`` is above the smallest force already found. The lower bound and
+the force incumbent come first from the cells with the largest ``K`` and the smallest ``F``
+(evaluated first), then from every chunk evaluated. A pruned sample gets ``kup = -inf``
+(never a candidate for the largest κ: its κ is below a sample's), ``force = inf`` (its force
+is above a sample's, strictly) and ``det = ±1`` (the certified sign), so the worst case's
+extremes, their poses, the singular samples and the sign-change counts are those of the pass
+over every sample; only the count of exact κ evaluations can differ.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import cache
+
+import numpy as np
+from numba import prange
+from numba import types as nt
+
+from ..runtime.jit import cached_kernel
+from ..runtime.threads import threads_for
+from ._fused import fused_available, fused_sweep_at
+from ._linalg import KAPPA_BRACKET, KAPPA_ROUND, sweep_core
+
+__all__ = ["CellPlan", "cells_available", "TILE"]
+
+#: grid units per axis in a cell (cells are TILE × TILE (× TILE) units at one orientation)
+TILE = 3
+#: cells evaluated first (largest K, smallest F) for the incumbents
+_SEED = 8
+_KMAX = 1e8
+
+
+def cells_available(mech) -> bool:
+    """True when ``mech`` has a fused Jacobian kernel and a box Jacobian (``_jac_box``)
+    declared by the same class as its ``_jac_one`` (a subclass with its own ``_jac_one`` does
+    not inherit the box of another)."""
+    if not fused_available(mech):
+        return False
+    owner = next(c for c in type(mech).__mro__ if "_jac_one" in vars(c))
+    return vars(owner).get("_jac_box") is not None
+
+
+@cache
+def _bounds_kernel(jac, box, ng: int):
+    def cell_bounds_loop(P, R, order, start, feas, g, L, fmax, K, F, S):
+        T, M = start.shape[0] - 1, R.shape[0]
+        r = 1.0 + KAPPA_ROUND
+        for t in prange(T):
+            J = np.empty((1, 6, 6))
+            Jlo = np.empty((6, 6))
+            Jhi = np.empty((6, 6))
+            A = np.empty((6, 6))
+            B = np.empty((6, 6))
+            G = np.empty((6, 6))
+            Tm = np.empty((6, 6))
+            piv = np.empty(6, np.int64)
+            q = np.empty((1, 6))
+            plo = np.empty(3)
+            phi = np.empty(3)
+            pc = np.empty(3)
+            for m in range(M):
+                K[t, m], F[t, m], S[t, m] = -np.inf, np.inf, 0
+                n = 0
+                for c in range(3):
+                    plo[c], phi[c] = np.inf, -np.inf
+                for j in range(start[t], start[t + 1]):
+                    u = order[j]
+                    if feas[u, m]:
+                        n += 1
+                        for c in range(3):
+                            plo[c] = min(plo[c], P[u, c])
+                            phi[c] = max(phi[c], P[u, c])
+                if n == 0:
+                    continue                            # nothing to evaluate in the cell
+                K[t, m], F[t, m] = np.inf, 0.0          # not certified, until shown
+                if not box(plo, phi, R[m], R[m], g, Jlo, Jhi):
+                    continue
+                for c in range(3):
+                    pc[c] = 0.5 * (plo[c] + phi[c])
+                jac(pc[0], pc[1], pc[2], R[m, 0, 0], R[m, 0, 1], R[m, 0, 2], R[m, 1, 0],
+                    R[m, 1, 1], R[m, 1, 2], R[m, 2, 0], R[m, 2, 1], R[m, 2, 2], g, q, J, 0)
+                la, lb, f0, d0 = sweep_core(J[0], L, fmax, A, B, G, Tm, piv)
+                if not (la > 0.0 and lb > 0.0 and d0 != 0.0):
+                    continue
+                sigma, iota = math.sqrt(la) * r, math.sqrt(lb) * r    # B = J_h0⁻¹
+                dh2 = 0.0
+                for i in range(6):
+                    for c in range(6):
+                        x = J[0, i, c]
+                        e = max(Jhi[i, c] - x, x - Jlo[i, c], 0.0)
+                        e = e if c < 3 else e / L
+                        Jlo[i, c] = e                       # D_h: |J_h(s) - J_h0| <= D_h
+                        dh2 += e * e
+                dh = math.sqrt(dh2) * r
+                mu2 = 0.0                                   # ‖ |J_h0⁻¹| D_h ‖_F², and rows 0:3
+                nu2 = 0.0
+                for i in range(6):
+                    for c in range(6):
+                        v = 0.0
+                        for k in range(6):
+                            v += abs(B[i, k]) * Jlo[k, c]
+                        mu2 += v * v
+                        if i < 3:
+                            nu2 += v * v
+                mu = min(iota * dh, math.sqrt(mu2) * r) * r   # >= ‖J_h0⁻¹ (J_h(s) - J_h0)‖₂
+                nu = math.sqrt(nu2) * r * r
+                if not mu < 1.0:
+                    continue
+                kb = (sigma + dh) * iota / (1.0 - mu) * r * r * r
+                if not kb < _KMAX:
+                    continue
+                fb = np.inf
+                for c in range(6):
+                    gc = B[0, c] * B[0, c] + B[1, c] * B[1, c] + B[2, c] * B[2, c]
+                    bc = gc
+                    for i in range(3, 6):
+                        bc += B[i, c] * B[i, c]
+                    eps = nu * math.sqrt(bc) / (1.0 - mu) * r * r
+                    fb = min(fb, fmax[c] / ((math.sqrt(gc) * r + eps) * r))
+                K[t, m], F[t, m], S[t, m] = kb, fb / r, 1 if d0 > 0.0 else -1
+
+    f8, f1, f2, f3 = nt.float64, nt.float64[::1], nt.float64[:, ::1], nt.float64[:, :, ::1]
+    i1 = nt.int64[::1]
+    return cached_kernel(cell_bounds_loop,
+                         nt.void(f2, f3, i1, i1, nt.boolean[:, ::1], nt.UniTuple(nt.float64, ng),
+                                 f8, f1, f2, f2, nt.int8[:, ::1]),
+                         parallel=True, error_model="numpy")
+
+
+def _tiles(unit_pos: np.ndarray, h: float):
+    """Units grouped into cells of :data:`TILE` grid steps per axis: ``(order, start)``,
+    the units of cell ``t`` being ``order[start[t]:start[t + 1]]``, and the cell of each unit."""
+    idx = np.floor((unit_pos - unit_pos.min(axis=0)) / h + 0.5).astype(np.int64) // TILE
+    _, cell = np.unique(idx, axis=0, return_inverse=True)
+    cell = cell.ravel()
+    order = np.argsort(cell, kind="stable")
+    start = np.searchsorted(cell[order], np.arange(cell.max() + 2))
+    return order.astype(np.int64), start.astype(np.int64), cell
+
+
+class CellPlan:
+    """Certified cell bounds of one (units × orientations) sweep and the incumbents; its
+    :meth:`chunk` gives the per-pose arrays of :func:`._fused.fused_sweep` with the pruned
+    samples marked (module notes)."""
+
+    def __init__(self, mech, unit_pos, Rs, feas, L, fmax, h, exact_kappa):
+        self.mech, self.L = mech, float(L)
+        self.P = np.require(unit_pos, np.float64, ("C", "A", "W"))
+        self.R = np.require(Rs, np.float64, ("C", "A", "W"))
+        self.fmax = np.require(np.broadcast_to(fmax, (6,)), np.float64, ("C", "A", "W"))
+        self.feas = np.require(feas, np.bool_, ("C", "A", "W"))
+        U, M = feas.shape
+        self.order, start, self.cell = _tiles(self.P, h)
+        T = len(start) - 1
+        self.K, self.F = np.empty((T, M)), np.empty((T, M))
+        self.S = np.empty((T, M), dtype=np.int8)
+        jac, g = mech.jacobian_kernel()
+        with threads_for(T * M * 4):
+            _bounds_kernel(jac, type(mech)._jac_box, len(g))(
+                self.P, self.R, self.order, start, self.feas, g, self.L, self.fmax, self.K,
+                self.F, self.S)
+        self.certified = np.isfinite(self.K) & (self.S != 0)
+        self.k_low, self.f_inc = -math.inf, math.inf
+        self.evaluated = 0
+        # incumbents: the cells of largest K and smallest F (certified or not), evaluated now
+        cand = np.flatnonzero(self.certified.ravel())
+        if len(cand):
+            kk, ff = self.K.ravel()[cand], self.F.ravel()[cand]
+            seed = np.unique(np.concatenate([cand[np.argsort(-kk, kind="stable")[:_SEED]],
+                                             cand[np.argsort(ff, kind="stable")[:_SEED]]]))
+            ts, ms = seed // M, seed % M
+            pick = np.zeros((U, M), dtype=bool)
+            for t, m in zip(ts, ms):
+                pick[self.order[start[t]:start[t + 1]], m] = True
+            pick &= self.feas
+            u, m = np.nonzero(pick)
+            at = m * U + u
+            kup, force, det = (np.full((M, U), v) for v in (-np.inf, np.inf, 0.0))
+            fused_sweep_at(mech, self.P, self.R, at, self.L, self.fmax, kup, force, det)
+            self._update(kup, force)
+            ku = kup.ravel()
+            j = int(np.argmax(ku))
+            if ku[j] > -np.inf:                          # an exact κ is a lower bound too
+                k = exact_kappa(j % U, j // U)
+                if math.isfinite(k):
+                    self.k_low = max(self.k_low, k)
+
+    def _update(self, kup, force):
+        fin = np.isfinite(kup) & (kup < _KMAX)
+        if fin.any():
+            self.k_low = max(self.k_low, float(kup[fin].max()) * (1 + KAPPA_ROUND)
+                             / KAPPA_BRACKET / (1 + KAPPA_ROUND) ** 3)
+        fc = force[~np.isnan(force)]
+        if len(fc):
+            self.f_inc = min(self.f_inc, float(fc.min()))
+
+    def chunk(self, m0: int, k: int):
+        """``(kup, force, det)`` ``(U, k)`` (transposed views) for orientations
+        ``m0 … m0 + k - 1``: evaluated where a sample may hold an extreme or its cell is not
+        certified; ``-inf``, ``inf``, the certified sign elsewhere; infeasible: ``-inf``,
+        ``inf``, ``0``."""
+        U = len(self.P)
+        sl = slice(m0, m0 + k)
+        Kc, Fc, Sc = self.K[:, sl], self.F[:, sl], self.S[:, sl]
+        prune = self.certified[:, sl] & (Kc < self.k_low) & (Fc > self.f_inc)
+        fe = self.feas[:, sl]
+        pr = prune[self.cell]                           # (U, k)
+        need = fe & ~pr
+        u, m = np.nonzero(need.T)[::-1]
+        at = m * U + u
+        self.evaluated += len(at)
+        kup = np.full((k, U), -np.inf)
+        force = np.full((k, U), np.inf)
+        det = np.where(fe & pr, Sc[self.cell], 0).astype(np.float64).T.copy()
+        fused_sweep_at(self.mech, self.P, self.R[sl], at, self.L, self.fmax, kup, force, det)
+        self._update(kup, force)
+        return kup.T, force.T, det.T
