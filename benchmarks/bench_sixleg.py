@@ -9,12 +9,18 @@ And the Hexaglide-like 6-PUS (sliders on horizontal
 rails): IK throughput and its constant workspace at 5 mm, exact columns against sampled voxels
 (ratio = sampled time / column time).
 
-Run: .venv/bin/python benchmarks/bench_sixleg.py   (state the load: ``uptime``)
+``--cpu``: the IK only, one numba thread, CPU time (best of 7) of the memory floor, the
+dedicated family and the generic declaration, and their ratios (on a loaded machine).
+
+Run: .venv/bin/python benchmarks/bench_sixleg.py [--cpu]   (state the load: ``uptime``)
 """
 
 from __future__ import annotations
 
+import math
 import os
+import sys
+import time
 from pathlib import Path
 
 import numba
@@ -54,7 +60,36 @@ def _poses(mech, n, rng):
         [rng.uniform(-40, 40, (n, 3)), np.radians(rng.uniform(-15, 15, (n, 3)))], axis=1)
 
 
+def _cpu(fn, repeats: int = 7) -> float:
+    fn()
+    ts = []
+    for _ in range(repeats):
+        c = time.process_time()
+        fn()
+        ts.append(time.process_time() - c)
+    return min(ts)
+
+
+def cpu_mode() -> None:
+    numba.set_num_threads(1)
+    print(f"one numba thread, CPU time, load average: {os.getloadavg()}")
+    rng = np.random.default_rng(0)
+    for name in (*FILES, "hexaglide-6pus"):
+        fast = pkmlab.load_mechanism(ROOT / f"{name}.yaml")
+        gen = fast if fast.family == "sixleg" else SixLeg.from_mechanism(fast)
+        X = _poses(fast, N_IK, rng)
+        tf = _cpu(lambda: memory_floor(X))                     # noqa: B023
+        tg = _cpu(lambda: gen.inverse(X))                      # noqa: B023
+        tk = _cpu(lambda: fast.inverse(X)) if gen is not fast else math.nan  # noqa: B023
+        print(f"{name}: memory floor {tf * 1e3:5.1f} ms; dedicated {tk / tf:4.2f}x, "
+              f"generic {tg / tf:4.2f}x the floor")
+    print(f"load average after: {os.getloadavg()}")
+
+
 def main() -> None:
+    if "--cpu" in sys.argv:
+        cpu_mode()
+        return
     print(f"numba threads: {numba.get_num_threads()}, load average: {os.getloadavg()}")
     rng = np.random.default_rng(0)
     for name in FILES:
