@@ -109,7 +109,15 @@ def test_kind_kernels_match_the_closed_forms_in_numpy(case):
     np.testing.assert_array_equal(res.leg_status, st)
     np.testing.assert_array_equal(np.isnan(res.q), np.isnan(q))
     np.testing.assert_allclose(res.q, q, rtol=0, atol=1e-9)
-    # the all-kinds kernel, on the same driver
+
+
+@pytest.mark.parametrize("case", sorted(EXPECTED))
+def test_kind_kernels_match_the_all_kinds_kernel(case):
+    """The kernel every instance ran before (its own driver: one compile of the largest
+    kernel, ~1 min of CPU on an empty cache)."""
+    m = _cases()[case]
+    X = _poses(m)
+    res = m.inverse(X)
     n, g = len(X), m._ik_geometry
     q0, st0 = np.empty((n, 6)), np.empty((n, 6), dtype=np.int8)
     r0 = np.empty(n, dtype=np.int8)
