@@ -14,8 +14,13 @@ time per candidate (``time.process_time``) and the rate two idle cores would giv
 ``src``) and with this checkout's, twice each, in fresh processes with their own kernel caches,
 and reports the ratio in that one run (issue 28), with the load average and whether the two
 give identical metrics for every candidate.
+``--ladder [G]`` runs the demo study (its NSGA-II, ``G`` generations, default its own) in this
+process, one numba thread, twice: as it is and with ``tolerance_ladder: {coarse: {angle: 0.1
+deg, length: 0.1 mm}}``; it reports the CPU time per candidate of each (the ladder's includes
+its re-certification), the ratio in that one run, how many candidates were refined and pruned,
+and whether every candidate both runs evaluated has identical final metrics (issue 28).
 
-    python benchmarks/bench_study.py [--full | --cpu [N] | --compare SRC [N]]
+    python benchmarks/bench_study.py [--full | --cpu [N] | --compare SRC [N] | --ladder [G]]
 """
 
 from __future__ import annotations
@@ -90,7 +95,72 @@ def compare(base_src: str, n: int) -> None:
           f"{out['before'] == out['now']}")
 
 
+def _run_demo(tmp: Path, name: str, generations: int | None, ladder: dict | None):
+    import yaml
+
+    from pkmlab.study import SerialRunner, run_study
+    from pkmlab.study.report import pareto_records
+
+    data = yaml.safe_load((ROOT / "studies/hopkins-6psu-redesign.yaml").read_text())
+    data["mechanism"]["file"] = str(ROOT / "studies" / data["mechanism"]["file"])
+    data["output"] = str(tmp / name)
+    if generations:
+        data["optimizer"]["generations"] = generations
+    if ladder:
+        data["tolerance_ladder"] = ladder
+    path = tmp / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(data))
+    study = load_study(path)
+    c0 = time.process_time()
+    store = run_study(study, SerialRunner())
+    cpu = time.process_time() - c0
+    records = store.all()
+    meta = store.get_meta("ladder")
+    store.close()
+    return cpu, records, pareto_records(study, records), meta
+
+
+def ladder_mode(generations: int | None) -> None:
+    import tempfile
+
+    from pkmlab.runtime.threads import single_thread_worker
+
+    single_thread_worker()
+    loads = [os.getloadavg()[0]]
+    with tempfile.TemporaryDirectory() as tmp:
+        _run_demo(Path(tmp), "warm", 1, None)              # kernels loaded / compiled
+        loads.append(os.getloadavg()[0])
+        c0, r0, f0, _ = _run_demo(Path(tmp), "plain", generations, None)
+        loads.append(os.getloadavg()[0])
+        c1, r1, f1, meta = _run_demo(Path(tmp), "ladder", generations,
+                                     {"coarse": {"angle": "0.1 deg", "length": "0.1 mm"}})
+        loads.append(os.getloadavg()[0])
+    fine = {json.dumps(r["params"], sort_keys=True): r for r in r0}
+
+    def final(r):            # without the ladder's coarse copies
+        return {m: v for m, v in r["metrics"].items() if not m.endswith("_coarse")}
+    same = [fine[k]["metrics"] == final(r) for r in r1 if r["status"] == "ok"
+            and (k := json.dumps(r["params"], sort_keys=True)) in fine]
+    fsame = [fine[k]["metrics"] == final(r) for r in f1
+             if (k := json.dumps(r["params"], sort_keys=True)) in fine]
+    n0, n1 = len(r0), len(r1)
+    print(f"demo study (NSGA-II, {generations or 'its own'} generations), one numba thread, "
+          f"CPU per candidate; load average {min(loads):.2f}-{max(loads):.2f} (2 cores)")
+    print(f"  without the ladder: {n0} evaluations, {c0:.1f} s CPU, {1e3 * c0 / n0:.0f} ms "
+          f"-> {2 * n0 / c0:.1f} candidates/s on 2 idle cores")
+    print(f"  with the ladder:    {n1} evaluations, {c1:.1f} s CPU, {1e3 * c1 / n1:.0f} ms "
+          f"-> {2 * n1 / c1:.1f} candidates/s on 2 idle cores ({meta})")
+    print(f"  ratio {(c0 / n0) / (c1 / n1):.2f}x; candidates in both runs with identical final "
+          f"metrics: {sum(same)} of {len(same)}; Pareto records of the ladder run with the "
+          f"plain run's metrics: {sum(fsame)} of {len(fsame)} found in it (fronts: {len(f0)} "
+          f"and {len(f1)} records)")
+
+
 def main() -> None:
+    if "--ladder" in sys.argv:
+        i = sys.argv.index("--ladder")
+        ladder_mode(int(sys.argv[i + 1]) if len(sys.argv) > i + 1 else None)
+        return
     if "--cpu-json" in sys.argv:
         print(json.dumps(cpu_mode(int(sys.argv[sys.argv.index("--cpu-json") + 1]))))
         return

@@ -274,6 +274,10 @@ class Mechanism(JointsMixin):
     def _gparams(self) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError
 
+    def _ik_kernel(self):
+        """The per-pose IK function: ``_ik_one`` (``sixleg`` picks one by its leg kinds)."""
+        return type(self)._ik_one
+
     def _jacobian(self, p: np.ndarray, R: np.ndarray) -> np.ndarray:
         """``(N, L, 6)`` by the family's ``_jac_one`` kernel (families without one override
         this with their own formula)."""
@@ -395,11 +399,9 @@ class Mechanism(JointsMixin):
     def _run_ik(self, X_or_p, R, lo: float, hi: float) -> IKResult:
         g = self._ik_geometry
         n, L = X_or_p.shape[0], self.n_actuators
-        q = np.empty((n, L))
-        st = np.empty((n, L), dtype=np.int8)
+        q, st = np.empty((n, L)), np.empty((n, L), dtype=np.int8)
         reason = np.empty(n, dtype=np.int8)
-        lo, hi = float(lo), float(hi)
-        one, ng = type(self)._ik_one, len(g)
+        one, ng, lo, hi = self._ik_kernel(), len(g), float(lo), float(hi)
         with threads_for(n):
             if R is None:
                 euler = _kernels.make_driver(one, ng, "euler", L)
@@ -441,7 +443,7 @@ class Mechanism(JointsMixin):
         n, g, L = len(p), self._ik_geometry, self.n_actuators
         q, J = np.empty((n, L)), np.empty((n, L, POSE_SIZE))
         st, reason = np.empty((n, L), dtype=np.int8), np.empty(n, dtype=np.int8)
-        drive = _kernels.make_kinematics_driver(type(self)._ik_one, jac, len(g), L)
+        drive = _kernels.make_kinematics_driver(self._ik_kernel(), jac, len(g), L)
         drive(p, R, g, float(lo), float(hi), q, st, reason, J)
         self._check_legs(reason)
         return (IKResult(q=q, valid=reason == _kernels.OK, reason=reason, leg_status=st),
@@ -596,5 +598,3 @@ def _frames_tuple(frames) -> tuple[np.ndarray, np.ndarray]:
     if len(p) != len(R):
         raise ParameterError("poses", "as many positions as rotations", f"{len(p)} and {len(R)}")
     return p, R
-
-

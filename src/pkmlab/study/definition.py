@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,10 +21,26 @@ from .evaluators import EVALUATORS, OMIT
 from .metrics import KIND_VOLUMES, METRICS
 from .space import DesignSpace, Variable
 
-__all__ = ["Study", "Evaluation", "Objective", "Constraint", "PENALTY"]
+__all__ = ["Study", "Evaluation", "Objective", "Constraint", "PENALTY", "Tolerances", "FINE"]
 
 #: Objective / constraint value of a candidate without the metric (failed, invalid, undefined).
 PENALTY = 1.0e12
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Certified tolerances of the bracketed optima: ``angle`` (rad) of the orientation
+    capability, ``length`` (mm) of the needed stroke."""
+
+    angle: float
+    length: float
+
+    def written(self) -> dict:
+        return {"angle": f"{math.degrees(self.angle):.12g} deg", "length": f"{self.length:.12g} mm"}
+
+
+#: the tolerances of a run without the ladder (``CAPABILITY_TOL_DEG``, ``STROKE_TOL_MM``)
+FINE = Tolerances(math.radians(0.01), 0.01)
 
 
 @dataclass(frozen=True)
@@ -31,10 +48,13 @@ class Evaluation:
     """What to compute for each candidate: ``plans`` maps each given ``evaluate`` block to its
     plan (what its evaluator built from the block, :mod:`.evaluators`); ``request`` is the
     built workspace request. A block's plan reads as an attribute (``evaluation.dexterity``,
-    ``None`` when the block is not given)."""
+    ``None`` when the block is not given). ``tolerances``: the certified tolerances of the
+    bracketed optima (:class:`.ladder.Tolerances`; None: the fine ones, 0.01° and 0.01 mm);
+    a study's tolerance ladder optimises with coarse ones (:meth:`with_tolerances`)."""
 
     plans: Mapping[str, Any]
     request: dict | None = None
+    tolerances: Any = None
 
     def __post_init__(self):
         object.__setattr__(self, "plans", MappingProxyType(dict(self.plans)))
@@ -51,11 +71,27 @@ class Evaluation:
         raise AttributeError(f"{type(self).__name__!s} has no attribute {name!r}")
 
     def __getstate__(self):
-        return {"plans": dict(self.plans), "request": self.request}
+        return {"plans": dict(self.plans), "request": self.request,
+                "tolerances": self.tolerances}
 
     def __setstate__(self, state):
         object.__setattr__(self, "plans", MappingProxyType(state["plans"]))
         object.__setattr__(self, "request", state["request"])
+        object.__setattr__(self, "tolerances", state.get("tolerances"))
+
+    def with_tolerances(self, tolerances) -> Evaluation:
+        """This evaluation with other certified tolerances (:class:`.ladder.Tolerances`)."""
+        return Evaluation(self.plans, self.request, tolerances)
+
+    @property
+    def angle_tolerance_deg(self) -> float:
+        """Bisection tolerance of the orientation capability (deg)."""
+        return math.degrees((self.tolerances or FINE).angle)
+
+    @property
+    def length_tolerance_mm(self) -> float:
+        """Bisection tolerance of the needed stroke (mm)."""
+        return (self.tolerances or FINE).length
 
     @property
     def evaluators(self) -> tuple[str, ...]:
@@ -115,6 +151,7 @@ class Study:
     output: Path
     top: int
     source: Path | None = None              # the study file
+    tolerance_ladder: Any = None            # ladder.ToleranceLadder, or None
 
     @property
     def variables(self) -> tuple[Variable, ...]:
@@ -157,6 +194,8 @@ class Study:
                             for c in self.constraints],
             "optimizer": self.optimizer.model_dump(),
             "seed": self.seed, "output": str(self.output), "top": self.top,
+            "tolerance_ladder": (None if self.tolerance_ladder is None
+                                 else self.tolerance_ladder.written()),
         }
 
     def input_files(self) -> list[str]:
@@ -188,6 +227,8 @@ class Study:
         seed): the store refuses to resume a study whose fingerprint changed."""
         r = self.resolved()
         keep = {k: r[k] for k in ("mechanism", "design", "derived", "evaluate", "seed")}
+        if r["tolerance_ladder"] is not None:    # coarse values are stored: part of the run
+            keep["tolerance_ladder"] = r["tolerance_ladder"]
         keep["input_files"] = self.input_digests()
         text = json.dumps(keep, sort_keys=True, separators=(",", ":"), default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:16]

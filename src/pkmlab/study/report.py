@@ -50,10 +50,15 @@ def _params(study: Study, record: dict) -> dict:
 
 def _rows(study: Study, records: list[dict]):
     metrics = [m for m in METRICS if any(m in r["metrics"] for r in records)]
+    # the tolerance ladder's coarse values (study.ladder), after the fine ones
+    coarse = [f"{m}_coarse" for m in metrics if any(f"{m}_coarse" in r["metrics"]
+                                                    for r in records)]
     header = (["seq", "role", "status", "reason", "seconds"]
               + [f"design.{v.name} ({v.unit})" if v.unit else f"design.{v.name}"
                  for v in study.variables]
-              + [METRICS[m].label for m in metrics] + ["violated", "notes"])
+              + [METRICS[m].label for m in metrics]
+              + [f"{c} ({METRICS[c[:-7]].unit})" for c in coarse] + ["violated", "notes"])
+    metrics = metrics + coarse
     rows = []
     for r in records:
         p = _params(study, r)

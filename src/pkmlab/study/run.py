@@ -9,20 +9,19 @@ wrote).
 from __future__ import annotations
 
 import logging
-import math
 import platform
 import time
 from pathlib import Path
-
-import numpy as np
 
 from .. import __version__
 from ..errors import CandidateError, ParameterError, Shown
 from ..runtime.jit import compile_log
 from ..runtime.memory import BudgetError
-from .definition import PENALTY, Study
+from .definition import Study
 from .evaluators import check_budget, evaluate_design
 from .folder import OutputLock, check_output, claim, clear_for_overwrite
+from .ladder import coarse_view, refine
+from .objectives import feasible, objective_matrix
 from .optimisers import OPTIMISERS, check_time
 from .store import Store, candidate_key
 
@@ -39,40 +38,6 @@ def provenance() -> dict:
     return {"pkmlab_version": __version__, "time": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
             "machine": platform.node(), "python": platform.python_version(),
             "platform": platform.platform()}
-
-
-def _value(record: dict, metric: str):
-    v = record["metrics"].get(metric) if record["status"] == "ok" else None
-    return None if v is None or not math.isfinite(v) else float(v)
-
-
-def objective_matrix(study: Study, records: list[dict]) -> tuple[np.ndarray, np.ndarray]:
-    """``F (n, n_obj)`` to minimise and ``G (n, n_con)`` that must be ``<= 0``."""
-    n_con = sum((c.min is not None) + (c.max is not None) for c in study.constraints)
-    F = np.full((len(records), len(study.objectives)), PENALTY)
-    G = np.full((len(records), n_con), PENALTY)
-    for i, r in enumerate(records):
-        for j, o in enumerate(study.objectives):
-            v = _value(r, o.metric)
-            if v is not None:
-                F[i, j] = v if o.sense == "minimize" else -v
-        j = 0
-        for c in study.constraints:
-            v = _value(r, c.metric)
-            for bound in ("min", "max"):
-                b = getattr(c, bound)
-                if b is not None:
-                    if v is not None:
-                        G[i, j] = (b - v) if bound == "min" else (v - b)
-                    j += 1
-    return F, G
-
-
-def feasible(study: Study, records: list[dict]) -> np.ndarray:
-    """``(n,)`` evaluated, every objective defined, every constraint met."""
-    F, G = objective_matrix(study, records)
-    ok = np.array([r["status"] == "ok" for r in records], dtype=bool)
-    return ok & np.all(F < PENALTY, axis=1) & np.all(G <= 0, axis=1)
 
 
 def _prepare(out: Path, fp: str, resume: bool, overwrite: bool, study_name: str) -> Store:
@@ -181,7 +146,10 @@ def _run(study: Study, runner, store: Store, fp: str, progress) -> None:
     runs = store.get_meta("runs") or []
     store.set_meta("runs", [*runs, {**provenance(), "seed": study.seed,
                                     "resumed": bool(runs)}])
-    space, ev, seed = study.space, study.evaluation, study.seed
+    space, seed = study.space, study.seed
+    ladder = study.tolerance_ladder
+    # with a tolerance ladder the optimiser sees the coarse tolerances (.ladder)
+    ev = study.evaluation if ladder is None else study.evaluation.with_tolerances(ladder.coarse)
 
     def commit(key, role, params, result):
         if result["status"] == "budget":       # the environment's limit: stop, store nothing
@@ -204,7 +172,9 @@ def _run(study: Study, runner, store: Store, fp: str, progress) -> None:
         by_key = dict(zip(keys, params_list))
         for k, result in runner.map(evaluate_design, todo):
             commit(k, "candidate", by_key[k], result)
-        return objective_matrix(study, [store.get(k) for k in keys])
+        records = [store.get(k) for k in keys]
+        return objective_matrix(study, records if ladder is None else
+                                [coarse_view(r) for r in records])
 
     base_key = candidate_key(fp, BASELINE)
     compiling = 0.0
@@ -226,4 +196,6 @@ def _run(study: Study, runner, store: Store, fp: str, progress) -> None:
         seconds = min(seconds, again)
     _check_time(study, runner, store, seconds)
     OPTIMISERS[study.optimizer.method](space, evaluate_batch, study.optimizer, seed)
+    if ladder is not None:
+        store.set_meta("ladder", refine(study, runner, store))
     store.set_meta("complete", True)

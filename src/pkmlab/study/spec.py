@@ -20,6 +20,7 @@ from ..mechanisms import REGISTRY
 from ..units import parse_angle, parse_length
 from .definition import Constraint, Evaluation, Objective, Study
 from .evaluators import EVALUATORS, check_requirements
+from .ladder import ladder_from_spec
 from .metrics import KIND_VOLUMES, METRICS
 from .optimisers import check_memory
 from .space import Derived, DesignSpace, Expression, Variable, get_path, parse_path
@@ -93,6 +94,9 @@ class StudySpec(_Model):
     output: str | None = Field(None, description="output folder, relative to the study file "
                                "(default results/<study> in the working directory)")
     top: int = Field(5, ge=0, le=100, description="Pareto designs exported in full")
+    tolerance_ladder: dict[str, Any] | None = Field(
+        None, description="optimise at coarse certified tolerances, re-certify at the fine "
+        "ones: {coarse: {angle: 0.1 deg, length: 0.1 mm}, prune: true} (docs/studies.md)")
     provenance: dict[str, Any] | None = Field(None, description="written by pkmlab into "
                                               "study.resolved.yaml; ignored on load")
 
@@ -407,7 +411,8 @@ def study_from_mapping(data: Any, base: Path | None = None,
                  space=DesignSpace(mech_spec, variables, tuple(derived)),
                  evaluation=evaluation, objectives=tuple(objectives),
                  constraints=tuple(constraints), optimizer=opt, seed=spec.seed,
-                 output=output, top=spec.top, source=source)
+                 output=output, top=spec.top, source=source,
+                 tolerance_ladder=ladder_from_spec(spec.tolerance_ladder, evaluation))
 
 
 def load_study(source: str | Path) -> Study:

@@ -187,6 +187,17 @@ class Store:
         if self._commits % CHECKPOINT_EVERY == 0:
             self.checkpoint()
 
+    def update(self, key: str, **fields) -> dict:
+        """Rewrite fields (``metrics``, ``notes``, ``status``, ``reason``, ``seconds``) of a
+        stored evaluation (the tolerance ladder's re-certification) → the record."""
+        enc = {"metrics": lambda v: _canon(_clean(v)), "notes": _canon, "status": str,
+               "reason": str, "seconds": float}
+        sets = ", ".join(f"{k} = ?" for k in fields)
+        self.conn.execute(f"UPDATE evaluations SET {sets} WHERE key = ?",
+                          (*(enc[k](v) for k, v in fields.items()), key))
+        self.conn.commit()
+        return self.get(key)
+
     def checkpoint(self) -> None:
         """Fold the write-ahead log into ``evaluations.sqlite``."""
         if not self.read_only:

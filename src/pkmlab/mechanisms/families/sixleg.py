@@ -66,13 +66,12 @@ from ...poses import euler_to_matrix
 from ...tolerances import TOL
 from .. import joints
 from ..base import NO_STROKE, Mechanism, as_points, as_stroke, as_vector3
-from ..kernels import ik as _kernels
 from ..kernels.set_columns import set_column_intervals
 from ..legs.crank import crank_column_leg, crank_params
 from ..legs.layout import PAIRED_ALIASES
 from ..legs.slider import K_MIN, slider_interval
 from ..validation import unit_rows, without_component
-from .rss6 import _atan2
+from .sixleg_ik import _sixleg_one, ik_function
 from .ups6 import _ups_column_leg, working_sides
 
 __all__ = ["SixLeg", "KINDS"]
@@ -80,67 +79,6 @@ __all__ = ["SixLeg", "KINDS"]
 #: actuator kind name → code stored in ``SixLeg.kinds``
 KINDS = {"prismatic": 0.0, "slider": 1.0, "crank": 2.0}
 _NAMES = {v: k for k, v in KINDS.items()}
-#: floats per leg in the IK geometry tuple
-_L = 16
-# per leg: B 0-2, tool point 3-5, kind 6, slider e / crank 2a·u 7-9, crank 2a·v 10-12,
-# slider l² / crank a² - s² 13, slider side / crank degenerate threshold on ρ² 14, branch
-# (prismatic: side) 15. (The drivers take at most 100 floats: numba's parfor tuple limit.)
-
-
-@njit(cache=True, inline="always")
-def _leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, o, qmin, qmax):
-    """Leg at offset ``o`` of ``g``: ``(q, status)``; the three kinds are evaluated and the
-    declared one selected (no branches on the kind)."""
-    tx, ty, tz = g[o + 3], g[o + 4], g[o + 5]
-    dx = px + r00 * tx + r01 * ty + r02 * tz - g[o]
-    dy = py + r10 * tx + r11 * ty + r12 * tz - g[o + 1]
-    dz = pz + r20 * tx + r21 * ty + r22 * tz - g[o + 2]
-    kind, b = g[o + 6], g[o + 15]
-    ex, ey, ez = g[o + 7], g[o + 8], g[o + 9]
-    # prismatic: the leg length, on the working-mode side of the base joint
-    qp = math.sqrt(dx * dx + dy * dy + dz * dz)
-    sp = _kernels.OTHER_MODE if dz * b <= 0.0 else _kernels.stroke_status(qp, qmin, qmax)
-    sp = _kernels.DEGENERATE if qp < 1e-12 else sp
-    # slider: q = d·e + b·h
-    t = dx * ex + dy * ey + dz * ez
-    nx, ny, nz = dx - t * ex, dy - t * ey, dz - t * ez
-    h2 = g[o + 13] - (nx * nx + ny * ny + nz * nz)
-    real = h2 >= 0.0
-    qs = t + b * math.sqrt(h2 if real else 0.0)
-    az = nz - b * math.sqrt(h2 if real else 0.0) * ez        # vertical part of the link
-    ss = (_kernels.OTHER_MODE if az * g[o + 14] < 0.0 else
-          _kernels.stroke_status(qs, qmin, qmax)) if real else _kernels.NO_SOLUTION
-    qs = qs if real else np.nan
-    # crank: E cos α + F sin α = G (ex, ey, ez hold 2a·u)
-    e = t
-    f = dx * g[o + 10] + dy * g[o + 11] + dz * g[o + 12]
-    gg = dx * dx + dy * dy + dz * dz + g[o + 13]
-    rho2 = e * e + f * f
-    hc2 = rho2 - gg * gg
-    creal = hc2 >= 0.0
-    hc = math.sqrt(hc2 if creal else 0.0)
-    qc = _atan2(f * gg + b * e * hc, e * gg - b * f * hc)
-    degenerate = rho2 <= g[o + 14]
-    sc = (_kernels.DEGENERATE if degenerate else
-          (_kernels.stroke_status(qc, qmin, qmax) if creal else _kernels.NO_SOLUTION))
-    qc = qc if creal and not degenerate else np.nan
-    q = qp if kind == 0.0 else (qs if kind == 1.0 else qc)
-    s = sp if kind == 0.0 else (ss if kind == 1.0 else sc)
-    return q, s
-
-
-@register_jitable(inline="always")
-def _sixleg_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st,
-                j):
-    """Per-pose inverse kinematics (see :mod:`._kernels`)."""
-    for i in range(6):
-        v, c = _leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, _L * i,
-                    qmin, qmax)
-        k = i * _kernels.ROW + j
-        q[k] = v
-        st[k] = c
-
-
 @register_jitable
 def _linear_interval(x, y, wx, wy, wz, k, p1, p2):
     """One leg's z interval on the column (x, y) (see :func:`.column_kernels.make_column_kernel`).
@@ -245,6 +183,7 @@ class SixLeg(Mechanism):
     branch: np.ndarray = (-1.0,) * 6  # type: ignore[assignment]
     tool_offset: np.ndarray = (0.0, 0.0, 0.0)  # type: ignore[assignment]
 
+    #: the kernel of any instance; :attr:`_ik_kernel` picks the one for the instance's kinds
     _ik_one = _sixleg_one
     #: named study variables (paths in the generator form of the YAML model)
     design_aliases: ClassVar[dict] = {
@@ -402,6 +341,11 @@ class SixLeg(Mechanism):
                              np.where(crank, 1e-24 * self.crank_length**4, self._slider_sides),
                              b])
         return g.ravel()
+
+    def _ik_kernel(self):
+        """The per-pose IK function for this instance's leg kinds (:func:`.sixleg_ik.ik_function`:
+        legs of one kind run only that kind's kernel)."""
+        return ik_function(self.kinds)
 
     # ---- kinematics --------------------------------------------------------------------------
     def _legs(self, p, R, q):

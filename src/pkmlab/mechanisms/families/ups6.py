@@ -49,21 +49,30 @@ def working_sides(mech) -> np.ndarray:
     return np.where(sz < 0, -1.0, 1.0)
 
 
+@njit(cache=True, inline="always")
+def _ups_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, bx, by, bz, ux, uy, uz,
+             side, qmin, qmax):
+    """One leg: ``(length, status)``; ``side`` (±1) is its working-mode side, a leg on the
+    other side of its base joint is ``OTHER_MODE`` (also the prismatic legs of ``sixleg``)."""
+    sx = px + r00 * ux + r01 * uy + r02 * uz - bx
+    sy = py + r10 * ux + r11 * uy + r12 * uz - by
+    sz = pz + r20 * ux + r21 * uy + r22 * uz - bz
+    v = math.sqrt(sx * sx + sy * sy + sz * sz)
+    s = _kernels.OTHER_MODE if sz * side <= 0.0 else _kernels.stroke_status(v, qmin, qmax)
+    return v, (_kernels.DEGENERATE if v < 1e-12 else s)
+
+
 @register_jitable(inline="always")
 def _ups_one(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, qmin, qmax, q, st, j):
     """Per-pose inverse kinematics (see :mod:`._kernels`): leg lengths; ``g[36 + i]`` is leg
     i's working-mode side (±1), a leg on the other side of its base joint is ``OTHER_MODE``."""
     for i in range(6):
-        bx, by, bz = g[3 * i], g[3 * i + 1], g[3 * i + 2]
-        ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
-        sx = px + r00 * ux + r01 * uy + r02 * uz - bx
-        sy = py + r10 * ux + r11 * uy + r12 * uz - by
-        sz = pz + r20 * ux + r21 * uy + r22 * uz - bz
-        v = math.sqrt(sx * sx + sy * sy + sz * sz)
-        s = _kernels.OTHER_MODE if sz * g[36 + i] <= 0.0 else _kernels.stroke_status(v, qmin, qmax)
+        v, s = _ups_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22,
+                        g[3 * i], g[3 * i + 1], g[3 * i + 2], g[18 + 3 * i], g[19 + 3 * i],
+                        g[20 + 3 * i], g[36 + i], qmin, qmax)
         k = i * _kernels.ROW + j
         q[k] = v
-        st[k] = _kernels.DEGENERATE if v < 1e-12 else s
+        st[k] = s
 
 
 @register_jitable(inline="always")

@@ -57,7 +57,8 @@ class NeededStroke(Evaluator):
                    "the stroke")
         else:
             try:
-                b = stroke_needed(mech, req["orientations"])
+                b = stroke_needed(mech, req["orientations"],
+                                  tol_mm=ctx.evaluation.length_tolerance_mm)
             except ParameterError as exc:
                 why = f"no needed stroke: {exc}"
         if why is not None:

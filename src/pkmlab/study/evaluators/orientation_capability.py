@@ -78,7 +78,8 @@ class OrientationCapability(Evaluator):
         samples = oset.samples if oset.kind == "box" else 7
         if supports_continuous(mech, req["constraints"]):
             # continuous positions, one compiled search, certified bracket (workspaces.optima)
-            b = continuous_capability(mech, samples)
+            b = continuous_capability(mech, samples,
+                                      tol_deg=ctx.evaluation.angle_tolerance_deg)
             a, upper, note = b.lower, b.upper, b.note
         else:
             a, bracket, note = capability(mech, req)

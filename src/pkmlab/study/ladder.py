@@ -1,0 +1,253 @@
+"""The tolerance ladder of a study: optimise at a coarse certified tolerance, re-certify the
+designs that can matter at the fine one (issue 28).
+
+Study file::
+
+    tolerance_ladder:
+      coarse: {angle: 0.1 deg, length: 0.1 mm}   # the capability's and the needed stroke's
+      prune: true                                  # certified pruning (default)
+
+**Coarse pass.** The optimiser sees every candidate evaluated with the coarse tolerances
+(:class:`Tolerances`): the orientation capability bisected to ``angle`` instead of 0.01°, the
+needed stroke to ``length`` instead of 0.01 mm. Every other metric does not depend on them.
+
+**Refinement** (:func:`refine`, after the optimiser). The stored candidates are re-certified at
+the fine tolerances (the study's own: exactly what a run without the ladder computes), front by
+front of their coarse values, best first. Only the laddered evaluators run again
+(:data:`LADDERED`); their fine values replace the coarse ones, and the coarse ones stay in the
+record as ``<metric>_coarse``.
+
+**Certified pruning.** Each laddered metric's fine value is bracketed by the coarse run's proofs:
+the fine ``orientation_capability`` is a certified lower end, so it lies at most at the coarse
+``orientation_capability_upper`` (a proven upper bound of the true capability); the fine
+``needed_stroke`` is a certified upper end, so at least the coarse ``needed_stroke_lower``
+(:func:`bounds`). A candidate not yet refined is *pruned* when its best case over those bounds
+(every other metric exact) is dominated by the fine values of a refined feasible candidate, or
+when its bounds violate a constraint whatever the fine value. Its record keeps the coarse values
+(``<metric>_coarse``, the fine ones null), status ``pruned`` and the reason (the bounds and the
+dominating candidate). A pruned candidate is certainly dominated at the fine tolerance, so the
+fine Pareto front of the refined candidates is the one of all candidates, and the exported
+designs and their metrics are those of a run without the ladder.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..units import parse_angle, parse_length
+from .definition import FINE, Tolerances
+from .evaluators import EVALUATORS
+from .evaluators.registry import Context
+from .objectives import feasible, objective_matrix
+from .selection import non_dominated
+
+__all__ = ["Tolerances", "ToleranceLadder", "LADDERED", "FINE", "bounds", "refine",
+           "ladder_from_spec", "coarse_name", "coarse_view"]
+
+
+@dataclass(frozen=True)
+class ToleranceLadder:
+    """``coarse`` tolerances for the optimisation; ``prune``: certified pruning."""
+
+    coarse: Tolerances
+    prune: bool = True
+
+    def written(self) -> dict:
+        return {"coarse": self.coarse.written(), "prune": self.prune}
+
+
+def ladder_from_spec(data, evaluation) -> ToleranceLadder | None:
+    """The study file's ``tolerance_ladder`` mapping → :class:`ToleranceLadder` (None: none),
+    for a study whose ``evaluation`` computes a laddered optimum."""
+    if data is None:
+        return None
+    where = "tolerance_ladder"
+    if not _laddered(evaluation):
+        raise ParameterError(where, f"used with one of evaluate.{' or evaluate.'.join(LADDERED)}"
+                             " (the optima with a certified tolerance)", data)
+    if not isinstance(data, dict) or set(data) - {"coarse", "prune"} or "coarse" not in data:
+        raise ParameterError(where, "{coarse: {angle: <angle>, length: <length>}, prune: "
+                             "true|false}", data)
+    c = data["coarse"]
+    if not isinstance(c, dict) or set(c) - {"angle", "length"}:
+        raise ParameterError(f"{where}.coarse", "{angle: 0.1 deg, length: 0.1 mm}", c)
+    angle = parse_angle(c.get("angle", "0.01 deg"), f"{where}.coarse.angle")
+    length = parse_length(c.get("length", "0.01 mm"), f"{where}.coarse.length")
+    if not FINE.angle <= angle <= math.radians(5.0):
+        raise ParameterError(f"{where}.coarse.angle", "an angle in [0.01, 5] deg (the fine "
+                             "tolerance is 0.01 deg)", c.get("angle"))
+    if not FINE.length <= length <= 10.0:
+        raise ParameterError(f"{where}.coarse.length", "a length in [0.01, 10] mm (the fine "
+                             "tolerance is 0.01 mm)", c.get("length"))
+    prune = data.get("prune", True)
+    if not isinstance(prune, bool):
+        raise ParameterError(f"{where}.prune", "true or false", prune)
+    return ToleranceLadder(Tolerances(angle, length), prune)
+
+
+#: laddered evaluator → its metrics, each with the coarse metric bounding its fine value
+#: from below and from above (None: no certified bound on that side)
+LADDERED = {
+    "orientation_capability": {
+        "orientation_capability": (None, "orientation_capability_upper"),
+        "orientation_capability_upper": ("orientation_capability", None),
+        "orientation_capability_bracket": (None, None)},
+    "needed_stroke": {
+        "needed_stroke": ("needed_stroke_lower", None),
+        "needed_stroke_lower": (None, "needed_stroke"),
+        "needed_stroke_bracket": (None, None)},
+}
+_BOUNDS = {m: b for ms in LADDERED.values() for m, b in ms.items()}
+
+
+def coarse_name(metric: str) -> str:
+    return f"{metric}_coarse"
+
+
+def bounds(record: dict, metric: str) -> tuple[float, float]:
+    """Certified ``(low, high)`` of ``metric``'s fine value from a coarse ``record`` (exact
+    metrics: the value twice; a missing bound: ∓inf)."""
+    m = record["metrics"]
+    if metric not in _BOUNDS:
+        v = m.get(metric)
+        return (math.nan, math.nan) if v is None else (float(v), float(v))
+    lo, hi = _BOUNDS[metric]
+
+    def value(name, default):
+        v = m.get(name) if name else None
+        return default if v is None else float(v)
+    # an open end (upper None: the search's largest box had a position) bounds nothing
+    return value(lo, -math.inf), value(hi, math.inf)
+
+
+def _laddered(evaluation) -> list[str]:
+    return [n for n in evaluation.evaluators if n in LADDERED]
+
+
+def refine_design(space, params, evaluation, seed: int) -> dict:
+    """The laddered evaluators of ``evaluation`` (fine tolerances) on one design → a result
+    with their metrics and notes (runs in a worker like :func:`.evaluators.evaluate_design`)."""
+    t0 = time.perf_counter()
+    mech = space.decode(params)
+    ctx = Context(evaluation, seed, choices=dict(space.evaluation_choices(params)))
+    metrics: dict = {}
+    for name in _laddered(evaluation):
+        metrics.update(EVALUATORS[name](mech, ctx))
+    return {"metrics": metrics, "notes": ctx.notes, "seconds": time.perf_counter() - t0}
+
+
+def _minimised(study, record, best_case: bool) -> np.ndarray:
+    """Objective row (minimised): the record's values, or (``best_case``) each objective at
+    the end of its certified bounds that is best for it."""
+    row = []
+    for o in study.objectives:
+        lo, hi = bounds(record, o.metric)
+        v = record["metrics"].get(o.metric)
+        if best_case:
+            v = hi if o.sense == "maximize" else lo
+        v = math.nan if v is None else float(v)
+        row.append(math.inf if math.isnan(v) else (-v if o.sense == "maximize" else v))
+    return np.array(row)
+
+
+def _violation(study, record) -> str:
+    """A constraint the record's certified bounds violate whatever the fine value, or ''."""
+    for c in study.constraints:
+        lo, hi = bounds(record, c.metric)
+        if math.isnan(lo):
+            return f"{c.metric} undefined"
+        if c.min is not None and hi < c.min:
+            return f"{c.metric} <= {hi:.6g} < {c.min:g} (certified)"
+        if c.max is not None and lo > c.max:
+            return f"{c.metric} >= {lo:.6g} > {c.max:g} (certified)"
+    return ""
+
+
+def refine(study, runner, store) -> dict:
+    """Re-certify the stored candidates at the fine tolerances, pruning those certainly
+    dominated (module notes) → ``{"refined": n, "pruned": n}``."""
+    ladder = study.tolerance_ladder
+    names = [m for n in _laddered(study.evaluation) for m in LADDERED[n]]
+    ok = [r for r in store.all() if r["status"] == "ok"]
+    fresh = [not any(coarse_name(m) in r["metrics"] for m in names) for r in ok]
+    todo = [r for r, f in zip(ok, fresh, strict=True) if f]
+    done = [r for r, f in zip(ok, fresh, strict=True) if not f]    # refined before a resume
+    counts = {"refined": 0, "pruned": 0}
+    if not names:
+        return counts
+    space, ev, seed = study.space, study.evaluation, study.seed
+    while todo:
+        # the next front of the coarse values among the candidates left
+        F = np.array([_minimised(study, r, False) for r in todo])
+        front = set(np.flatnonzero(non_dominated(F)).tolist())
+        # the Pareto front is over candidates: the baseline never dominates (nor is pruned)
+        refined_ok = [r for r in done if r["role"] == "candidate" and feasible(study, [r])[0]]
+        Fd = objective_matrix(study, refined_ok)[0] if refined_ok else np.empty((0, 0))
+        batch, keep = [], []
+        for i in range(len(todo)):
+            r = todo[i]
+            why = ""
+            if ladder.prune and r["role"] == "candidate":
+                why = _violation(study, r)
+                best = _minimised(study, r, True)
+                for j, d in enumerate(refined_ok if not why else ()):
+                    if np.all(Fd[j] <= best) and np.any(Fd[j] < best):
+                        why = (f"certainly dominated by evaluation {d['seq']}: best case "
+                               f"{_text(study, best)} vs {_text(study, Fd[j])}")
+                        break
+            if why:
+                _prune(store, r, names, why)
+                counts["pruned"] += 1
+            elif i in front or r["role"] == "baseline":
+                batch.append(r)
+            else:
+                keep.append(r)
+        tasks = [(r["key"], (space, None if r["role"] == "baseline" else r["params"], ev,
+                             seed)) for r in batch]
+        by_key = {r["key"]: r for r in batch}
+        for key, res in runner.map(refine_design, tasks):
+            done.append(_refined(store, by_key[key], names, res))
+            counts["refined"] += 1
+        todo = keep
+    return counts
+
+
+def coarse_view(record: dict) -> dict:
+    """``record`` as the coarse pass stored it (what the optimiser saw: a resumed run's
+    optimiser sees the same values)."""
+    m = record["metrics"]
+    back = {k[:-len("_coarse")]: v for k, v in m.items() if k.endswith("_coarse")}
+    if not back:
+        return record
+    status = "ok" if record["status"] == "pruned" else record["status"]
+    return {**record, "status": status, "metrics": {**m, **back}}
+
+
+def _text(study, row) -> str:
+    return "(" + ", ".join(f"{o.metric} {(-v if o.sense == 'maximize' else v):.6g}"
+                           for o, v in zip(study.objectives, row, strict=True)) + ")"
+
+
+def _refined(store, record, names, res) -> dict:
+    metrics = dict(record["metrics"])
+    for m in names:
+        metrics[coarse_name(m)] = metrics.get(m)
+    metrics.update(res["metrics"])
+    notes = {k: v for k, v in record["notes"].items() if k not in names}
+    notes.update(res["notes"])
+    return store.update(record["key"], metrics=metrics, notes=notes,
+                        seconds=record["seconds"] + res["seconds"])
+
+
+def _prune(store, record, names, why: str) -> dict:
+    metrics = dict(record["metrics"])
+    for m in names:
+        metrics[coarse_name(m)] = metrics.pop(m, None)
+        metrics[m] = None
+    return store.update(record["key"], metrics=metrics, status="pruned",
+                        reason=f"not re-certified at the fine tolerance: {why}")
