@@ -256,7 +256,7 @@ def inverse_free(mech, X: np.ndarray, lo: float, hi: float):
     where = np.full(POSE_SIZE, -1, dtype=np.int64)
     where[list(index)] = np.arange(len(index))
     fixed = carray(mech.nominal_pose)
-    drive = make_free_driver(type(mech)._ik_one, len(g), L, index)
+    drive = make_free_driver(mech._ik_kernel(), len(g), L, index)
     with threads_for(n):
         drive(carray(X), where, fixed, fixed_rotation(fixed[3:]), g, float(lo), float(hi), q,
               st, reason)
