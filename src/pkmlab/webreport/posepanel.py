@@ -115,6 +115,76 @@ def _leg_model(leg: Leg, scale: float) -> tuple[dict | None, str]:
                   f"{act.type} joint {a} actuated is not a leg kind the page solves")
 
 
+def _pairs(declared, solved, nominal, scale: float) -> list:
+    """``solved`` with the legs that are none of the single kinds read as ``pair`` legs where
+    two of them end in the same last link and platform joint (:func:`_pair_model`)."""
+    out = list(solved)
+    groups: dict[tuple[str, str], list[int]] = {}
+    for i, (leg, (m, _)) in enumerate(zip(declared, solved)):
+        if m is None and leg.links:
+            groups.setdefault((leg.links[-1].name, leg.joints[-1].name), []).append(i)
+    from ..poses import euler_to_matrix
+
+    R = euler_to_matrix(np.asarray(nominal[3:], float))
+    for idx in groups.values():
+        if len(idx) != 2:
+            continue
+        pair, reason = _pair_model(declared[idx[0]], declared[idx[1]], R, scale)
+        for k, i in enumerate(idx):
+            out[i] = (pair[k], "") if pair else (None, reason)
+    return out
+
+
+def _pair_model(leg1: Leg, leg2: Leg, R: np.ndarray, scale: float):
+    """Two U–P–R–U legs that share their upper link (``pair``; a luzi3 chain): each a strut
+    ``A_j → B_j`` (P carried by a link, zero at the base U's centre ``A_j``) whose base U turns
+    about the chord ``r = A_2 − A_1`` and whose R at ``B_j`` is normal to the plane γ of
+    ``A_1, A_2`` and the common platform joint ``C``: the shared link lies in γ, and in the
+    plane normal to the platform joint's platform-fixed axis ``k`` (its second axis). So
+    ``t = ±(k × (r × (C − A_1)))/|…|`` (sign: ``t·r ≥ 0``), ``B_j = C + s_j t`` with ``s_j``
+    the signed offset of ``B_j`` along ``t`` at the nominal pose, ``q_j = |B_j − A_j|``; the
+    branch is the nominal sign of ``(k × (r × (C − A_1)))·r``. Returns ``((m1, m2), "")`` or
+    ``(None, why not)``."""
+    tol = 1e-9 * scale
+    legs = (leg1, leg2)
+    A = [leg.joints[0].location for leg in legs]
+    C = leg1.joints[-1].location
+    r = A[1] - A[0]
+    rn = float(np.linalg.norm(r))
+    w = np.cross(r, C - A[0])
+    n = np.cross(leg1.joints[-1].axes[1], w)
+    nn = float(np.linalg.norm(n))
+    why = f"{leg1.name}, {leg2.name}: "
+    if rn <= tol or nn <= 1e-9 * rn * float(np.linalg.norm(C - A[0])):
+        return None, why + "a shared link whose plane is not defined at the nominal pose"
+    branch = 1.0 if n @ r >= 0 else -1.0
+    t = branch * n / nn
+    gamma = w / np.linalg.norm(w)
+    models = []
+    for leg, a in zip(legs, A):
+        js = leg.joints
+        types = "-".join(j.type for j in js)
+        act, B = leg.actuated, leg.actuated.location
+        s = float((B - C) @ t)
+        if (types != "U-P-R-U" or leg.actuated_index != 1 or act.parent == "base"
+                or js[0].mount != "base" or js[-1].mount != "platform"
+                or np.linalg.norm(act.zero - a) > tol
+                or abs(np.linalg.norm(B - a) - leg.value) > tol
+                or np.linalg.norm(np.cross(js[0].axes[0], r / rn)) > 1e-9
+                or np.linalg.norm(np.cross(js[2].axes[0], gamma)) > 1e-9
+                or np.linalg.norm(js[2].location - B) > tol
+                or np.linalg.norm(B - C - s * t) > tol
+                or abs(abs(s) - leg.links[-1].length) > tol):
+            return None, (why + f"a {types} chain sharing its last link is solved only as two "
+                          "U-P-R-U struts whose base U joints turn about their common chord "
+                          "and whose link lies in the chain's plane and the platform's")
+        models.append({"name": leg.name, "kind": "pair", "platform": js[-1].mount_location.tolist(),
+                       "base": a.tolist(), "a1": A[0].tolist(), "a2": A[1].tolist(),
+                       "normal": (R.T @ js[-1].axes[1]).tolist(), "offset": s,
+                       "branch": branch})
+    return models, ""
+
+
 def pose_model(mech) -> dict:
     """Everything ``posepanel.js`` needs for ``mech`` (JSON-ready): ``supported`` and, when not,
     ``reason``; the mobility, nominal pose, actuator window and unit, the legs, the
@@ -124,8 +194,10 @@ def pose_model(mech) -> dict:
     mob = mech.mobility
     scale = float(mech.scale)
     legs, why = [], []
-    for leg in mech.legs():
-        m, reason = _leg_model(leg, scale)
+    declared = mech.legs()
+    solved = [_leg_model(leg, scale) for leg in declared]
+    solved = _pairs(declared, solved, mech.nominal_pose, scale)
+    for m, reason in solved:
         if m is None:
             why.append(reason)
         else:

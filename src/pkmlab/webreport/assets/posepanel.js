@@ -1,6 +1,6 @@
 /* pkmlab pose panel: jog a mechanism in the page. The inverse kinematics, leg status and κ are
    computed here from the legs pkmlab declares (pkmlab.webreport.posepanel: leg kinds distance,
-   rail and crank; hinge planes for dependent coordinates), never from precomputed values.
+   rail, crank and pair; hinge planes for dependent coordinates), never from precomputed values.
    window.pkmlabPose.solve(model, pose6) is what the browser test checks against pkmlab. */
 (function () {
   "use strict";
@@ -66,9 +66,31 @@
     return [(n22 * b1 - n12 * b2) / det, (n11 * b2 - n12 * b1) / det, Math.atan2(sg, cg)];
   }
 
+  /* a strut of a pair sharing its upper link (posepanel._pair_model): t = ±k×(c×(W−A1))/|…|
+     with t·c ≥ 0 (c = A2 − A1), B = W + offset·t, q = |B − A|; the row is ∂q/∂(v, ω):
+     dq = e·dW + e·dt·offset, dt = (I − ttᵀ)·dn·sgn/|n|, dn = dk×w + k×(c×dW), dk = ω×k,
+     dW = v + ω×r, so with g = offset·sgn/|n|·(I − ttᵀ)e and h = e + (g×k)×c the row is
+     [h, r×h + k×(w×g)] */
+  function pair(m, L, W, r, R) {
+    var k = mv(R, L.normal), c = sub(L.a2, L.a1), d = sub(W, L.a1);
+    var w = cross(c, d), n = cross(k, w), nn = Math.sqrt(dot(n, n));
+    if (!(nn > 1e-12 * Math.sqrt(dot(c, c)) * Math.sqrt(dot(d, d)))) {
+      return {q: NaN, status: 3, why: "link plane undefined", E: null, row: null};
+    }
+    var sg = dot(n, c) >= 0 ? 1 : -1, t = scl(n, sg / nn);
+    var B = add(W, scl(t, L.offset)), e = sub(B, L.base), q = Math.sqrt(dot(e, e));
+    var st = 0, why = "";
+    if (sg * L.branch <= 0) { st = 3; why = "other working mode"; }
+    if (!st && stroke(q, m)) { st = 1; why = q < m.stroke[0] ? "below stroke" : "above stroke"; }
+    var eu = scl(e, 1 / q), g = scl(sub(eu, scl(t, dot(t, eu))), L.offset * sg / nn);
+    var h = add(eu, cross(cross(g, k), c));
+    return {q: q, status: st, why: why, E: B, row: h.concat(add(cross(r, h), cross(k, cross(w, g))))};
+  }
+
   /* one leg at platform joint W: {q, status, why, E (intermediate joint), row (6)} */
-  function leg(m, L, W, r) {
+  function leg(m, L, W, r, R) {
     var q, st = 0, why = "", E = null, Lv, dE, h2;
+    if (L.kind === "pair") { return pair(m, L, W, r, R); }
     if (L.kind === "distance") {
       var d = sub(W, L.base);
       q = Math.sqrt(dot(d, d));
@@ -187,12 +209,12 @@
     var out = {pose: X, q: [], status: [], why: [], points: [], W: []}, rows = [], cons = [];
     m.legs.forEach(function (L) {
       var r = mv(R, sub(L.platform, m.tool_offset)), W = add(p, r);
-      var s = leg(m, L, W, r);
+      var s = leg(m, L, W, r, R);
       out.q.push(s.q);
       out.status.push(s.status);
       out.why.push(s.why);
       out.W.push(W);
-      var start = L.kind === "distance" ? L.base : (L.kind === "rail" ? L.zero : L.pivot);
+      var start = L.kind === "distance" || L.kind === "pair" ? L.base : (L.kind === "rail" ? L.zero : L.pivot);
       out.points.push(s.E ? [start, s.E, W] : [start, W]);
       rows.push(s.row || [NaN, NaN, NaN, NaN, NaN, NaN]);
       if (L.plane) { cons.push(L.plane.concat(cross(r, L.plane))); }
