@@ -44,3 +44,30 @@ def test_model_reads_the_declaration(family):
     cl = resolve_length(mech)
     assert m["char_length"] == (None if cl.length is None else pytest.approx(cl.length))
     assert {leg["kind"] for leg in m["legs"]} <= {"distance", "rail", "crank", "pair"}
+
+
+def test_pair_reads_the_joints_and_refuses_other_chains():
+    """luzi3's legs are read as ``pair`` legs from their joints: both struts of a chain share
+    its chord and the platform normal, and their offsets along the link are ∓l/2 (1e-9 mm).
+    A chain whose R joint at B_j is not normal to the chain's plane (turned 1e-3 rad) is not
+    solved, and the model names its legs."""
+    import dataclasses
+
+    from pkmlab.webreport import posepanel
+
+    mech = sample("luzi3")
+    legs = pose_model(mech)["legs"]
+    half = 0.5 * mech.upper_link
+    assert [leg["kind"] for leg in legs] == ["pair"] * 6
+    for k in range(0, 6, 2):
+        a, b = legs[k], legs[k + 1]
+        assert a["a1"] == b["a1"] and a["a2"] == b["a2"] and a["normal"] == b["normal"]
+        assert abs(a["offset"] + half) <= 1e-9 and abs(b["offset"] - half) <= 1e-9
+    declared = mech.legs()
+    j = declared[0].joints[2]
+    c, s = np.cos(1e-3), np.sin(1e-3)
+    turned = dataclasses.replace(j, axes=j.axes @ np.array([[c, s, 0], [-s, c, 0], [0, 0, 1]]))
+    bent = dataclasses.replace(declared[0],
+                               joints=(*declared[0].joints[:2], turned, declared[0].joints[3]))
+    pair, why = posepanel._pair_model(bent, declared[1], np.eye(3), float(mech.scale))
+    assert pair is None and why.startswith("l11, l12:"), why

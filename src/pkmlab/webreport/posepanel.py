@@ -2,8 +2,8 @@
 (``assets/posepanel.js``), read from the declared joints (``mech.legs()``, the nominal pose),
 its mobility and its parameter vector, and the study's task region as 3-D traces.
 
-**Leg kinds.** Every leg the page can solve is one of three shapes of a declared chain, told
-apart by its actuated joint, never by the family:
+**Leg kinds.** Every leg the page can solve is one of four shapes of a declared chain, told
+apart by its joints, never by the family:
 
 * ``distance`` — an actuated P joint carried by a link (its axis turns with the leg: U–P–S,
   R–P–R, U–P–U) whose zero is the first joint's centre and whose location is the platform
@@ -14,7 +14,15 @@ apart by its actuated joint, never by the family:
 * ``crank`` — an actuated R joint on the base turning a crank of length ``r`` (zero direction
   ``u``, ``v = n × u``) followed by a link of length ``l`` to the platform joint:
   ``A cos q + B sin q = K`` with ``A = d·u``, ``B = d·v``, ``K = (|d|² + r² − l²)/(2r)``
-  (R–S–S, R–R–R).
+  (R–S–S, R–R–R);
+* ``pair`` — two U–P–R–U struts ``A_j → B_j`` that share their last link ``B_1 B_2`` and its
+  platform joint ``C`` (luzi3's chains): the base U joints turn about the chord ``c = A_2 −
+  A_1`` and the R joints keep the link in the plane of ``A_1, A_2, C``; the platform joint's
+  platform-fixed axis ``k`` keeps it normal to ``k``, so ``t = ±k × (c × (C − A_1))/|…|``
+  (``t·c ≥ 0``), ``B_j = C + s_j t`` and ``q_j = |B_j − A_j|`` (:func:`_pair_model`). The
+  chain keeps the nominal sign of ``(k × (c × (C − A_1)))·c`` (else: unreachable, another
+  working mode), as ``luzi3.working_branches``; a vanishing ``k × (c × (C − A_1))`` is
+  unreachable (the link's direction is undefined).
 
 The branch ``b`` (rail, crank) is the root that gives the declared actuator value at the
 nominal pose. A leg whose link has a vertical component at the nominal pose keeps its sign
@@ -24,7 +32,8 @@ planes are the constraints that give a mobility's dependent coordinates (the 3-P
 θz``). Passive-joint limits are read from the parameter vector (:data:`PASSIVE_LIMITS`).
 
 The page computes, from these and the pose, each actuator's value and status (ok / out of
-stroke / joint limit / unreachable), the Jacobian rows ``[L, r × L] / (L·∂E/∂q)`` over the free
+stroke / joint limit / unreachable), the Jacobian rows ``[L, r × L] / (L·∂E/∂q)`` (a pair's:
+the derivative of ``q_j`` through ``C`` and ``t``, ``posepanel.js``) over the free
 twist columns (dependent ones eliminated through the plane constraints) and κ as pkmlab
 defines it (:func:`pkmlab.dexterity.metrics.condition_number`, with
 :func:`~pkmlab.dexterity.metrics.resolve_length`'s characteristic length).
