@@ -55,7 +55,8 @@ from pkmlab.study.spec import family_aliases
 from pkmlab.testing import run_contract
 m = pkmlab.load_mechanism({str(PLUGIN / "legs6-demo.yaml")!r})
 assert type(m) is REGISTRY["legs6"] and not PLUGIN_ERRORS, PLUGIN_ERRORS
-assert family_aliases("legs6") == {{"stroke_max": ("stroke[1]", "length")}}
+assert family_aliases("legs6") == {{"stroke_max": ("stroke[1]", "length"),
+                                   "home_height": ("nominal_pose[2]", "length")}}
 print(run_contract(m, skip=("assembly_modes",)))
 """
     run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,

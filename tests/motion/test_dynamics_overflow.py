@@ -38,7 +38,7 @@ def test_an_overflowing_sample_is_flagged_not_ok():
 def test_the_motions_evaluator_reports_it(tmp_path, monkeypatch):
     mech = pkmlab.load_mechanism(MECH_DIR / "gough-stewart-6ups.yaml")
     plan = build_motions([{"name": "p", "paper": True}], tmp_path)
-    monkeypatch.setattr(type(plan), "motions", lambda self, m: [_overflowing(m)])
+    monkeypatch.setattr(type(plan), "motions", lambda self, m, centre=None: [_overflowing(m)])
     ev = Evaluation({"motions": plan, "payload": build_payload({"mass": "100 kg"})})
     ctx = Context(ev, 0)
     out = EVALUATORS["motions"](mech, ctx)
