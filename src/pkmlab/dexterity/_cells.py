@@ -23,8 +23,8 @@ gets certified bounds over all its samples:
   (1 - μ)``; ``(J_h(s)⁻¹ - J_h₀⁻¹)_{0:3, c} = -(J_h₀⁻¹)_{0:3, :} (J_h(s) - J_h₀) J_h(s)⁻¹ e_c``
   and ``‖J_h(s)⁻¹ e_c‖ <= ‖b_c‖ / (1 - μ)`` (``b_c`` the column of ``J_h₀⁻¹``), so
   ``‖(J(s)⁻¹)_{0:3, c}‖ <= g_c + ν ‖b_c‖ / (1 - μ)``, which bounds the force
-  ``min_c fmax_c / ‖(J(s)⁻¹)_{0:3, c}‖`` below by ``F``; and ``J_h₀ + t (J_h(s) - J_h₀)`` is non-singular for
-  ``t ∈ [0, 1]``, so ``det J(s)`` has the sign of ``det J₀``.
+  ``min_c fmax_c / ‖(J(s)⁻¹)_{0:3, c}‖`` below by ``F``; and ``J_h₀ + t (J_h(s) - J_h₀)`` is
+  non-singular for ``t ∈ [0, 1]``, so ``det J(s)`` has the sign of ``det J₀``.
 
 Every bound is multiplied (or divided) by ``1 + KAPPA_ROUND`` per rounded quantity, and a cell
 with ``K >= 1e8`` is never pruned (:func:`._linalg.kappa_upper`'s range). The box Jacobians'

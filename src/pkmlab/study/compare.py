@@ -43,8 +43,8 @@ import numpy as np
 from .. import dexterity as dx
 from ..escaping import markdown_text
 from ..motion import check_trajectory, paper_motion
-from ..workspaces import OrientationSet, workspace
 from ..units import effort_limit
+from ..workspaces import OrientationSet, workspace
 
 log = logging.getLogger(__name__)
 
@@ -271,9 +271,9 @@ def comparison_markdown(rows: list[dict], box_deg: float | None = None) -> str:
               "`pkmlab workspace --inscribed`. L: Angeles' characteristic length (status in "
               "brackets). GCI: every voxel × orientation sample. κ range and force: the grid's "
               "smallest κ and `pkmlab.dexterity.worst_case` (every voxel and column end × "
-              f"orientation sample; {_limits_text(req)}; inf / 0 N when a singular pose is found inside or on the "
-              "boundary, at a sample or column end or by a sign change of det J between "
-              "neighbours; otherwise a singular pose between samples is not excluded)."]
+              f"orientation sample; {_limits_text(req)}; inf / 0 N when a singular pose is "
+              "found inside or on the boundary, at a sample or column end or by a sign "
+              "change of det J between neighbours; otherwise a singular pose between samples is not excluded)."]
     return "\n".join(lines) + "\n"
 
 
