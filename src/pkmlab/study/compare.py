@@ -273,7 +273,8 @@ def comparison_markdown(rows: list[dict], box_deg: float | None = None) -> str:
               "smallest κ and `pkmlab.dexterity.worst_case` (every voxel and column end × "
               f"orientation sample; {_limits_text(req)}; inf / 0 N when a singular pose is "
               "found inside or on the boundary, at a sample or column end or by a sign "
-              "change of det J between neighbours; otherwise a singular pose between samples is not excluded)."]
+              "change of det J between neighbours; otherwise a singular pose between samples "
+              "is not excluded)."]
     return "\n".join(lines) + "\n"
 
 
