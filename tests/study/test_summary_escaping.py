@@ -6,6 +6,8 @@ emphasis, no extra table cell."""
 
 from __future__ import annotations
 
+import types
+
 import pytest
 
 from pkmlab.escaping import markdown_text
@@ -21,6 +23,7 @@ EVIL = ('<a href="https://evil.example/x">click</a><img src=x onerror=alert(1)>'
 class _Var:
     unit = "mm"
     role = "geometry"
+    kind = "choice"           # never on a bound of the design box
 
     def __init__(self, name):
         self.name = name
@@ -42,6 +45,7 @@ class _Study:
     constraints = []
     top = 2
     space = _Space()
+    evaluation = types.SimpleNamespace(task=None)     # no task: no placement or κ flags
 
 
 def _render(text: str) -> str:
@@ -62,11 +66,13 @@ def test_hostile_strings_in_summary_md_render_as_text():
     records, front = _records()
     text = _summary(_Study(), records, front, records[0])
     page = _render(text)
-    # no element made from the user's strings: no link, image, emphasis, raw HTML; one list
-    # item (pkmlab's own note line; the description starting with "- " is not a list)
+    # no element made from the user's strings: no link, image, emphasis, raw HTML; list items
+    # only from pkmlab's own note lines (the description starting with "- " is not a list)
     for tag in ("<a ", "<img", "<strong>", "<em>"):
         assert tag not in page, (tag, page)
-    assert page.count("<li>") == 1, page
+    own = [ln for ln in text.splitlines() if ln.startswith(("- baseline", "- #"))]
+    assert own and page.count("<li>") == len(own), page
+    assert not text.splitlines()[2].startswith("- ")       # the escaped description
     # the strings are there, as text (the renderer's entities for < and >)
     assert page.count("&lt;a href=&quot;https://evil.example/x&quot;&gt;click&lt;/a&gt;") >= 5
     assert page.count("[md](https://evil.example/m) **bold** | cell") >= 5

@@ -57,27 +57,30 @@ def design_flags(study: Study, designs: list[dict], params_of, quiet: bool = Fal
     least-violating ones): on-bound variables, poor conditioning at the task, the placed
     task centre. ``params_of(record)`` gives a record's design values; ``text`` escapes the
     user's strings (variable names) for the renderer (Markdown: ``markdown_text``)."""
-    out, info = [], []
+    out, info, logged = [], [], []
     for r in designs:
         name = label(r)
-        b = [text(t) for t in on_bound(study, params_of(r))]
-        if b:
-            out.append(f"- {name} lies on a bound of the design box (within "
-                       f"{BOUND_SHARE:.0%} of the range): {', '.join(b)}; the best design may "
-                       "lie outside the box — widen it in that direction")
+        b = on_bound(study, params_of(r))
+        for esc, lines in ((text, out), (str, logged)):      # escaped: the file; raw: the log
+            if b:
+                lines.append(f"- {name} lies on a bound of the design box (within "
+                             f"{BOUND_SHARE:.0%} of the range): {', '.join(map(esc, b))}; the "
+                             "best design may lie outside the box — widen it in that direction")
         k = r["metrics"].get("sampled_task_kappa")
         if "sampled_task_kappa" in r["metrics"] and (k is None or k > TASK_KAPPA_WARN):
             shown = "singular or unreachable" if k is None else f"κ {k:.3g}"
-            out.append(f"- {name}: poor conditioning at the task ({shown} > "
-                       f"{TASK_KAPPA_WARN:g} at its corners and centre × orientation samples, "
-                       "a sampled value): force and accuracy degrade there")
+            line = (f"- {name}: poor conditioning at the task ({shown} > "
+                    f"{TASK_KAPPA_WARN:g} at its corners and centre × orientation samples, "
+                    "a sampled value): force and accuracy degrade there")
+            out.append(line)
+            logged.append(line)
         if getattr(study.evaluation.task, "auto", None) and any(study.evaluation.task.auto):
             c = [r["metrics"].get(f"task_centre_{a}") for a in "xyz"]
             if all(v is not None for v in c):
                 info.append(f"- {name}: task centre placed at x {c[0]:.4g}, y {c[1]:.4g}, "
                            f"z {c[2]:.4g} mm (relative to the task frame; a search result, "
                            "not a proven optimum)")
-    for line in [] if quiet else out:
+    for line in [] if quiet else logged:
         log.warning("%s", line[2:])
     for line in [] if quiet else info:
         log.info("%s", line[2:])
