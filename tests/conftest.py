@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -96,3 +97,15 @@ def assert_point_holds(mech, p, th, rng, minima=3) -> None:
         r = minimize(lambda v: point_margin(mech, p, v)[0], e, method="L-BFGS-B",
                      bounds=[(-th, th)] * 3)
         assert r.fun >= -1e-9
+
+
+def same_result(a, b) -> bool:
+    """Equal nested results (dicts, lists, numbers), NaN equal to NaN: the bit-for-bit
+    comparisons of the worst-case passes."""
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(same_result(a[k], b[k]) for k in a)
+    if isinstance(a, list | tuple):
+        return len(a) == len(b) and all(same_result(x, y) for x, y in zip(a, b))
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    return a == b

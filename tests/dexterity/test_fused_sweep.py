@@ -5,11 +5,10 @@ path's values bit for bit: per pose against ``mech.jacobian`` + ``sweep_bounds``
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 from conftest import MECH_DIR
+from conftest import same_result as _same
 
 import pkmlab
 from pkmlab import dexterity as dx
@@ -20,16 +19,6 @@ from pkmlab.workspaces import OrientationSet, workspace
 
 PSU = pkmlab.load_mechanism(MECH_DIR / "hopkins-williams-6psu.yaml")
 UPS = pkmlab.load_mechanism(MECH_DIR / "gough-stewart-6ups.yaml")
-
-
-def _same(a, b) -> bool:
-    if isinstance(a, dict):
-        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
-    if isinstance(a, list | tuple):
-        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
-    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
-        return True
-    return a == b
 
 
 @pytest.mark.parametrize("mech", [PSU, UPS], ids=["psu6", "ups6"])
