@@ -187,3 +187,15 @@ def test_the_suggested_resolution_fits_both_budgets(monkeypatch):
     with pytest.raises(Stop):
         engine.workspace(mech, "constant", resolution=h)
     assert seen["bytes"] <= memory_limit() and seen["seconds"] <= 3600.0, (h, seen)
+
+
+def test_a_cost_that_fits_gets_no_hint_and_never_overflows():
+    """An integer setting with zero need (a plugin's evaluator whose time model is 0 s) used to
+    raise OverflowError while building the unused hint; a need over the limit still gets one."""
+    from pkmlab.study.evaluators.registry import Cost, check_costs
+
+    free = Cost("evaluate.x.samples", 5, "", 0.5, bytes=0.0, seconds=0.0, integer=True)
+    assert free.fits(0.0, 10.0) == ""
+    assert check_costs([free]) == [free]
+    big = Cost("evaluate.x.samples", 100, "", 1.0, seconds=40.0, integer=True)
+    assert big.fits(40.0, 10.0) == "try <= 22"

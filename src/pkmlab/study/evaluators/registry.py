@@ -99,7 +99,11 @@ class Cost:
         """A setting of ``field`` whose need would fit ``limit`` (``try <= x`` / ``>= x``)."""
         from ...runtime.memory import readable_step
 
+        if not need > limit:                # it fits as it is: no other setting to suggest
+            return ""
         x = self.value * (max(limit, 1e-300) / max(need, 1e-300)) ** (1.0 / self.power)
+        if not math.isfinite(x):
+            return ""
         if self.power < 0:
             x = readable_step(x * 1.05, self.value)
             text = f"try >= {x:g}"
