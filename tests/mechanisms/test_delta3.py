@@ -295,3 +295,31 @@ def test_printer_block_and_command(tmp_path):
     assert r.exit_code == 0 and "printable cylinder: r = 158.250 mm" in r.output
     r = CliRunner().invoke(app, ["printer", str(root / "clavel-delta3.yaml")])
     assert r.exit_code == 2 and "mechanism: must be a linear delta" in r.output
+
+
+def test_printer_speed_ratio_on_a_serial_singularity_is_null_with_a_note(monkeypatch):
+    """Klipper's example prints out to the rods' reach (158.25 mm), where a rod is level (at
+    right angles to its tower): the tower/XY speed ratio on the disc is unbounded and is stored
+    empty with a note saying why (it was stored empty without one). A bounded map gives its
+    largest value and no note."""
+    from types import SimpleNamespace
+
+    from pkmlab.mechanisms.families import delta_printer as dp
+    from pkmlab.study.evaluators.printer import Printer, PrinterSpec
+
+    ctx = SimpleNamespace(evaluation=SimpleNamespace(printer=PrinterSpec(grid=5)), notes={})
+    out = Printer().compute(KLIPPER, ctx)
+    assert out["printable_radius"] == pytest.approx(333 - 174.75, abs=1e-9)
+    assert out["sampled_printer_speed_ratio"] is None
+    assert "right angles to its tower" in ctx.notes["sampled_printer_speed_ratio"]
+    real = dp.speed_ratio_map
+
+    def bounded(*a, **k):
+        m = real(*a, **k)
+        m["ratio"] = np.where(np.isfinite(m["ratio"]), m["ratio"], 7.5)
+        return m
+
+    monkeypatch.setattr(dp, "speed_ratio_map", bounded)
+    ctx.notes.clear()
+    out = Printer().compute(KLIPPER, ctx)
+    assert 7.5 <= out["sampled_printer_speed_ratio"] < math.inf and not ctx.notes

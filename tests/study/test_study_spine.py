@@ -150,6 +150,25 @@ def test_readme_metric_table_is_the_registry():
     assert metrics_markdown() in readme, "regenerate the README table: pkmlab metrics"
 
 
+def test_docs_evaluate_table_has_a_row_for_every_evaluator_and_its_metrics():
+    """docs/studies.md's `evaluate` table names every registered block and every metric it
+    declares (planar_workspace, printer, delta_task and volume_bracket had no row)."""
+    import re
+
+    from pkmlab.study.evaluators.registry import EVALUATORS
+
+    text = (ROOT / "docs" / "studies.md").read_text()
+    rows = {m.group(1): m.group(0) for m in re.finditer(r"^\| `([a-z_0-9]+)` \|.*$", text,
+                                                          re.M)}
+    for name, ev in EVALUATORS.items():
+        if name == "geometry":                      # the "(always)" row
+            continue
+        assert name in rows, f"docs/studies.md: no row for evaluate.{name}"
+        for m in ev.metrics:
+            kind = re.sub(r"^(constant|reachable|dexterous)_", "<kind>_", m.name)
+            assert m.name in rows[name] or kind in rows[name], (name, m.name)
+
+
 def test_every_evaluator_writes_exactly_its_declared_metrics(monkeypatch, tmp_path):
     s = load_study(write(tmp_path, study(tmp_path)))
     metrics, _ = ev_mod.evaluate_mechanism(s.baseline(), s.evaluation, 0)

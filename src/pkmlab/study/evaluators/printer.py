@@ -47,8 +47,8 @@ class Printer(Evaluator):
         metric("sampled_printer_step_z", "mm", "sampled", "the same in z"),
         metric("sampled_printer_speed_ratio", "", "sampled",
                "largest tower/XY speed ratio (carriage speed per unit XY tool speed) over "
-               "the same grid; inf on a serial singularity (a rod at right angles to its "
-               "tower)"),
+               "the same grid; empty with a note on a serial singularity (a rod at right angles "
+               "to its tower)"),
     )
 
     def check(self, plan, evaluation, mech) -> None:
@@ -75,7 +75,11 @@ class Printer(Evaluator):
         worst = float(np.nanmax(np.where(disc, ratio, np.nan)))
         out.update(sampled_printer_step_xy=float(max(res["worst"][:2])),
                    sampled_printer_step_z=float(res["worst"][2]),
-                   sampled_printer_speed_ratio=worst if math.isfinite(worst) else math.inf)
+                   sampled_printer_speed_ratio=worst if math.isfinite(worst) else None)
+        if out["sampled_printer_speed_ratio"] is None:
+            ctx.notes["sampled_printer_speed_ratio"] = (
+                "unbounded: a rod is at right angles to its tower (a serial singularity) at a "
+                f"grid point of the disc at z = {zm:.2f} mm")
         return out
 
 
