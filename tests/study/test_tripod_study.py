@@ -145,9 +145,16 @@ def test_templates_validate_and_run(tmp_path, name, evaluator):
     assert len(rows) == 3 and all(r["status"] == "ok" for r in rows), rows
     for r in rows:
         assert set(r["metrics"]) >= set(s.evaluation.metrics)
-        if evaluator == "tripod_workspace":      # (printer: an infinite speed ratio is null)
-            assert all(v is not None or k in r["notes"] for k, v in r["metrics"].items()
-                       if k in metrics_of(evaluator)), (r["metrics"], r["notes"])
+        assert all(v is not None or k in r["notes"] for k, v in r["metrics"].items()
+                   if k in metrics_of(evaluator)), (r["metrics"], r["notes"])
+    # the summary's footer states the units of the columns it shows (it said "volumes in
+    # cm³" for the tripod's mm·deg² volumes)
+    from pkmlab.study.report import write_report
+
+    write_report(tmp_path / "out", s, rows)
+    foot = (tmp_path / "out" / "summary.md").read_text().splitlines()[-1]
+    want = {"tripod_workspace": "mm·deg²", "printer": "cm³"}[evaluator]
+    assert want in foot and ("cm³" in foot) == (evaluator == "printer"), foot
     if evaluator == "tripod_workspace":    # open_results gives the tripod's workspace
         from pkmlab import open_results
 

@@ -240,8 +240,9 @@ def _summary(study: Study, records, front, baseline) -> str:
                   "designs are named by their evaluation number, the `seq` column):", *flags]
     if notes:
         lines += ["", "Notes (a value shown as — is undefined for the reason given):", *notes]
-    lines += ["", "Lengths in mm, angles in degrees, volumes in cm³, forces in N; "
-              "servos: torques in N·m, angular speeds in deg/s. Metric "
+    units = ", ".join(dict.fromkeys(METRICS[m].unit for m in metrics if METRICS[m].unit))
+    lines += ["", "Each metric's unit is in its column header" + (f" ({units})" if units else "")
+              + "; design variables and notes: lengths in mm, angles in degrees. Metric "
               "definitions: `pkmlab metrics`. Full tables: evaluations.csv, pareto.csv; "
               "exported designs (mechanism YAML, workspace STL, slices, κ map) under designs/."]
     return "\n".join(lines) + "\n"
