@@ -311,6 +311,15 @@ def test_derived_parametrisation_removes_the_invalid_share(tmp_path):
     mech = s.space.decode({"base_outer_radius": 400.0, "base_inner_ratio": 0.75})
     r = np.linalg.norm(mech.base_points[:, :2], axis=1)
     assert sorted(set(np.round(r, 9))) == [300.0, 400.0]
+    # study.resolved.yaml keeps the derived field's name (a rebuilt report's card showed the
+    # path generator.base_radii[0]); the alias and its path are the same study
+    res = s.resolved()
+    assert res["derived"] == {"base_inner_radius": "base_inner_ratio * base_outer_radius"}
+    again = load_study(write(tmp_path, {**res, "output": str(tmp_path / "out")}, "res.yaml"))
+    assert [d.name for d in again.space.derived] == ["base_inner_radius"]
+    by_path = dict(ratio, derived={"generator.base_radii[0]":
+                                   "base_inner_ratio * base_outer_radius"})
+    assert load_study(write(tmp_path, by_path, "p.yaml")).fingerprint() == s.fingerprint()
     r = CliRunner().invoke(app, ["validate", str(tmp_path / "c.yaml"), "--json"])
     assert r.exit_code == 0 and json.loads(r.stdout)["warnings"], r.output
 

@@ -186,7 +186,8 @@ class Study:
             "study": self.name, "description": self.description,
             "mechanism": {"inline": to_display(self.space.base_spec)},
             "design": design,
-            "derived": {_path_text(d.target): d.expression.text for d in self.space.derived},
+            # each derived field under the name the study gave it (an alias or a path)
+            "derived": {d.name: d.expression.text for d in self.space.derived},
             "evaluate": evaluate,
             "objectives": [{o.sense: o.metric} for o in self.objectives],
             "constraints": [{c.metric: {k: getattr(c, k) for k in ("min", "max")
@@ -226,7 +227,9 @@ class Study:
         """Hash of what determines the evaluations (mechanism, design space, evaluation,
         seed): the store refuses to resume a study whose fingerprint changed."""
         r = self.resolved()
-        keep = {k: r[k] for k in ("mechanism", "design", "derived", "evaluate", "seed")}
+        keep = {k: r[k] for k in ("mechanism", "design", "evaluate", "seed")}
+        # by the field each sets: an alias and its path are the same study
+        keep["derived"] = {_path_text(d.target): d.expression.text for d in self.space.derived}
         if r["tolerance_ladder"] is not None:    # coarse values are stored: part of the run
             keep["tolerance_ladder"] = r["tolerance_ladder"]
         keep["input_files"] = self.input_digests()
