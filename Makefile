@@ -61,8 +61,11 @@ $(BROWSER): | $(STAMP)
 demo: bytecode
 	$(VENV)/bin/pkmlab run studies/hopkins-6psu-redesign.yaml --jobs 2 --overwrite
 
+# the suite runs in TEST_JOBS processes (pytest-xdist), whole files per process so that module
+# fixtures are built once; most of a cold run is numba compiling, which is single-threaded
+TEST_JOBS ?= 2
 test: lock-check bytecode $(BROWSER)
-	$(PY) -m pytest
+	$(PY) -m pytest -n $(TEST_JOBS) --dist loadfile
 
 bench: bytecode
 	$(PY) benchmarks/bench_kinematics.py
