@@ -171,6 +171,10 @@ def test_compare_html_overlays_the_designs(tmp_path):
     assert not re.search(r"<script\b[^>]*\bsrc=", html)
     with pytest.raises(ValueError):
         compare_html([], tmp_path / "none.html")
+    # a design without metrics (only a label) gets dashes, not a TypeError from the format
+    bare = compare_html([rows[0], {"label": "bare"}], tmp_path / "bare.html", slices=False)
+    cells = re.findall(r"<td[^>]*>(.*?)</td>", bare.read_text(), re.S)
+    assert any(c.strip() == "—" for c in cells)
 
 
 def test_data_is_strict_json_without_nan(tiny_report):

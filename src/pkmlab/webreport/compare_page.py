@@ -36,6 +36,8 @@ def _png(fig) -> str:
 def _cell(value, fmt: str, ref) -> tuple[str, str]:
     if isinstance(value, str):
         return value, ""
+    if value is None:                       # a design without this metric
+        return "—", ""
     text = fmt.format(value)
     if ref is None or isinstance(ref, str):
         return text, ""
