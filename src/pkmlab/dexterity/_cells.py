@@ -38,7 +38,12 @@ the force incumbent come first from the cells with the largest ``K`` and the sma
 (never a candidate for the largest κ: its κ is below a sample's), ``force = inf`` (its force
 is above a sample's, strictly) and ``det = ±1`` (the certified sign), so the worst case's
 extremes, their poses, the singular samples and the sign-change counts are those of the pass
-over every sample; only the count of exact κ evaluations can differ.
+over every sample; only the count of exact κ evaluations can differ. A sample of a cell that
+is certified with ``K`` below the lower bound but not ``F`` above the incumbent is evaluated
+for its force and ``det J`` only (:func:`._linalg.lu_force`, the same arithmetic as the full
+pass's, so both are the same bit for bit) and gets ``kup = -inf``: ``K`` certifies that its
+κ is below the maximum and not singular. The choice per cell and the bookkeeping are one numba
+loop per chunk of orientations (:func:`_eval_kernel`).
 """
 
 from __future__ import annotations
