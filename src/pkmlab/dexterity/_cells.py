@@ -230,7 +230,8 @@ def _tiles(unit_pos: np.ndarray, h: float):
     """Units grouped into cells of :data:`TILE` grid steps per axis: ``(order, start)``,
     the units of cell ``t`` being ``order[start[t]:start[t + 1]]``, and the cell of each unit."""
     idx = np.floor((unit_pos - unit_pos.min(axis=0)) / h + 0.5).astype(np.int64) // TILE
-    _, cell = np.unique(idx, axis=0, return_inverse=True)
+    n = idx.max(axis=0) + 1                      # one integer key per cell, in the row order
+    _, cell = np.unique((idx[:, 0] * n[1] + idx[:, 1]) * n[2] + idx[:, 2], return_inverse=True)
     cell = cell.ravel()
     order = np.argsort(cell, kind="stable")
     start = np.searchsorted(cell[order], np.arange(cell.max() + 2))
@@ -269,20 +270,19 @@ class CellPlan:
             n = min(_SEED, len(cand)) - 1
             seed = np.unique(np.concatenate([cand[np.argpartition(-kk, n)[:n + 1]],
                                              cand[np.argpartition(ff, n)[:n + 1]]]))
-            ts, ms = seed // M, seed % M
-            pick = np.zeros((U, M), dtype=bool)
-            for t, m in zip(ts, ms):
-                pick[self.order[start[t]:start[t + 1]], m] = True
-            pick &= self.feas
-            u, m = np.nonzero(pick)
-            at = m * U + u
-            kup, force, det = (np.full((M, U), v) for v in (-np.inf, np.inf, 0.0))
+            at = []                                      # their feasible samples, m · U + u
+            for t, m in zip(seed // M, seed % M):
+                units = self.order[start[t]:start[t + 1]]
+                at.append(m * U + units[self.feas[units, m]])
+            at = np.sort(np.concatenate(at))
+            # only the entries at `at` are written and read (np.empty: no fill of M × U)
+            kup, force, det = np.empty((M, U)), np.empty((M, U)), np.empty((M, U))
             fused_sweep_at(mech, self.P, self.R, at, self.L, self.fmax, kup, force, det)
-            self._update(kup, force)
-            ku = kup.ravel()
-            j = int(np.argmax(ku))
-            if ku[j] > -np.inf:                          # an exact κ is a lower bound too
-                k = exact_kappa(j % U, j // U)
+            ku, fo = kup.ravel()[at], force.ravel()[at]
+            self._update(ku, fo)
+            j = int(np.argmax(ku)) if len(ku) else 0
+            if len(ku) and ku[j] > -np.inf:              # an exact κ is a lower bound too
+                k = exact_kappa(int(at[j] % U), int(at[j] // U))
                 if math.isfinite(k):
                     self.k_low = max(self.k_low, k)
 
