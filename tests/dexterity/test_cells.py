@@ -85,19 +85,14 @@ def _plan(mech, res):
     return plan, unit_pos, Rs, feas, L, fmax
 
 
-@pytest.mark.parametrize("mech,h,deg,tight", [(PSU, 5.0, 15.0, 5.0), (UPS, 20.0, 10.0, 20.0)],
-                         ids=["psu6", "ups6"])
-def test_cell_bounds_are_certified(mech, h, deg, tight):
-    """Every feasible sample of a certified cell, and random poses in its box: exact κ <= K,
-    force >= F, sign(det J) = the cell's sign. The 6-UPS's cells are 60 mm boxes here (its
-    median K / κ was 7.8), the 6-PSU's 15 mm."""
-    res = workspace(mech, "dexterous", OrientationSet.box(np.radians([deg] * 3), samples=3), h)
-    plan, unit_pos, Rs, feas, L, fmax = _plan(mech, res)
+def _violations(mech, plan, unit_pos, Rs, feas, L, fmax, K, F, S, n_cells=60, seed=1):
+    """Sampled check of cell bounds ``K, F, S`` (T, M) on ``n_cells`` random certified cells:
+    every feasible sample and 20 random poses in the cell's box. Returns ``(violations,
+    ratios K / max κ)``; a violation is a pose with κ > K, force < F or sign(det J) != S."""
     cert = np.argwhere(plan.certified)
-    assert len(cert) > 0.5 * np.sum(plan.K > -np.inf)          # most cells are certified
-    rng = np.random.default_rng(1)
-    ratios = []
-    for t, m in cert[rng.permutation(len(cert))[:60]]:
+    rng = np.random.default_rng(seed)
+    bad, ratios = 0, []
+    for t, m in cert[rng.permutation(len(cert))[:n_cells]]:
         units = plan.order[np.flatnonzero(plan.cell[plan.order] == t)]
         units = units[feas[units, m]]
         lo, hi = unit_pos[units].min(axis=0), unit_pos[units].max(axis=0)
@@ -105,11 +100,29 @@ def test_cell_bounds_are_certified(mech, h, deg, tight):
         J = mech.jacobian((p, np.repeat(Rs[[m]], len(p), axis=0)))
         k = condition_number(J, L)
         f = max_force_all_directions(J, fmax, L, mech.mobility)
-        assert np.all(k <= plan.K[t, m]), (k.max(), plan.K[t, m])
-        assert np.all(f >= plan.F[t, m]), (f.min(), plan.F[t, m])
-        assert np.all(np.sign(np.linalg.det(J)) == plan.S[t, m])
-        ratios.append(plan.K[t, m] / k.max())
+        bad += int(np.sum(k > K[t, m]) + np.sum(f < F[t, m])
+                   + np.sum(np.sign(np.linalg.det(J)) != S[t, m]))
+        ratios.append(K[t, m] / k.max())
+    return bad, ratios
+
+
+@pytest.mark.parametrize("mech,h,deg,tight", [(PSU, 5.0, 15.0, 5.0), (UPS, 20.0, 10.0, 20.0)],
+                         ids=["psu6", "ups6"])
+def test_cell_bounds_are_certified(mech, h, deg, tight):
+    """Every feasible sample of a certified cell, and random poses in its box: exact κ <= K,
+    force >= F, sign(det J) = the cell's sign. The 6-UPS's cells are 60 mm boxes here (its
+    median K / κ was 7.8), the 6-PSU's 15 mm. The same check finds deliberately broken
+    bounds (K lowered 20 %, F raised 20 %, the sign flipped)."""
+    res = workspace(mech, "dexterous", OrientationSet.box(np.radians([deg] * 3), samples=3), h)
+    plan, unit_pos, Rs, feas, L, fmax = _plan(mech, res)
+    assert np.sum(plan.certified) > 0.5 * np.sum(plan.K > -np.inf)   # most are certified
+    args = (mech, plan, unit_pos, Rs, feas, L, fmax)
+    bad, ratios = _violations(*args, plan.K, plan.F, plan.S)
+    assert bad == 0
     assert np.median(ratios) < tight                           # a bound, not a vacuous one
+    for K, F, S in ((plan.K * 0.8, plan.F, plan.S), (plan.K, plan.F * 1.2, plan.S),
+                    (plan.K, plan.F, -plan.S)):
+        assert _violations(*args, K, F, S)[0] > 0
 
 
 @pytest.mark.parametrize("case", ["psu6", "psu6-wide", "ups6", "ups6-singular"])
@@ -143,3 +156,56 @@ def test_worst_case_with_cells_is_identical(case):
     assert _same(out[False], out[True]), (out[False], out[True])
     if case == "ups6-singular":
         assert out[True]["singular"]
+
+
+@pytest.mark.parametrize("mech", [PSU, UPS], ids=["psu6", "ups6"])
+def test_chunk_evaluates_pruned_and_force_only_samples_as_stated(mech):
+    """:meth:`CellPlan.chunk` against :func:`fused_sweep` over every sample, with the
+    incumbents set to the middle of the cell bounds: a sample is evaluated in full (kup,
+    force, det bit for bit) unless its cell is certified with K below the κ lower bound — then
+    force and det bit for bit and kup = -inf — and, if also F is above the force incumbent,
+    pruned (-inf, inf, the sign of det J); infeasible samples: -inf, inf, 0. Each of the three
+    kinds occurs."""
+    h, deg = (5.0, 15.0) if mech is PSU else (20.0, 10.0)
+    res = workspace(mech, "dexterous", OrientationSet.box(np.radians([deg] * 3), samples=3), h)
+    plan, unit_pos, Rs, feas, L, fmax = _plan(mech, res)
+    M = len(Rs)
+    cert = plan.certified
+    plan.k_low = float(np.median(plan.K[cert]))
+    plan.f_inc = float(np.median(plan.F[cert]))
+    kc = (cert & (plan.K < plan.k_low))[plan.cell]              # (U, M)
+    fc = (cert & (plan.F > plan.f_inc))[plan.cell]
+    kup, force, det = plan.chunk(0, M)                          # (it updates the incumbents)
+    want = fused_sweep(mech, unit_pos, Rs, feas, L, fmax)
+    full, fonly, pruned = feas & ~kc, feas & kc & ~fc, feas & kc & fc
+    for got, ref in zip((kup, force, det), want):
+        np.testing.assert_array_equal(got[full], ref[full])
+    np.testing.assert_array_equal(force[fonly], want[1][fonly])
+    np.testing.assert_array_equal(det[fonly], want[2][fonly])
+    assert np.all(kup[fonly] == -np.inf)
+    assert np.all(kup[pruned] == -np.inf) and np.all(force[pruned] == np.inf)
+    np.testing.assert_array_equal(det[pruned], np.sign(want[2][pruned]))
+    assert np.all(kup[~feas] == -np.inf) and np.all(force[~feas] == np.inf)
+    assert np.all(det[~feas] == 0.0)
+    assert full.sum() and fonly.sum() and pruned.sum()
+    assert plan.evaluated == int(full.sum() + fonly.sum())
+
+
+def test_broken_cell_bounds_change_the_worst_case(monkeypatch):
+    """The identity check has teeth: cells whose bounds claim too much (K = 0, F = inf, every
+    cell certified with det J > 0) make ``worst_case`` differ from the pass over every
+    sample."""
+    res = workspace(PSU, "dexterous", OrientationSet.box(np.radians([15] * 3), samples=3), 5.0)
+    want = dx.worst_case(PSU, res, None, 150.0).as_dict()
+    init = _cells.CellPlan.__init__
+
+    def broken(self, *a, **kw):
+        init(self, *a, **kw)
+        self.K[:], self.F[:], self.S[:] = 0.0, np.inf, 1
+        self.certified[:] = True
+        self.k_low, self.f_inc = 1.0, 0.0
+
+    monkeypatch.setattr(_cells.CellPlan, "__init__", broken)
+    got = dx.worst_case(PSU, res, None, 150.0).as_dict()
+    assert got["worst_kappa"] != want["worst_kappa"]
+    assert got["min_force_N"] != want["min_force_N"]

@@ -38,7 +38,12 @@ the force incumbent come first from the cells with the largest ``K`` and the sma
 (never a candidate for the largest κ: its κ is below a sample's), ``force = inf`` (its force
 is above a sample's, strictly) and ``det = ±1`` (the certified sign), so the worst case's
 extremes, their poses, the singular samples and the sign-change counts are those of the pass
-over every sample; only the count of exact κ evaluations can differ.
+over every sample; only the count of exact κ evaluations can differ. A sample of a cell that
+is certified with ``K`` below the lower bound but not ``F`` above the incumbent is evaluated
+for its force and ``det J`` only (:func:`._linalg.lu_force`, the same arithmetic as the full
+pass's, so both are the same bit for bit) and gets ``kup = -inf``: ``K`` certifies that its
+κ is below the maximum and not singular. The choice per cell and the bookkeeping are one numba
+loop per chunk of orientations (:func:`_eval_kernel`).
 """
 
 from __future__ import annotations
@@ -53,7 +58,7 @@ from numba import types as nt
 from ..runtime.jit import cached_kernel
 from ..runtime.threads import threads_for
 from ._fused import fused_available, fused_sweep_at
-from ._linalg import KAPPA_BRACKET, KAPPA_ROUND, sweep_core
+from ._linalg import KAPPA_BRACKET, KAPPA_ROUND, lu_force, sweep_core, sweep_one
 
 __all__ = ["CellPlan", "cells_available", "TILE"]
 
@@ -161,11 +166,72 @@ def _bounds_kernel(jac, box, ng: int):
                          parallel=True, error_model="numpy")
 
 
+@cache
+def _eval_kernel(jac, ng: int):
+    """The per-chunk pass over the cells: each cell × orientation either pruned (its samples
+    get ``-inf``, ``inf`` and the certified sign), or its feasible samples evaluated — in
+    full (:func:`._linalg.sweep_one`) where the cell may hold the largest κ, else only the
+    force and ``det J`` (:func:`._linalg.lu_force`, the same arithmetic, ``kup = -inf``:
+    ``K`` below the lower bound certifies that no sample of the cell is the maximum or
+    singular). Per cell: the largest finite ``kup`` below ``_KMAX``, the smallest non-NaN
+    force and the count of evaluated samples (for the incumbents)."""
+
+    def cell_eval_loop(P, R, order, start, feas, K, F, S, k_low, f_inc, m0, g, L, fmax,
+                       kup, force, det, tk, tf, tn):
+        T, k = start.shape[0] - 1, kup.shape[0]
+        for t in prange(T):
+            J = np.empty((1, 6, 6))
+            A = np.empty((6, 6))
+            B = np.empty((6, 6))
+            G = np.empty((6, 6))
+            Tm = np.empty((6, 6))
+            piv = np.empty(6, np.int64)
+            q = np.empty((1, 6))
+            kt, ft, nt_ = -np.inf, np.inf, 0
+            for mm in range(k):
+                m = m0 + mm
+                cert = K[t, m] < np.inf and S[t, m] != 0
+                kneed = not (cert and K[t, m] < k_low)
+                fneed = not (cert and F[t, m] > f_inc)
+                for j in range(start[t], start[t + 1]):
+                    u = order[j]
+                    if not feas[u, m]:
+                        kup[mm, u], force[mm, u], det[mm, u] = -np.inf, np.inf, 0.0
+                        continue
+                    if not (kneed or fneed):
+                        kup[mm, u], force[mm, u], det[mm, u] = -np.inf, np.inf, S[t, m]
+                        continue
+                    nt_ += 1
+                    jac(P[u, 0], P[u, 1], P[u, 2], R[m, 0, 0], R[m, 0, 1], R[m, 0, 2],
+                        R[m, 1, 0], R[m, 1, 1], R[m, 1, 2], R[m, 2, 0], R[m, 2, 1], R[m, 2, 2],
+                        g, q, J, 0)
+                    if kneed:
+                        ku, fo, de = sweep_one(J[0], L, fmax, A, B, G, Tm, piv)
+                    else:
+                        ok, fo, de = lu_force(J[0], fmax, A, B, piv)
+                        ku = -np.inf
+                    kup[mm, u], force[mm, u], det[mm, u] = ku, fo, de
+                    if ku < _KMAX and ku > kt:          # finite: -inf < ku < 1e8
+                        kt = ku
+                    if fo < ft:                         # NaN never compares less
+                        ft = fo
+            tk[t], tf[t], tn[t] = kt, ft, nt_
+
+    f8, f1, f2, f3 = nt.float64, nt.float64[::1], nt.float64[:, ::1], nt.float64[:, :, ::1]
+    i1 = nt.int64[::1]
+    return cached_kernel(cell_eval_loop,
+                         nt.void(f2, f3, i1, i1, nt.boolean[:, ::1], f2, f2, nt.int8[:, ::1],
+                                 f8, f8, nt.int64, nt.UniTuple(nt.float64, ng), f8, f1, f2, f2,
+                                 f2, f1, f1, i1),
+                         parallel=True, error_model="numpy")
+
+
 def _tiles(unit_pos: np.ndarray, h: float):
     """Units grouped into cells of :data:`TILE` grid steps per axis: ``(order, start)``,
     the units of cell ``t`` being ``order[start[t]:start[t + 1]]``, and the cell of each unit."""
     idx = np.floor((unit_pos - unit_pos.min(axis=0)) / h + 0.5).astype(np.int64) // TILE
-    _, cell = np.unique(idx, axis=0, return_inverse=True)
+    n = idx.max(axis=0) + 1                      # one integer key per cell, in the row order
+    _, cell = np.unique((idx[:, 0] * n[1] + idx[:, 1]) * n[2] + idx[:, 2], return_inverse=True)
     cell = cell.ravel()
     order = np.argsort(cell, kind="stable")
     start = np.searchsorted(cell[order], np.arange(cell.max() + 2))
@@ -185,6 +251,7 @@ class CellPlan:
         self.feas = np.require(feas, np.bool_, ("C", "A", "W"))
         U, M = feas.shape
         self.order, start, self.cell = _tiles(self.P, h)
+        self.start = start
         T = len(start) - 1
         self.K, self.F = np.empty((T, M)), np.empty((T, M))
         self.S = np.empty((T, M), dtype=np.int8)
@@ -200,22 +267,22 @@ class CellPlan:
         cand = np.flatnonzero(self.certified.ravel())
         if len(cand):
             kk, ff = self.K.ravel()[cand], self.F.ravel()[cand]
-            seed = np.unique(np.concatenate([cand[np.argsort(-kk, kind="stable")[:_SEED]],
-                                             cand[np.argsort(ff, kind="stable")[:_SEED]]]))
-            ts, ms = seed // M, seed % M
-            pick = np.zeros((U, M), dtype=bool)
-            for t, m in zip(ts, ms):
-                pick[self.order[start[t]:start[t + 1]], m] = True
-            pick &= self.feas
-            u, m = np.nonzero(pick)
-            at = m * U + u
-            kup, force, det = (np.full((M, U), v) for v in (-np.inf, np.inf, 0.0))
+            n = min(_SEED, len(cand)) - 1
+            seed = np.unique(np.concatenate([cand[np.argpartition(-kk, n)[:n + 1]],
+                                             cand[np.argpartition(ff, n)[:n + 1]]]))
+            at = []                                      # their feasible samples, m · U + u
+            for t, m in zip(seed // M, seed % M):
+                units = self.order[start[t]:start[t + 1]]
+                at.append(m * U + units[self.feas[units, m]])
+            at = np.sort(np.concatenate(at))
+            # only the entries at `at` are written and read (np.empty: no fill of M × U)
+            kup, force, det = np.empty((M, U)), np.empty((M, U)), np.empty((M, U))
             fused_sweep_at(mech, self.P, self.R, at, self.L, self.fmax, kup, force, det)
-            self._update(kup, force)
-            ku = kup.ravel()
-            j = int(np.argmax(ku))
-            if ku[j] > -np.inf:                          # an exact κ is a lower bound too
-                k = exact_kappa(j % U, j // U)
+            ku, fo = kup.ravel()[at], force.ravel()[at]
+            self._update(ku, fo)
+            j = int(np.argmax(ku)) if len(ku) else 0
+            if len(ku) and ku[j] > -np.inf:              # an exact κ is a lower bound too
+                k = exact_kappa(int(at[j] % U), int(at[j] // U))
                 if math.isfinite(k):
                     self.k_low = max(self.k_low, k)
 
@@ -231,21 +298,21 @@ class CellPlan:
     def chunk(self, m0: int, k: int):
         """``(kup, force, det)`` ``(U, k)`` (transposed views) for orientations
         ``m0 … m0 + k - 1``: evaluated where a sample may hold an extreme or its cell is not
-        certified; ``-inf``, ``inf``, the certified sign elsewhere; infeasible: ``-inf``,
-        ``inf``, ``0``."""
-        U = len(self.P)
-        sl = slice(m0, m0 + k)
-        Kc, Fc, Sc = self.K[:, sl], self.F[:, sl], self.S[:, sl]
-        prune = self.certified[:, sl] & (Kc < self.k_low) & (Fc > self.f_inc)
-        fe = self.feas[:, sl]
-        pr = prune[self.cell]                           # (U, k)
-        need = fe & ~pr
-        u, m = np.nonzero(need.T)[::-1]
-        at = m * U + u
-        self.evaluated += len(at)
-        kup = np.full((k, U), -np.inf)
-        force = np.full((k, U), np.inf)
-        det = np.where(fe & pr, Sc[self.cell], 0).astype(np.float64).T.copy()
-        fused_sweep_at(self.mech, self.P, self.R[sl], at, self.L, self.fmax, kup, force, det)
-        self._update(kup, force)
+        certified (``kup = -inf`` where only the force may: :func:`_eval_kernel`); ``-inf``,
+        ``inf``, the certified sign elsewhere; infeasible: ``-inf``, ``inf``, ``0``."""
+        U, T = len(self.P), len(self.start) - 1
+        kup, force, det = np.empty((k, U)), np.empty((k, U)), np.empty((k, U))
+        tk, tf, tn = np.empty(T), np.empty(T), np.empty(T, dtype=np.int64)
+        jac, g = self.mech.jacobian_kernel()
+        with threads_for(U * k):
+            _eval_kernel(jac, len(g))(self.P, self.R, self.order, self.start, self.feas,
+                                      self.K, self.F, self.S, self.k_low, self.f_inc, m0, g,
+                                      self.L, self.fmax, kup, force, det, tk, tf, tn)
+        self.evaluated += int(tn.sum())
+        kt = float(tk.max()) if T else -math.inf
+        if kt > -math.inf:
+            self.k_low = max(self.k_low, kt * (1 + KAPPA_ROUND) / KAPPA_BRACKET
+                             / (1 + KAPPA_ROUND) ** 3)
+        if T:
+            self.f_inc = min(self.f_inc, float(tf.min()))
         return kup.T, force.T, det.T

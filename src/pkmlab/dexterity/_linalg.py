@@ -271,10 +271,12 @@ def sweep_one(Jm, L, fmax, A, B, G, T, piv):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def sweep_core(Jm, L, fmax, A, B, G, T, piv):
-    """:func:`sweep_one`'s parts: ``(la, lb, force, det)`` with ``la >= λmax(J_hᵀJ_h)`` and
-    ``lb >= λmax(J_h⁻ᵀJ_h⁻¹)`` (``-1`` for a non-finite or exactly singular ``Jm``); on
-    return ``B`` holds ``J_h⁻¹`` and ``A`` its transpose."""
+def lu_force(Jm, fmax, A, B, piv):
+    """The first half of :func:`sweep_core`: ``(ok, force, det)`` from one LU of ``Jm``
+    (partial pivoting) and ``B = J⁻¹``; ``ok`` False for a non-finite ``Jm`` (force and det
+    NaN) or an exactly zero pivot (both 0). :func:`sweep_core` calls it, so a caller that
+    needs only the force and the sign of ``det J`` (:mod:`._cells`) gets the same values bit
+    for bit without the two Gram bounds."""
     finite = True
     for i in range(6):
         for k in range(6):
@@ -283,7 +285,7 @@ def sweep_core(Jm, L, fmax, A, B, G, T, piv):
                 finite = False
             A[i, k] = v
     if not finite:
-        return -1.0, -1.0, np.nan, np.nan
+        return False, np.nan, np.nan
     d = 1.0
     zero = False
     for k in range(6):
@@ -310,7 +312,7 @@ def sweep_core(Jm, L, fmax, A, B, G, T, piv):
             for c in range(k + 1, 6):
                 A[i, c] -= f * A[k, c]
     if zero:
-        return -1.0, -1.0, 0.0, 0.0
+        return False, 0.0, 0.0
     for i in range(6):                    # B = P·I, then forward and back substitution
         for c in range(6):
             B[i, c] = 1.0 if i == c else 0.0
@@ -339,6 +341,17 @@ def sweep_core(Jm, L, fmax, A, B, G, T, piv):
             v = fmax[c] / math.sqrt(g)
             if v < fm:
                 fm = v
+    return True, fm, d
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def sweep_core(Jm, L, fmax, A, B, G, T, piv):
+    """:func:`sweep_one`'s parts: ``(la, lb, force, det)`` with ``la >= λmax(J_hᵀJ_h)`` and
+    ``lb >= λmax(J_h⁻ᵀJ_h⁻¹)`` (``-1`` for a non-finite or exactly singular ``Jm``); on
+    return ``B`` holds ``J_h⁻¹`` and ``A`` its transpose."""
+    ok, fm, d = lu_force(Jm, fmax, A, B, piv)
+    if not ok:
+        return -1.0, -1.0, fm, d
     for i in range(6):                    # J_h = J·diag(1, 1, 1, 1/L, 1/L, 1/L)
         for k in range(6):
             A[i, k] = Jm[i, k] if k < 3 else Jm[i, k] / L
