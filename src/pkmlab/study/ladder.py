@@ -38,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import NumericalError, ParameterError
 from ..units import parse_angle, parse_length
 from .definition import FINE, Tolerances
 from .evaluators import EVALUATORS
@@ -63,19 +63,17 @@ class ToleranceLadder:
 
 def ladder_from_spec(data, evaluation) -> ToleranceLadder | None:
     """The study file's ``tolerance_ladder`` mapping → :class:`ToleranceLadder` (None: none),
-    for a study whose ``evaluation`` computes a laddered optimum."""
+    for a study whose ``evaluation`` computes a laddered metric."""
     if data is None:
         return None
     where = "tolerance_ladder"
-    if not _laddered(evaluation):
-        raise ParameterError(where, f"used with one of evaluate.{' or evaluate.'.join(LADDERED)}"
-                             " (the optima with a certified tolerance)", data)
     if not isinstance(data, dict) or set(data) - {"coarse", "prune"} or "coarse" not in data:
-        raise ParameterError(where, "{coarse: {angle: <angle>, length: <length>}, prune: "
-                             "true|false}", data)
+        raise ParameterError(where, "{coarse: {angle: <angle>, length: <length>, worst_case: "
+                             "bound|exact}, prune: true|false}", data)
     c = data["coarse"]
-    if not isinstance(c, dict) or set(c) - {"angle", "length"}:
-        raise ParameterError(f"{where}.coarse", "{angle: 0.1 deg, length: 0.1 mm}", c)
+    if not isinstance(c, dict) or set(c) - {"angle", "length", "worst_case"}:
+        raise ParameterError(f"{where}.coarse", "{angle: 0.1 deg, length: 0.1 mm, worst_case: "
+                             "bound}", c)
     angle = parse_angle(c.get("angle", "0.01 deg"), f"{where}.coarse.angle")
     length = parse_length(c.get("length", "0.01 mm"), f"{where}.coarse.length")
     if not FINE.angle <= angle <= math.radians(5.0):
@@ -84,14 +82,23 @@ def ladder_from_spec(data, evaluation) -> ToleranceLadder | None:
     if not FINE.length <= length <= 10.0:
         raise ParameterError(f"{where}.coarse.length", "a length in [0.01, 10] mm (the fine "
                              "tolerance is 0.01 mm)", c.get("length"))
+    worst = c.get("worst_case", "bound")
+    if worst not in ("bound", "exact"):
+        raise ParameterError(f"{where}.coarse.worst_case", "'bound' (certified bounds from a "
+                             "subset of the samples) or 'exact'", worst)
     prune = data.get("prune", True)
     if not isinstance(prune, bool):
         raise ParameterError(f"{where}.prune", "true or false", prune)
-    return ToleranceLadder(Tolerances(angle, length), prune)
+    ladder = ToleranceLadder(Tolerances(angle, length, worst), prune)
+    if not laddered(evaluation, ladder):
+        raise ParameterError(where, f"used with one of evaluate.{' or evaluate.'.join(LADDERED)}"
+                             " (the optima with a certified tolerance; dexterity with "
+                             "coarse.worst_case: bound)", data)
+    return ladder
 
 
-#: laddered evaluator → its metrics, each with the coarse metric bounding its fine value
-#: from below and from above (None: no certified bound on that side)
+#: laddered evaluator → its metrics that the coarse rung changes, each with the coarse metric
+#: bounding its fine value from below and from above (None: no certified bound on that side)
 LADDERED = {
     "orientation_capability": {
         "orientation_capability": (None, "orientation_capability_upper"),
@@ -101,7 +108,14 @@ LADDERED = {
         "needed_stroke": ("needed_stroke_lower", None),
         "needed_stroke_lower": (None, "needed_stroke"),
         "needed_stroke_bracket": (None, None)},
+    # coarse.worst_case: bound (.evaluators.worst_bound); its other metrics are exact
+    "dexterity": {
+        "worst_kappa": ("worst_kappa", None),
+        "min_force": (None, "min_force"),
+        "singularity_free": (None, "singularity_free")},
 }
+#: what a laddered evaluator's re-certification runs before it (it reads the workspace)
+_NEEDS = {"dexterity": ("workspace",)}
 _BOUNDS = {m: b for ms in LADDERED.values() for m, b in ms.items()}
 
 
@@ -109,11 +123,12 @@ def coarse_name(metric: str) -> str:
     return f"{metric}_coarse"
 
 
-def bounds(record: dict, metric: str) -> tuple[float, float]:
+def bounds(record: dict, metric: str, names=None) -> tuple[float, float]:
     """Certified ``(low, high)`` of ``metric``'s fine value from a coarse ``record`` (exact
-    metrics: the value twice; a missing bound: ∓inf)."""
+    metrics, and those not in ``names``, the metrics the run's ladder changes (default: every
+    laddered one): the value twice; a missing bound: ∓inf)."""
     m = record["metrics"]
-    if metric not in _BOUNDS:
+    if metric not in _BOUNDS or (names is not None and metric not in names):
         v = m.get(metric)
         return (math.nan, math.nan) if v is None else (float(v), float(v))
     lo, hi = _BOUNDS[metric]
@@ -125,40 +140,57 @@ def bounds(record: dict, metric: str) -> tuple[float, float]:
     return value(lo, -math.inf), value(hi, math.inf)
 
 
-def _laddered(evaluation) -> list[str]:
-    return [n for n in evaluation.evaluators if n in LADDERED]
+def laddered(evaluation, ladder: ToleranceLadder) -> list[str]:
+    """The evaluators of ``evaluation`` whose metrics the coarse rung of ``ladder`` changes
+    (dexterity only with ``worst_case: bound``), in evaluation order."""
+    return [n for n in evaluation.evaluators if n in LADDERED
+            and (n != "dexterity" or ladder.coarse.worst_case == "bound")]
 
 
-def refine_design(space, params, evaluation, seed: int) -> dict:
-    """The laddered evaluators of ``evaluation`` (fine tolerances) on one design → a result
-    with their metrics and notes (runs in a worker like :func:`.evaluators.evaluate_design`)."""
+def refine_design(space, params, evaluation, seed: int, names: tuple[str, ...]) -> dict:
+    """The evaluators ``names`` of ``evaluation`` (fine tolerances) on one design → a result
+    ``{"status", "reason", "metrics", "notes", "seconds"}`` with their metrics and notes (runs
+    in a worker like :func:`.evaluators.evaluate_design`; an invalid design or a declared
+    numerical failure is a status with its reason)."""
     t0 = time.perf_counter()
-    mech = space.decode(params)
-    ctx = Context(evaluation, seed, choices=dict(space.evaluation_choices(params)))
+    run = [n for n in evaluation.evaluators
+           if n in names or any(n in _NEEDS.get(m, ()) for m in names)]
     metrics: dict = {}
-    for name in _laddered(evaluation):
-        metrics.update(EVALUATORS[name](mech, ctx))
-    return {"metrics": metrics, "notes": ctx.notes, "seconds": time.perf_counter() - t0}
+    status, reason = "ok", ""
+    try:
+        mech = space.decode(params)
+        ctx = Context(evaluation, seed, choices=dict(space.evaluation_choices(params)))
+        for name in run:
+            out = EVALUATORS[name](mech, ctx)
+            if name in names:
+                metrics.update(out)
+        notes = ctx.notes
+    except ParameterError as exc:
+        status, reason, notes = "invalid", str(exc), {}
+    except NumericalError as exc:
+        status, reason, notes = "failed", str(exc), {}
+    return {"status": status, "reason": reason, "metrics": metrics, "notes": notes,
+            "seconds": time.perf_counter() - t0}
 
 
-def _minimised(study, record, best_case: bool) -> np.ndarray:
-    """Objective row (minimised): the record's values, or (``best_case``) each objective at
-    the end of its certified bounds that is best for it."""
+def _minimised(study, record, case: str = "value", names=None) -> np.ndarray:
+    """Objective row (minimised): the record's values, or (``case`` "best" / "worst") each
+    objective at the end of its certified bounds that is best / worst for it."""
     row = []
     for o in study.objectives:
-        lo, hi = bounds(record, o.metric)
+        lo, hi = bounds(record, o.metric, names)
         v = record["metrics"].get(o.metric)
-        if best_case:
-            v = hi if o.sense == "maximize" else lo
+        if case != "value":
+            v = hi if (o.sense == "maximize") == (case == "best") else lo
         v = math.nan if v is None else float(v)
         row.append(math.inf if math.isnan(v) else (-v if o.sense == "maximize" else v))
     return np.array(row)
 
 
-def _violation(study, record) -> str:
+def _violation(study, record, names=None) -> str:
     """A constraint the record's certified bounds violate whatever the fine value, or ''."""
     for c in study.constraints:
-        lo, hi = bounds(record, c.metric)
+        lo, hi = bounds(record, c.metric, names)
         if math.isnan(lo):
             return f"{c.metric} undefined"
         if c.min is not None and hi < c.min:
@@ -172,7 +204,8 @@ def refine(study, runner, store) -> dict:
     """Re-certify the stored candidates at the fine tolerances, pruning those certainly
     dominated (module notes) → ``{"refined": n, "pruned": n}``."""
     ladder = study.tolerance_ladder
-    names = [m for n in _laddered(study.evaluation) for m in LADDERED[n]]
+    evaluators = tuple(laddered(study.evaluation, ladder))
+    names = [m for n in evaluators for m in LADDERED[n]]
     ok = [r for r in store.all() if r["status"] == "ok"]
     fresh = [not any(coarse_name(m) in r["metrics"] for m in names) for r in ok]
     todo = [r for r, f in zip(ok, fresh, strict=True) if f]
@@ -181,9 +214,10 @@ def refine(study, runner, store) -> dict:
     if not names:
         return counts
     space, ev, seed = study.space, study.evaluation, study.seed
+    jobs = _slots(runner)
     while todo:
         # the next front of the coarse values among the candidates left
-        F = np.array([_minimised(study, r, False) for r in todo])
+        F = np.array([_minimised(study, r) for r in todo])
         front = set(np.flatnonzero(non_dominated(F)).tolist())
         # the Pareto front is over candidates: the baseline never dominates (nor is pruned)
         refined_ok = [r for r in done if r["role"] == "candidate" and feasible(study, [r])[0]]
@@ -193,8 +227,8 @@ def refine(study, runner, store) -> dict:
             r = todo[i]
             why = ""
             if ladder.prune and r["role"] == "candidate":
-                why = _violation(study, r)
-                best = _minimised(study, r, True)
+                why = _violation(study, r, names)
+                best = _minimised(study, r, "best", names)
                 for j, d in enumerate(refined_ok if not why else ()):
                     if np.all(Fd[j] <= best) and np.any(Fd[j] < best):
                         why = (f"certainly dominated by evaluation {d['seq']}: best case "
@@ -207,14 +241,45 @@ def refine(study, runner, store) -> dict:
                 batch.append(r)
             else:
                 keep.append(r)
+        if ladder.prune and len(batch) > jobs:
+            # one batch of workers at a time, those likeliest to prune the most first
+            batch = sorted(batch, key=lambda r: -_power(study, r, keep + batch, names))
+            batch, keep = batch[:jobs], keep + batch[jobs:]
         tasks = [(r["key"], (space, None if r["role"] == "baseline" else r["params"], ev,
-                             seed)) for r in batch]
+                             seed, evaluators)) for r in batch]
         by_key = {r["key"]: r for r in batch}
         for key, res in runner.map(refine_design, tasks):
             done.append(_refined(store, by_key[key], names, res))
             counts["refined"] += 1
         todo = keep
     return counts
+
+
+def _slots(runner) -> int:
+    """Evaluations the runner runs at once: its ``jobs``, 1 in this process, and for a
+    cluster (Dask) its workers' threads (large when unknown: whole fronts at once)."""
+    if getattr(runner, "name", "") == "serial":
+        return 1
+    jobs = getattr(runner, "jobs", None)
+    if jobs is None:
+        try:
+            jobs = sum(runner.client.nthreads().values())
+        except Exception:  # noqa: BLE001 - unknown: no batching
+            jobs = 1 << 30
+    return max(1, int(jobs))
+
+
+def _power(study, record, others, names) -> int:
+    """How many of ``others`` ``record``'s certified worst case dominates (the baseline
+    dominates none): the order of the re-certifications within a front."""
+    if record["role"] != "candidate":
+        return len(others) + 1                     # refined anyway: first
+    w = _minimised(study, record, "worst", names)
+    n = 0
+    for r in others:
+        b = _minimised(study, r, "best", names)
+        n += bool(np.all(w <= b) and np.any(w < b))
+    return n
 
 
 def coarse_view(record: dict) -> dict:
@@ -224,7 +289,10 @@ def coarse_view(record: dict) -> dict:
     back = {k[:-len("_coarse")]: v for k, v in m.items() if k.endswith("_coarse")}
     if not back:
         return record
-    status = "ok" if record["status"] == "pruned" else record["status"]
+    # pruned, or failed at the fine tolerance only: the coarse pass stored it as evaluated
+    coarse_ok = record["status"] == "pruned" or record["reason"].startswith(
+        "at the fine tolerance")
+    status = "ok" if coarse_ok else record["status"]
     return {**record, "status": status, "metrics": {**m, **back}}
 
 
@@ -237,11 +305,15 @@ def _refined(store, record, names, res) -> dict:
     metrics = dict(record["metrics"])
     for m in names:
         metrics[coarse_name(m)] = metrics.get(m)
+        if res["status"] != "ok":
+            metrics[m] = None
     metrics.update(res["metrics"])
     notes = {k: v for k, v in record["notes"].items() if k not in names}
-    notes.update(res["notes"])
+    notes.update({k: v for k, v in res["notes"].items() if k in names})
+    extra = {} if res["status"] == "ok" else {
+        "status": res["status"], "reason": f"at the fine tolerance: {res['reason']}"}
     return store.update(record["key"], metrics=metrics, notes=notes,
-                        seconds=record["seconds"] + res["seconds"])
+                        seconds=record["seconds"] + res["seconds"], **extra)
 
 
 def _prune(store, record, names, why: str) -> dict:

@@ -15,6 +15,7 @@ from ...dexterity.budget import WORST_BYTES_PER_SAMPLE, require_grid
 from ...errors import NumericalError, ParameterError
 from ...units import effort_limit, parse_length
 from .registry import Evaluator, finite, metric, register_evaluator
+from .worst_bound import worst_bound
 
 
 def _auto_length(v: Any) -> float | None:
@@ -127,16 +128,11 @@ class Dexterity(Evaluator):
             return out
         require_grid(res, "evaluate.workspace.resolution", WORST_BYTES_PER_SAMPLE)
         effort = effort_limit(mech.actuator_unit, plan.force_limit, plan.torque_limit)
-        wc = dx.worst_case(res.mechanism, res, length,
-                           plan.force_limit if effort is None else effort)
-        if wc.status != "ok":
-            raise NumericalError("worst case over the workspace", wc.reason)
-        out["worst_kappa"] = finite(wc.worst_kappa)
-        out["min_force"] = float(wc.min_force) if effort is not None else None
-        out["singularity_free"] = float(not wc.singular)
-        if wc.singular:
-            ctx.notes["worst_kappa"] = (f"singular pose in the workspace or on its boundary: "
-                                        f"{wc.reason}")
+        force = plan.force_limit if effort is None else effort
+        if ctx.evaluation.worst_case_exact:
+            out.update(_exact_worst(res, length, force, effort, ctx))
+        else:       # a tolerance ladder's coarse rung: certified bounds (study.ladder)
+            out.update(_worst_bounds(res, length, force, effort, ctx))
         # one Monte-Carlo sample serves every sampled statistic
         p, R = dx.aggregate.sample_poses(res, plan.gci_samples,
                                          np.random.default_rng(ctx.seed))
@@ -158,6 +154,34 @@ class Dexterity(Evaluator):
                 ctx.notes.setdefault(n, "a sampled pose is singular" if g.ok and
                                      n == "sampled_max_kappa" else "no valid Monte-Carlo pose")
         return out
+
+
+def _exact_worst(res, length, force, effort, ctx) -> dict:
+    wc = dx.worst_case(res.mechanism, res, length, force)
+    if wc.status != "ok":
+        raise NumericalError("worst case over the workspace", wc.reason)
+    out = {"worst_kappa": finite(wc.worst_kappa),
+           "min_force": float(wc.min_force) if effort is not None else None,
+           "singularity_free": float(not wc.singular)}
+    if wc.singular:
+        ctx.notes["worst_kappa"] = (f"singular pose in the workspace or on its boundary: "
+                                    f"{wc.reason}")
+    return out
+
+
+def _worst_bounds(res, length, force, effort, ctx) -> dict:
+    """The coarse rung: ``worst_kappa`` a certified lower bound, ``min_force`` an upper one,
+    ``singularity_free`` 0 only when a sample of the subset is singular (a certificate), else
+    1 (an upper bound: the exact pass may find one)."""
+    b = worst_bound(res.mechanism, res, length, force)
+    out = {"worst_kappa": finite(b.kappa_lower),
+           "min_force": finite(b.force_upper) if effort is not None else None,
+           "singularity_free": float(not b.singular)}
+    for n in ("worst_kappa", "min_force", "singularity_free"):
+        ctx.notes[n] = b.describe()
+    if b.singular:
+        ctx.notes["worst_kappa"] = f"a singular sample: {b.describe()}"
+    return out
 
 
 register_evaluator(Dexterity())
