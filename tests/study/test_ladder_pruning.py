@@ -23,12 +23,13 @@ from scipy.stats import qmc
 
 from pkmlab import dexterity as dx
 from pkmlab.errors import ParameterError
-from pkmlab.study import load_study
+from pkmlab.study import SerialRunner, load_study, run_study
 from pkmlab.study.evaluators import EVALUATORS
 from pkmlab.study.evaluators.registry import Context
 from pkmlab.study.evaluators.worst_bound import worst_bound
+from pkmlab.study.export import chosen_designs
 from pkmlab.study.ladder import refine
-from pkmlab.study.report import write_report
+from pkmlab.study.report import pareto_records, write_report
 from pkmlab.study.store import Store
 
 DEMO = Path(__file__).resolve().parents[2] / "studies" / "hopkins-6psu-redesign.yaml"
@@ -194,3 +195,60 @@ def test_the_resolved_study_states_the_ladder_it_ran_with(tmp_path):
     again.write_text(text)
     assert load_study(again).tolerance_ladder == study.tolerance_ladder
     assert math.isclose(study.tolerance_ladder.coarse.angle, math.radians(1.0))
+
+
+# ---- a whole study, with and without the ladder ---------------------------------------------
+
+def _e2e(tmp, name, ladder=None):
+    data = {
+        "study": "e2e", "mechanism": {"file": str(MECH_DIR / "hopkins-williams-6psu.yaml")},
+        "design": {"platform_outer_radius": {"low": "55 mm", "high": "90 mm"},
+                   "link_length": {"low": "200 mm", "high": "260 mm"}},
+        "evaluate": {"workspace": {"kind": "dexterous", "box": ["5 deg"] * 3, "samples": 3,
+                                   "semantics": "simultaneous", "resolution": "10 mm"},
+                     "orientation_capability": True, "dexterity": {"gci_samples": 200}},
+        "objectives": [{"maximize": "orientation_capability"}, {"maximize": "gci"}],
+        "constraints": [{"worst_kappa": {"max": 4.5}}],
+        "optimizer": {"method": "sobol", "samples": 12}, "seed": 3,
+        "output": str(tmp / name), "top": 3}
+    if ladder:
+        data["tolerance_ladder"] = ladder
+    p = tmp / f"{name}.yaml"
+    p.write_text(yaml.safe_dump(data))
+    study = load_study(p)
+    store = run_study(study, SerialRunner())
+    records, meta = store.all(), store.get_meta("ladder")
+    store.close()
+    return study, records, meta
+
+
+def test_a_study_with_the_coarse_worst_case_exports_what_a_plain_run_exports(tmp_path):
+    """12 Sobol candidates of the 6-PSU, capability and GCI maximised, worst κ ≤ 4.5 (about
+    half the candidates violate it), coarse 1° and worst-case bounds: the Pareto records (same
+    designs, every metric ==) and the exported designs are the plain run's; candidates are
+    pruned both by the constraint's certified bound and by dominance, and each pruned one is
+    off the plain run's front, its bounds holding the plain run's values."""
+    s0, r0, _ = _e2e(tmp_path, "plain")
+    s1, r1, meta = _e2e(tmp_path, "ladder", {"coarse": {"angle": "1 deg"}})
+    f0, f1 = pareto_records(s0, r0), pareto_records(s1, r1)
+    assert len(f0) >= 2 and [r["params"] for r in f0] == [r["params"] for r in f1]
+    for a, b in zip(f0, f1, strict=True):
+        assert {m: b["metrics"][m] for m in a["metrics"]} == a["metrics"]
+        assert b["metrics"]["worst_kappa_coarse"] <= b["metrics"]["worst_kappa"]
+    e0, e1 = chosen_designs(s0, f0), chosen_designs(s1, f1)
+    assert [(r["params"], k) for r, k, _ in e0] == [(r["params"], k) for r, k, _ in e1]
+    fine = {str(r["params"]): r["metrics"] for r in r0}
+    front = {str(r["params"]) for r in f0}
+    pruned = [r for r in r1 if r["status"] == "pruned"]
+    why = [r["reason"] for r in pruned]
+    assert any("worst_kappa >=" in w for w in why) and any("dominated" in w for w in why), why
+    assert meta["pruned"] == len(pruned) and meta["refined"] + len(pruned) == len(r1)
+    for r in pruned:
+        ref, m = fine[str(r["params"])], r["metrics"]
+        assert str(r["params"]) not in front
+        assert m["worst_kappa"] is None and m["worst_kappa_coarse"] <= ref["worst_kappa"]
+        assert m["min_force_coarse"] >= ref["min_force"]
+        assert ref["orientation_capability"] <= m["orientation_capability_upper_coarse"]
+        assert m["gci"] == ref["gci"]                   # exact on both rungs
+        if "worst_kappa >=" in r["reason"]:
+            assert ref["worst_kappa"] > 4.5

@@ -42,6 +42,7 @@ from ..errors import NumericalError, ParameterError
 from ..units import parse_angle, parse_length
 from .definition import FINE, Tolerances
 from .evaluators import EVALUATORS
+from .evaluators.dexterity import worst_metrics
 from .evaluators.registry import Context
 from .objectives import feasible, objective_matrix
 from .selection import non_dominated
@@ -116,6 +117,9 @@ LADDERED = {
 }
 #: what a laddered evaluator's re-certification runs before it (it reads the workspace)
 _NEEDS = {"dexterity": ("workspace",)}
+#: a laddered evaluator's re-certification, when it is not the whole evaluator: the
+#: dexterity's other metrics (GCI, sampled statistics) do not depend on the rung
+_REFINE = {"dexterity": worst_metrics}
 _BOUNDS = {m: b for ms in LADDERED.values() for m, b in ms.items()}
 
 
@@ -161,9 +165,10 @@ def refine_design(space, params, evaluation, seed: int, names: tuple[str, ...]) 
         mech = space.decode(params)
         ctx = Context(evaluation, seed, choices=dict(space.evaluation_choices(params)))
         for name in run:
-            out = EVALUATORS[name](mech, ctx)
             if name in names:
-                metrics.update(out)
+                metrics.update(_REFINE.get(name, EVALUATORS[name])(mech, ctx))
+            else:
+                EVALUATORS[name](mech, ctx)
         notes = ctx.notes
     except ParameterError as exc:
         status, reason, notes = "invalid", str(exc), {}
