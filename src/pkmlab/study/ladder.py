@@ -4,29 +4,38 @@ designs that can matter at the fine one (issue 28).
 Study file::
 
     tolerance_ladder:
-      coarse: {angle: 0.1 deg, length: 0.1 mm}   # the capability's and the needed stroke's
+      coarse: {angle: 0.1 deg, length: 0.1 mm,   # the capability's and the needed stroke's
+               worst_case: bound}                # the dexterity's worst case (default bound)
       prune: true                                  # certified pruning (default)
 
 **Coarse pass.** The optimiser sees every candidate evaluated with the coarse tolerances
 (:class:`Tolerances`): the orientation capability bisected to ``angle`` instead of 0.01°, the
-needed stroke to ``length`` instead of 0.01 mm. Every other metric does not depend on them.
+needed stroke to ``length`` instead of 0.01 mm, and (``worst_case: bound``) the dexterity's
+worst case replaced by certified bounds from a subset of its samples
+(:mod:`.evaluators.worst_bound`: ``worst_kappa`` a lower bound, ``min_force`` an upper one,
+``singularity_free`` 0 only on a singular sample). Every other metric does not depend on them.
 
 **Refinement** (:func:`refine`, after the optimiser). The stored candidates are re-certified at
 the fine tolerances (the study's own: exactly what a run without the ladder computes), front by
-front of their coarse values, best first. Only the laddered evaluators run again
-(:data:`LADDERED`); their fine values replace the coarse ones, and the coarse ones stay in the
-record as ``<metric>_coarse``.
+front of their coarse values, best first, one batch of workers at a time (within a front, the
+candidates whose certified worst case dominates the most others' best cases first). Only the
+laddered metrics are computed again (:data:`LADDERED`; the dexterity's worst-case metrics
+alone); their fine values replace the coarse ones, and the coarse ones stay in the record as
+``<metric>_coarse``. A failure at the fine tolerance (an invalid design, a declared numerical
+failure) is stored as that status, with the reason and the coarse values.
 
-**Certified pruning.** Each laddered metric's fine value is bracketed by the coarse run's proofs:
-the fine ``orientation_capability`` is a certified lower end, so it lies at most at the coarse
+**Certified pruning.** Each laddered metric's fine value is bracketed by the coarse run's proofs
+(:func:`bounds`): the fine ``orientation_capability`` lies at most at the coarse
 ``orientation_capability_upper`` (a proven upper bound of the true capability); the fine
-``needed_stroke`` is a certified upper end, so at least the coarse ``needed_stroke_lower``
-(:func:`bounds`). A candidate not yet refined is *pruned* when its best case over those bounds
-(every other metric exact) is dominated by the fine values of a refined feasible candidate, or
-when its bounds violate a constraint whatever the fine value. Its record keeps the coarse values
-(``<metric>_coarse``, the fine ones null), status ``pruned`` and the reason (the bounds and the
-dominating candidate). A pruned candidate is certainly dominated at the fine tolerance, so the
-fine Pareto front of the refined candidates is the one of all candidates, and the exported
+``needed_stroke`` at least at the coarse ``needed_stroke_lower``; the fine ``worst_kappa`` at
+least at the coarse one, the fine ``min_force`` at most at the coarse one. A candidate not yet
+refined is *pruned* when its bounds violate a constraint whatever the fine value (checked
+first: constraint-first, e.g. a certified worst κ above the constraint's maximum), or when its
+best case over those bounds (every other metric exact) is dominated by the fine values of a
+refined feasible candidate. Its record keeps the coarse values (``<metric>_coarse``, the fine
+ones null), status ``pruned`` and the reason (the bounds and the dominating candidate or the
+constraint). A pruned candidate is certainly infeasible or dominated at the fine tolerance, so
+the fine Pareto front of the refined candidates is the one of all candidates, and the exported
 designs and their metrics are those of a run without the ladder.
 """
 
