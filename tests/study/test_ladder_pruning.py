@@ -120,8 +120,9 @@ CASES = {
 
 
 class _Runner:
-    def __init__(self):
+    def __init__(self, name="stand-in"):
         self.asked = []
+        self.name = name            # "serial": one re-certification at a time
 
     def map(self, fn, tasks):
         for key, args in tasks:
@@ -135,15 +136,16 @@ class _Runner:
                         "seconds": 0.0}
 
 
-@pytest.mark.parametrize("prune", [True, False])
-def test_refine_prunes_exactly_the_certainly_dominated_or_infeasible(tmp_path, prune):
+@pytest.mark.parametrize("prune,runner", [(True, "serial"), (True, "stand-in"),
+                                           (False, "serial")])
+def test_refine_prunes_exactly_the_certainly_dominated_or_infeasible(tmp_path, prune, runner):
     study = _study(tmp_path, prune)
     store = Store(tmp_path / "e.sqlite")
     for k, (m, _) in CASES.items():
         store.put(k, "candidate", {"link_length": 1.0}, {"status": "ok", "reason": "",
                                                         "metrics": m, "notes": {},
                                                         "seconds": 0.0})
-    runner = _Runner()
+    runner = _Runner(runner)
     counts = refine(study, runner, store)
     rec = {r["key"]: r for r in store.all()}
     if not prune:

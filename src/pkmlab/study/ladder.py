@@ -229,25 +229,31 @@ def refine(study, runner, store) -> dict:
         return counts
     space, ev, seed = study.space, study.evaluation, study.seed
     jobs = _slots(runner)
+    # the Pareto front is over candidates: the baseline never dominates (nor is pruned)
+    dominators = [r for r in done if r["role"] == "candidate" and feasible(study, [r])[0]]
+    rows: dict = {}                 # key → (coarse row, best case, worst case, violation)
+
+    def row(r):
+        if r["key"] not in rows:
+            rows[r["key"]] = (_minimised(study, r), _minimised(study, r, "best", names),
+                              _minimised(study, r, "worst", names),
+                              _violation(study, r, names))
+        return rows[r["key"]]
     while todo:
         # the next front of the coarse values among the candidates left
-        F = np.array([_minimised(study, r) for r in todo])
-        front = set(np.flatnonzero(non_dominated(F)).tolist())
-        # the Pareto front is over candidates: the baseline never dominates (nor is pruned)
-        refined_ok = [r for r in done if r["role"] == "candidate" and feasible(study, [r])[0]]
-        Fd = objective_matrix(study, refined_ok)[0] if refined_ok else np.empty((0, 0))
+        front = set(np.flatnonzero(non_dominated(np.array([row(r)[0] for r in todo]))).tolist())
+        Fd = objective_matrix(study, dominators)[0] if dominators else np.empty((0, 0))
         batch, keep = [], []
-        for i in range(len(todo)):
-            r = todo[i]
+        for i, r in enumerate(todo):
             why = ""
             if ladder.prune and r["role"] == "candidate":
-                why = _violation(study, r, names)
-                best = _minimised(study, r, "best", names)
-                for j, d in enumerate(refined_ok if not why else ()):
-                    if np.all(Fd[j] <= best) and np.any(Fd[j] < best):
-                        why = (f"certainly dominated by evaluation {d['seq']}: best case "
-                               f"{_text(study, best)} vs {_text(study, Fd[j])}")
-                        break
+                _, best, _, why = row(r)
+                if not why and len(Fd):
+                    dom = np.all(Fd <= best, axis=1) & np.any(Fd < best, axis=1)
+                    if dom.any():
+                        j = int(np.argmax(dom))
+                        why = (f"certainly dominated by evaluation {dominators[j]['seq']}: best "
+                               f"case {_text(study, best)} vs {_text(study, Fd[j])}")
             if why:
                 _prune(store, r, names, why)
                 counts["pruned"] += 1
@@ -257,13 +263,18 @@ def refine(study, runner, store) -> dict:
                 keep.append(r)
         if ladder.prune and len(batch) > jobs:
             # one batch of workers at a time, those likeliest to prune the most first
-            batch = sorted(batch, key=lambda r: -_power(study, r, keep + batch, names))
-            batch, keep = batch[:jobs], keep + batch[jobs:]
+            power = _power([row(r)[2] for r in batch], [row(r)[1] for r in keep + batch])
+            power[[r["role"] != "candidate" for r in batch]] = len(todo) + 1   # refined anyway
+            order = np.argsort(-power, kind="stable")
+            batch, keep = ([batch[k] for k in order[:jobs]],
+                           keep + [batch[k] for k in order[jobs:]])
         tasks = [(r["key"], (space, None if r["role"] == "baseline" else r["params"], ev,
                              seed, evaluators)) for r in batch]
         by_key = {r["key"]: r for r in batch}
         for key, res in runner.map(refine_design, tasks):
-            done.append(_refined(store, by_key[key], names, res))
+            rec = _refined(store, by_key[key], names, res)
+            if rec["role"] == "candidate" and feasible(study, [rec])[0]:
+                dominators.append(rec)
             counts["refined"] += 1
         todo = keep
     return counts
@@ -283,17 +294,11 @@ def _slots(runner) -> int:
     return max(1, int(jobs))
 
 
-def _power(study, record, others, names) -> int:
-    """How many of ``others`` ``record``'s certified worst case dominates (the baseline
-    dominates none): the order of the re-certifications within a front."""
-    if record["role"] != "candidate":
-        return len(others) + 1                     # refined anyway: first
-    w = _minimised(study, record, "worst", names)
-    n = 0
-    for r in others:
-        b = _minimised(study, r, "best", names)
-        n += bool(np.all(w <= b) and np.any(w < b))
-    return n
+def _power(worst: list, best: list) -> np.ndarray:
+    """For each certified worst case in ``worst``, how many of the best cases ``best`` it
+    dominates: the order of the re-certifications within a front."""
+    W, B = np.array(worst)[:, None, :], np.array(best)[None, :, :]
+    return np.sum(np.all(W <= B, axis=2) & np.any(W < B, axis=2), axis=1)
 
 
 def coarse_view(record: dict) -> dict:
