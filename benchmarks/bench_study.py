@@ -15,12 +15,17 @@ time per candidate (``time.process_time``) and the rate two idle cores would giv
 and reports the ratio in that one run (issue 28), with the load average and whether the two
 give identical metrics for every candidate.
 ``--ladder [G]`` runs the demo study (its NSGA-II, ``G`` generations, default its own) in this
-process, one numba thread, twice: as it is and with ``tolerance_ladder: {coarse: {angle: 0.1
-deg, length: 0.1 mm}}``; it reports the CPU time per candidate of each (the ladder's includes
+process, one numba thread, twice: as it is and with ``tolerance_ladder: {coarse: {angle: A,
+length: 0.1 mm, worst_case: W}}`` (``--coarse A W``: A in deg, default 0.1; W ``bound``, the
+default, or ``exact``); it reports the CPU time per candidate of each (the ladder's includes
 its re-certification), the ratio in that one run, how many candidates were refined and pruned,
 and whether every candidate both runs evaluated has identical final metrics (issue 28).
+``--ladder-sobol N`` does the same with the demo's evaluation on N Sobol candidates instead
+of its NSGA-II (the same candidates in both runs: the fronts and the exported designs must be
+the same).
 
-    python benchmarks/bench_study.py [--full | --cpu [N] | --compare SRC [N] | --ladder [G]]
+    python benchmarks/bench_study.py [--full | --cpu [N] | --compare SRC [N] | --ladder [G]
+                                      | --ladder-sobol N] [--coarse A W]
 """
 
 from __future__ import annotations
@@ -95,7 +100,8 @@ def compare(base_src: str, n: int) -> None:
           f"{out['before'] == out['now']}")
 
 
-def _run_demo(tmp: Path, name: str, generations: int | None, ladder: dict | None):
+def _run_demo(tmp: Path, name: str, generations: int | None, ladder: dict | None,
+              sobol: int | None = None):
     import yaml
 
     from pkmlab.study import SerialRunner, run_study
@@ -106,6 +112,8 @@ def _run_demo(tmp: Path, name: str, generations: int | None, ladder: dict | None
     data["output"] = str(tmp / name)
     if generations:
         data["optimizer"]["generations"] = generations
+    if sobol:
+        data["optimizer"] = {"method": "sobol", "samples": sobol}
     if ladder:
         data["tolerance_ladder"] = ladder
     path = tmp / f"{name}.yaml"
@@ -120,7 +128,7 @@ def _run_demo(tmp: Path, name: str, generations: int | None, ladder: dict | None
     return cpu, records, pareto_records(study, records), meta
 
 
-def ladder_mode(generations: int | None) -> None:
+def ladder_mode(generations: int | None, coarse: dict, sobol: int | None = None) -> None:
     import tempfile
 
     from pkmlab.runtime.threads import single_thread_worker
@@ -130,10 +138,10 @@ def ladder_mode(generations: int | None) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         _run_demo(Path(tmp), "warm", 1, None)              # kernels loaded / compiled
         loads.append(os.getloadavg()[0])
-        c0, r0, f0, _ = _run_demo(Path(tmp), "plain", generations, None)
+        c0, r0, f0, _ = _run_demo(Path(tmp), "plain", generations, None, sobol)
         loads.append(os.getloadavg()[0])
-        c1, r1, f1, meta = _run_demo(Path(tmp), "ladder", generations,
-                                     {"coarse": {"angle": "0.1 deg", "length": "0.1 mm"}})
+        c1, r1, f1, meta = _run_demo(Path(tmp), "ladder", generations, {"coarse": coarse},
+                                     sobol)
         loads.append(os.getloadavg()[0])
     fine = {json.dumps(r["params"], sort_keys=True): r for r in r0}
 
@@ -144,8 +152,10 @@ def ladder_mode(generations: int | None) -> None:
     fsame = [fine[k]["metrics"] == final(r) for r in f1
              if (k := json.dumps(r["params"], sort_keys=True)) in fine]
     n0, n1 = len(r0), len(r1)
-    print(f"demo study (NSGA-II, {generations or 'its own'} generations), one numba thread, "
-          f"CPU per candidate; load average {min(loads):.2f}-{max(loads):.2f} (2 cores)")
+    how = (f"{sobol} Sobol candidates" if sobol else
+           f"NSGA-II, {generations or 'its own'} generations")
+    print(f"demo study ({how}), one numba thread, CPU per candidate; ladder {coarse}; load "
+          f"average {min(loads):.2f}-{max(loads):.2f} (2 cores)")
     print(f"  without the ladder: {n0} evaluations, {c0:.1f} s CPU, {1e3 * c0 / n0:.0f} ms "
           f"-> {2 * n0 / c0:.1f} candidates/s on 2 idle cores")
     print(f"  with the ladder:    {n1} evaluations, {c1:.1f} s CPU, {1e3 * c1 / n1:.0f} ms "
@@ -153,13 +163,26 @@ def ladder_mode(generations: int | None) -> None:
     print(f"  ratio {(c0 / n0) / (c1 / n1):.2f}x; candidates in both runs with identical final "
           f"metrics: {sum(same)} of {len(same)}; Pareto records of the ladder run with the "
           f"plain run's metrics: {sum(fsame)} of {len(fsame)} found in it (fronts: {len(f0)} "
-          f"and {len(f1)} records)")
+          f"and {len(f1)} records); same Pareto designs: "
+          f"{sorted(_key(r) for r in f0) == sorted(_key(r) for r in f1)}")
+
+
+def _key(r) -> str:
+    return json.dumps(r["params"], sort_keys=True)
 
 
 def main() -> None:
+    coarse = {"angle": "0.1 deg", "length": "0.1 mm", "worst_case": "bound"}
+    if "--coarse" in sys.argv:
+        i = sys.argv.index("--coarse")
+        coarse.update(angle=f"{sys.argv[i + 1]} deg", worst_case=sys.argv[i + 2])
+    if "--ladder-sobol" in sys.argv:
+        ladder_mode(None, coarse, int(sys.argv[sys.argv.index("--ladder-sobol") + 1]))
+        return
     if "--ladder" in sys.argv:
         i = sys.argv.index("--ladder")
-        ladder_mode(int(sys.argv[i + 1]) if len(sys.argv) > i + 1 else None)
+        g = sys.argv[i + 1] if len(sys.argv) > i + 1 else ""
+        ladder_mode(int(g) if g.isdigit() else None, coarse)
         return
     if "--cpu-json" in sys.argv:
         print(json.dumps(cpu_mode(int(sys.argv[sys.argv.index("--cpu-json") + 1]))))

@@ -30,13 +30,17 @@ PENALTY = 1.0e12
 @dataclass(frozen=True)
 class Tolerances:
     """Certified tolerances of the bracketed optima: ``angle`` (rad) of the orientation
-    capability, ``length`` (mm) of the needed stroke."""
+    capability, ``length`` (mm) of the needed stroke; ``worst_case``: ``"exact"`` (the
+    dexterity's worst case over every sample) or ``"bound"`` (certified bounds from a subset of
+    those samples, :mod:`.evaluators.worst_bound`: a tolerance ladder's coarse rung)."""
 
     angle: float
     length: float
+    worst_case: str = "exact"
 
     def written(self) -> dict:
-        return {"angle": f"{math.degrees(self.angle):.12g} deg", "length": f"{self.length:.12g} mm"}
+        return {"angle": f"{math.degrees(self.angle):.12g} deg", "length": f"{self.length:.12g} mm",
+                "worst_case": self.worst_case}
 
 
 #: the tolerances of a run without the ladder (``CAPABILITY_TOL_DEG``, ``STROKE_TOL_MM``)
@@ -92,6 +96,12 @@ class Evaluation:
     def length_tolerance_mm(self) -> float:
         """Bisection tolerance of the needed stroke (mm)."""
         return (self.tolerances or FINE).length
+
+    @property
+    def worst_case_exact(self) -> bool:
+        """The dexterity's worst case over every sample (else certified bounds from a
+        subset: a tolerance ladder's coarse rung)."""
+        return (self.tolerances or FINE).worst_case == "exact"
 
     @property
     def evaluators(self) -> tuple[str, ...]:

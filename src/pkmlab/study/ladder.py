@@ -4,29 +4,38 @@ designs that can matter at the fine one (issue 28).
 Study file::
 
     tolerance_ladder:
-      coarse: {angle: 0.1 deg, length: 0.1 mm}   # the capability's and the needed stroke's
+      coarse: {angle: 0.1 deg, length: 0.1 mm,   # the capability's and the needed stroke's
+               worst_case: bound}                # the dexterity's worst case (default bound)
       prune: true                                  # certified pruning (default)
 
 **Coarse pass.** The optimiser sees every candidate evaluated with the coarse tolerances
 (:class:`Tolerances`): the orientation capability bisected to ``angle`` instead of 0.01°, the
-needed stroke to ``length`` instead of 0.01 mm. Every other metric does not depend on them.
+needed stroke to ``length`` instead of 0.01 mm, and (``worst_case: bound``) the dexterity's
+worst case replaced by certified bounds from a subset of its samples
+(:mod:`.evaluators.worst_bound`: ``worst_kappa`` a lower bound, ``min_force`` an upper one,
+``singularity_free`` 0 only on a singular sample). Every other metric does not depend on them.
 
 **Refinement** (:func:`refine`, after the optimiser). The stored candidates are re-certified at
 the fine tolerances (the study's own: exactly what a run without the ladder computes), front by
-front of their coarse values, best first. Only the laddered evaluators run again
-(:data:`LADDERED`); their fine values replace the coarse ones, and the coarse ones stay in the
-record as ``<metric>_coarse``.
+front of their coarse values, best first, one batch of workers at a time (within a front, the
+candidates whose certified worst case dominates the most others' best cases first). Only the
+laddered metrics are computed again (:data:`LADDERED`; the dexterity's worst-case metrics
+alone); their fine values replace the coarse ones, and the coarse ones stay in the record as
+``<metric>_coarse``. A failure at the fine tolerance (an invalid design, a declared numerical
+failure) is stored as that status, with the reason and the coarse values.
 
-**Certified pruning.** Each laddered metric's fine value is bracketed by the coarse run's proofs:
-the fine ``orientation_capability`` is a certified lower end, so it lies at most at the coarse
+**Certified pruning.** Each laddered metric's fine value is bracketed by the coarse run's proofs
+(:func:`bounds`): the fine ``orientation_capability`` lies at most at the coarse
 ``orientation_capability_upper`` (a proven upper bound of the true capability); the fine
-``needed_stroke`` is a certified upper end, so at least the coarse ``needed_stroke_lower``
-(:func:`bounds`). A candidate not yet refined is *pruned* when its best case over those bounds
-(every other metric exact) is dominated by the fine values of a refined feasible candidate, or
-when its bounds violate a constraint whatever the fine value. Its record keeps the coarse values
-(``<metric>_coarse``, the fine ones null), status ``pruned`` and the reason (the bounds and the
-dominating candidate). A pruned candidate is certainly dominated at the fine tolerance, so the
-fine Pareto front of the refined candidates is the one of all candidates, and the exported
+``needed_stroke`` at least at the coarse ``needed_stroke_lower``; the fine ``worst_kappa`` at
+least at the coarse one, the fine ``min_force`` at most at the coarse one. A candidate not yet
+refined is *pruned* when its bounds violate a constraint whatever the fine value (checked
+first: constraint-first, e.g. a certified worst κ above the constraint's maximum), or when its
+best case over those bounds (every other metric exact) is dominated by the fine values of a
+refined feasible candidate. Its record keeps the coarse values (``<metric>_coarse``, the fine
+ones null), status ``pruned`` and the reason (the bounds and the dominating candidate or the
+constraint). A pruned candidate is certainly infeasible or dominated at the fine tolerance, so
+the fine Pareto front of the refined candidates is the one of all candidates, and the exported
 designs and their metrics are those of a run without the ladder.
 """
 
@@ -38,10 +47,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import NumericalError, ParameterError
 from ..units import parse_angle, parse_length
 from .definition import FINE, Tolerances
 from .evaluators import EVALUATORS
+from .evaluators.dexterity import worst_metrics
 from .evaluators.registry import Context
 from .objectives import feasible, objective_matrix
 from .selection import non_dominated
@@ -63,19 +73,17 @@ class ToleranceLadder:
 
 def ladder_from_spec(data, evaluation) -> ToleranceLadder | None:
     """The study file's ``tolerance_ladder`` mapping → :class:`ToleranceLadder` (None: none),
-    for a study whose ``evaluation`` computes a laddered optimum."""
+    for a study whose ``evaluation`` computes a laddered metric."""
     if data is None:
         return None
     where = "tolerance_ladder"
-    if not _laddered(evaluation):
-        raise ParameterError(where, f"used with one of evaluate.{' or evaluate.'.join(LADDERED)}"
-                             " (the optima with a certified tolerance)", data)
     if not isinstance(data, dict) or set(data) - {"coarse", "prune"} or "coarse" not in data:
-        raise ParameterError(where, "{coarse: {angle: <angle>, length: <length>}, prune: "
-                             "true|false}", data)
+        raise ParameterError(where, "{coarse: {angle: <angle>, length: <length>, worst_case: "
+                             "bound|exact}, prune: true|false}", data)
     c = data["coarse"]
-    if not isinstance(c, dict) or set(c) - {"angle", "length"}:
-        raise ParameterError(f"{where}.coarse", "{angle: 0.1 deg, length: 0.1 mm}", c)
+    if not isinstance(c, dict) or set(c) - {"angle", "length", "worst_case"}:
+        raise ParameterError(f"{where}.coarse", "{angle: 0.1 deg, length: 0.1 mm, worst_case: "
+                             "bound}", c)
     angle = parse_angle(c.get("angle", "0.01 deg"), f"{where}.coarse.angle")
     length = parse_length(c.get("length", "0.01 mm"), f"{where}.coarse.length")
     if not FINE.angle <= angle <= math.radians(5.0):
@@ -84,14 +92,23 @@ def ladder_from_spec(data, evaluation) -> ToleranceLadder | None:
     if not FINE.length <= length <= 10.0:
         raise ParameterError(f"{where}.coarse.length", "a length in [0.01, 10] mm (the fine "
                              "tolerance is 0.01 mm)", c.get("length"))
+    worst = c.get("worst_case", "bound")
+    if worst not in ("bound", "exact"):
+        raise ParameterError(f"{where}.coarse.worst_case", "'bound' (certified bounds from a "
+                             "subset of the samples) or 'exact'", worst)
     prune = data.get("prune", True)
     if not isinstance(prune, bool):
         raise ParameterError(f"{where}.prune", "true or false", prune)
-    return ToleranceLadder(Tolerances(angle, length), prune)
+    ladder = ToleranceLadder(Tolerances(angle, length, worst), prune)
+    if not laddered(evaluation, ladder):
+        raise ParameterError(where, f"used with one of evaluate.{' or evaluate.'.join(LADDERED)}"
+                             " (the optima with a certified tolerance; dexterity with "
+                             "coarse.worst_case: bound)", data)
+    return ladder
 
 
-#: laddered evaluator → its metrics, each with the coarse metric bounding its fine value
-#: from below and from above (None: no certified bound on that side)
+#: laddered evaluator → its metrics that the coarse rung changes, each with the coarse metric
+#: bounding its fine value from below and from above (None: no certified bound on that side)
 LADDERED = {
     "orientation_capability": {
         "orientation_capability": (None, "orientation_capability_upper"),
@@ -101,7 +118,17 @@ LADDERED = {
         "needed_stroke": ("needed_stroke_lower", None),
         "needed_stroke_lower": (None, "needed_stroke"),
         "needed_stroke_bracket": (None, None)},
+    # coarse.worst_case: bound (.evaluators.worst_bound); its other metrics are exact
+    "dexterity": {
+        "worst_kappa": ("worst_kappa", None),
+        "min_force": (None, "min_force"),
+        "singularity_free": (None, "singularity_free")},
 }
+#: what a laddered evaluator's re-certification runs before it (it reads the workspace)
+_NEEDS = {"dexterity": ("workspace",)}
+#: a laddered evaluator's re-certification, when it is not the whole evaluator: the
+#: dexterity's other metrics (GCI, sampled statistics) do not depend on the rung
+_REFINE = {"dexterity": worst_metrics}
 _BOUNDS = {m: b for ms in LADDERED.values() for m, b in ms.items()}
 
 
@@ -109,11 +136,12 @@ def coarse_name(metric: str) -> str:
     return f"{metric}_coarse"
 
 
-def bounds(record: dict, metric: str) -> tuple[float, float]:
+def bounds(record: dict, metric: str, names=None) -> tuple[float, float]:
     """Certified ``(low, high)`` of ``metric``'s fine value from a coarse ``record`` (exact
-    metrics: the value twice; a missing bound: ∓inf)."""
+    metrics, and those not in ``names``, the metrics the run's ladder changes (default: every
+    laddered one): the value twice; a missing bound: ∓inf)."""
     m = record["metrics"]
-    if metric not in _BOUNDS:
+    if metric not in _BOUNDS or (names is not None and metric not in names):
         v = m.get(metric)
         return (math.nan, math.nan) if v is None else (float(v), float(v))
     lo, hi = _BOUNDS[metric]
@@ -125,40 +153,58 @@ def bounds(record: dict, metric: str) -> tuple[float, float]:
     return value(lo, -math.inf), value(hi, math.inf)
 
 
-def _laddered(evaluation) -> list[str]:
-    return [n for n in evaluation.evaluators if n in LADDERED]
+def laddered(evaluation, ladder: ToleranceLadder) -> list[str]:
+    """The evaluators of ``evaluation`` whose metrics the coarse rung of ``ladder`` changes
+    (dexterity only with ``worst_case: bound``), in evaluation order."""
+    return [n for n in evaluation.evaluators if n in LADDERED
+            and (n != "dexterity" or ladder.coarse.worst_case == "bound")]
 
 
-def refine_design(space, params, evaluation, seed: int) -> dict:
-    """The laddered evaluators of ``evaluation`` (fine tolerances) on one design → a result
-    with their metrics and notes (runs in a worker like :func:`.evaluators.evaluate_design`)."""
+def refine_design(space, params, evaluation, seed: int, names: tuple[str, ...]) -> dict:
+    """The evaluators ``names`` of ``evaluation`` (fine tolerances) on one design → a result
+    ``{"status", "reason", "metrics", "notes", "seconds"}`` with their metrics and notes (runs
+    in a worker like :func:`.evaluators.evaluate_design`; an invalid design or a declared
+    numerical failure is a status with its reason)."""
     t0 = time.perf_counter()
-    mech = space.decode(params)
-    ctx = Context(evaluation, seed, choices=dict(space.evaluation_choices(params)))
+    run = [n for n in evaluation.evaluators
+           if n in names or any(n in _NEEDS.get(m, ()) for m in names)]
     metrics: dict = {}
-    for name in _laddered(evaluation):
-        metrics.update(EVALUATORS[name](mech, ctx))
-    return {"metrics": metrics, "notes": ctx.notes, "seconds": time.perf_counter() - t0}
+    status, reason = "ok", ""
+    try:
+        mech = space.decode(params)
+        ctx = Context(evaluation, seed, choices=dict(space.evaluation_choices(params)))
+        for name in run:
+            if name in names:
+                metrics.update(_REFINE.get(name, EVALUATORS[name])(mech, ctx))
+            else:
+                EVALUATORS[name](mech, ctx)
+        notes = ctx.notes
+    except ParameterError as exc:
+        status, reason, notes = "invalid", str(exc), {}
+    except NumericalError as exc:
+        status, reason, notes = "failed", str(exc), {}
+    return {"status": status, "reason": reason, "metrics": metrics, "notes": notes,
+            "seconds": time.perf_counter() - t0}
 
 
-def _minimised(study, record, best_case: bool) -> np.ndarray:
-    """Objective row (minimised): the record's values, or (``best_case``) each objective at
-    the end of its certified bounds that is best for it."""
+def _minimised(study, record, case: str = "value", names=None) -> np.ndarray:
+    """Objective row (minimised): the record's values, or (``case`` "best" / "worst") each
+    objective at the end of its certified bounds that is best / worst for it."""
     row = []
     for o in study.objectives:
-        lo, hi = bounds(record, o.metric)
+        lo, hi = bounds(record, o.metric, names)
         v = record["metrics"].get(o.metric)
-        if best_case:
-            v = hi if o.sense == "maximize" else lo
+        if case != "value":
+            v = hi if (o.sense == "maximize") == (case == "best") else lo
         v = math.nan if v is None else float(v)
         row.append(math.inf if math.isnan(v) else (-v if o.sense == "maximize" else v))
     return np.array(row)
 
 
-def _violation(study, record) -> str:
+def _violation(study, record, names=None) -> str:
     """A constraint the record's certified bounds violate whatever the fine value, or ''."""
     for c in study.constraints:
-        lo, hi = bounds(record, c.metric)
+        lo, hi = bounds(record, c.metric, names)
         if math.isnan(lo):
             return f"{c.metric} undefined"
         if c.min is not None and hi < c.min:
@@ -172,7 +218,8 @@ def refine(study, runner, store) -> dict:
     """Re-certify the stored candidates at the fine tolerances, pruning those certainly
     dominated (module notes) → ``{"refined": n, "pruned": n}``."""
     ladder = study.tolerance_ladder
-    names = [m for n in _laddered(study.evaluation) for m in LADDERED[n]]
+    evaluators = tuple(laddered(study.evaluation, ladder))
+    names = [m for n in evaluators for m in LADDERED[n]]
     ok = [r for r in store.all() if r["status"] == "ok"]
     fresh = [not any(coarse_name(m) in r["metrics"] for m in names) for r in ok]
     todo = [r for r, f in zip(ok, fresh, strict=True) if f]
@@ -181,25 +228,32 @@ def refine(study, runner, store) -> dict:
     if not names:
         return counts
     space, ev, seed = study.space, study.evaluation, study.seed
+    jobs = _slots(runner)
+    # the Pareto front is over candidates: the baseline never dominates (nor is pruned)
+    dominators = [r for r in done if r["role"] == "candidate" and feasible(study, [r])[0]]
+    rows: dict = {}                 # key → (coarse row, best case, worst case, violation)
+
+    def row(r):
+        if r["key"] not in rows:
+            rows[r["key"]] = (_minimised(study, r), _minimised(study, r, "best", names),
+                              _minimised(study, r, "worst", names),
+                              _violation(study, r, names))
+        return rows[r["key"]]
     while todo:
         # the next front of the coarse values among the candidates left
-        F = np.array([_minimised(study, r, False) for r in todo])
-        front = set(np.flatnonzero(non_dominated(F)).tolist())
-        # the Pareto front is over candidates: the baseline never dominates (nor is pruned)
-        refined_ok = [r for r in done if r["role"] == "candidate" and feasible(study, [r])[0]]
-        Fd = objective_matrix(study, refined_ok)[0] if refined_ok else np.empty((0, 0))
+        front = set(np.flatnonzero(non_dominated(np.array([row(r)[0] for r in todo]))).tolist())
+        Fd = objective_matrix(study, dominators)[0] if dominators else np.empty((0, 0))
         batch, keep = [], []
-        for i in range(len(todo)):
-            r = todo[i]
+        for i, r in enumerate(todo):
             why = ""
             if ladder.prune and r["role"] == "candidate":
-                why = _violation(study, r)
-                best = _minimised(study, r, True)
-                for j, d in enumerate(refined_ok if not why else ()):
-                    if np.all(Fd[j] <= best) and np.any(Fd[j] < best):
-                        why = (f"certainly dominated by evaluation {d['seq']}: best case "
-                               f"{_text(study, best)} vs {_text(study, Fd[j])}")
-                        break
+                _, best, _, why = row(r)
+                if not why and len(Fd):
+                    dom = np.all(Fd <= best, axis=1) & np.any(Fd < best, axis=1)
+                    if dom.any():
+                        j = int(np.argmax(dom))
+                        why = (f"certainly dominated by evaluation {dominators[j]['seq']}: best "
+                               f"case {_text(study, best)} vs {_text(study, Fd[j])}")
             if why:
                 _prune(store, r, names, why)
                 counts["pruned"] += 1
@@ -207,14 +261,44 @@ def refine(study, runner, store) -> dict:
                 batch.append(r)
             else:
                 keep.append(r)
+        if ladder.prune and len(batch) > jobs:
+            # one batch of workers at a time, those likeliest to prune the most first
+            power = _power([row(r)[2] for r in batch], [row(r)[1] for r in keep + batch])
+            power[[r["role"] != "candidate" for r in batch]] = len(todo) + 1   # refined anyway
+            order = np.argsort(-power, kind="stable")
+            batch, keep = ([batch[k] for k in order[:jobs]],
+                           keep + [batch[k] for k in order[jobs:]])
         tasks = [(r["key"], (space, None if r["role"] == "baseline" else r["params"], ev,
-                             seed)) for r in batch]
+                             seed, evaluators)) for r in batch]
         by_key = {r["key"]: r for r in batch}
         for key, res in runner.map(refine_design, tasks):
-            done.append(_refined(store, by_key[key], names, res))
+            rec = _refined(store, by_key[key], names, res)
+            if rec["role"] == "candidate" and feasible(study, [rec])[0]:
+                dominators.append(rec)
             counts["refined"] += 1
         todo = keep
     return counts
+
+
+def _slots(runner) -> int:
+    """Evaluations the runner runs at once: its ``jobs``, 1 in this process, and for a
+    cluster (Dask) its workers' threads (large when unknown: whole fronts at once)."""
+    if getattr(runner, "name", "") == "serial":
+        return 1
+    jobs = getattr(runner, "jobs", None)
+    if jobs is None:
+        try:
+            jobs = sum(runner.client.nthreads().values())
+        except Exception:  # noqa: BLE001 - unknown: no batching
+            jobs = 1 << 30
+    return max(1, int(jobs))
+
+
+def _power(worst: list, best: list) -> np.ndarray:
+    """For each certified worst case in ``worst``, how many of the best cases ``best`` it
+    dominates: the order of the re-certifications within a front."""
+    W, B = np.array(worst)[:, None, :], np.array(best)[None, :, :]
+    return np.sum(np.all(W <= B, axis=2) & np.any(W < B, axis=2), axis=1)
 
 
 def coarse_view(record: dict) -> dict:
@@ -224,7 +308,10 @@ def coarse_view(record: dict) -> dict:
     back = {k[:-len("_coarse")]: v for k, v in m.items() if k.endswith("_coarse")}
     if not back:
         return record
-    status = "ok" if record["status"] == "pruned" else record["status"]
+    # pruned, or failed at the fine tolerance only: the coarse pass stored it as evaluated
+    coarse_ok = record["status"] == "pruned" or record["reason"].startswith(
+        "at the fine tolerance")
+    status = "ok" if coarse_ok else record["status"]
     return {**record, "status": status, "metrics": {**m, **back}}
 
 
@@ -237,11 +324,15 @@ def _refined(store, record, names, res) -> dict:
     metrics = dict(record["metrics"])
     for m in names:
         metrics[coarse_name(m)] = metrics.get(m)
+        if res["status"] != "ok":
+            metrics[m] = None
     metrics.update(res["metrics"])
     notes = {k: v for k, v in record["notes"].items() if k not in names}
-    notes.update(res["notes"])
+    notes.update({k: v for k, v in res["notes"].items() if k in names})
+    extra = {} if res["status"] == "ok" else {
+        "status": res["status"], "reason": f"at the fine tolerance: {res['reason']}"}
     return store.update(record["key"], metrics=metrics, notes=notes,
-                        seconds=record["seconds"] + res["seconds"])
+                        seconds=record["seconds"] + res["seconds"], **extra)
 
 
 def _prune(store, record, names, why: str) -> dict:

@@ -96,7 +96,8 @@ class StudySpec(_Model):
     top: int = Field(5, ge=0, le=100, description="Pareto designs exported in full")
     tolerance_ladder: dict[str, Any] | None = Field(
         None, description="optimise at coarse certified tolerances, re-certify at the fine "
-        "ones: {coarse: {angle: 0.1 deg, length: 0.1 mm}, prune: true} (docs/studies.md)")
+        "ones: {coarse: {angle: 0.1 deg, length: 0.1 mm, worst_case: bound}, prune: true} "
+        "(docs/studies.md)")
     provenance: dict[str, Any] | None = Field(None, description="written by pkmlab into "
                                               "study.resolved.yaml; ignored on load")
 

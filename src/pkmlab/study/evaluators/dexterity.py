@@ -15,6 +15,7 @@ from ...dexterity.budget import WORST_BYTES_PER_SAMPLE, require_grid
 from ...errors import NumericalError, ParameterError
 from ...units import effort_limit, parse_length
 from .registry import Evaluator, finite, metric, register_evaluator
+from .worst_bound import worst_bound
 
 
 def _auto_length(v: Any) -> float | None:
@@ -45,6 +46,7 @@ class DexteritySpec(BaseModel):
                                                    "family; no default")
 
 
+_WORST = ("worst_kappa", "min_force", "singularity_free")
 _OVER_WORKSPACE = ("worst_kappa", "min_force", "singularity_free", "gci", "gci_std_error",
                    "sampled_max_kappa", "sampled_min_force")
 
@@ -108,9 +110,7 @@ class Dexterity(Evaluator):
 
     def compute(self, mech, ctx) -> dict:
         plan, res = ctx.evaluation.dexterity, ctx.result
-        length = dx.resolve_length(mech, plan.characteristic_length)
-        if length.status == "fallback":
-            raise NumericalError("characteristic length", length.reason)
+        length = _length(mech, plan)
         L = length.length
         ctx.L = L
         J0 = mech.jacobian(mech.nominal_pose)
@@ -125,18 +125,8 @@ class Dexterity(Evaluator):
                 ctx.notes[n] = "workspace empty"
             out.update(dict.fromkeys(_OVER_WORKSPACE))
             return out
-        require_grid(res, "evaluate.workspace.resolution", WORST_BYTES_PER_SAMPLE)
+        out.update(worst_metrics(mech, ctx, length))
         effort = effort_limit(mech.actuator_unit, plan.force_limit, plan.torque_limit)
-        wc = dx.worst_case(res.mechanism, res, length,
-                           plan.force_limit if effort is None else effort)
-        if wc.status != "ok":
-            raise NumericalError("worst case over the workspace", wc.reason)
-        out["worst_kappa"] = finite(wc.worst_kappa)
-        out["min_force"] = float(wc.min_force) if effort is not None else None
-        out["singularity_free"] = float(not wc.singular)
-        if wc.singular:
-            ctx.notes["worst_kappa"] = (f"singular pose in the workspace or on its boundary: "
-                                        f"{wc.reason}")
         # one Monte-Carlo sample serves every sampled statistic
         p, R = dx.aggregate.sample_poses(res, plan.gci_samples,
                                          np.random.default_rng(ctx.seed))
@@ -150,14 +140,74 @@ class Dexterity(Evaluator):
                                         mobility=mech.mobility)
         out["sampled_min_force"] = float(np.min(F)) if len(F) and effort is not None else None
         if effort is None:
-            for n in ("min_force", "sampled_min_force"):
-                ctx.notes[n] = ("servos need evaluate.dexterity.torque_limit (N·m): a linear "
-                                "force limit is never applied to a servo")
+            ctx.notes["sampled_min_force"] = _SERVO
         for n in ("gci", "gci_std_error", "sampled_max_kappa", "sampled_min_force"):
             if out[n] is None:
                 ctx.notes.setdefault(n, "a sampled pose is singular" if g.ok and
                                      n == "sampled_max_kappa" else "no valid Monte-Carlo pose")
         return out
+
+
+_SERVO = ("servos need evaluate.dexterity.torque_limit (N·m): a linear force limit is never "
+          "applied to a servo")
+
+
+def _length(mech, plan):
+    length = dx.resolve_length(mech, plan.characteristic_length)
+    if length.status == "fallback":
+        raise NumericalError("characteristic length", length.reason)
+    return length
+
+
+def worst_metrics(mech, ctx, length=None) -> dict:
+    """``worst_kappa``, ``min_force`` and ``singularity_free`` (with their notes) as
+    :meth:`Dexterity.compute` writes them — exact, or on a tolerance ladder's coarse rung the
+    certified bounds of :mod:`.worst_bound` — after the workspace evaluator (``ctx.result``).
+    A ladder re-certifies these alone (:mod:`pkmlab.study.ladder`)."""
+    plan, res = ctx.evaluation.dexterity, ctx.result
+    length = _length(mech, plan) if length is None else length
+    if res.empty:
+        for n in _WORST:
+            ctx.notes[n] = "workspace empty"
+        return dict.fromkeys(_WORST)
+    require_grid(res, "evaluate.workspace.resolution", WORST_BYTES_PER_SAMPLE)
+    effort = effort_limit(mech.actuator_unit, plan.force_limit, plan.torque_limit)
+    force = plan.force_limit if effort is None else effort
+    if ctx.evaluation.worst_case_exact:
+        out = _exact_worst(res, length, force, effort, ctx)
+    else:       # a tolerance ladder's coarse rung: certified bounds (study.ladder)
+        out = _worst_bounds(res, length, force, effort, ctx)
+    if effort is None:
+        ctx.notes["min_force"] = _SERVO
+    return out
+
+
+def _exact_worst(res, length, force, effort, ctx) -> dict:
+    wc = dx.worst_case(res.mechanism, res, length, force)
+    if wc.status != "ok":
+        raise NumericalError("worst case over the workspace", wc.reason)
+    out = {"worst_kappa": finite(wc.worst_kappa),
+           "min_force": float(wc.min_force) if effort is not None else None,
+           "singularity_free": float(not wc.singular)}
+    if wc.singular:
+        ctx.notes["worst_kappa"] = (f"singular pose in the workspace or on its boundary: "
+                                    f"{wc.reason}")
+    return out
+
+
+def _worst_bounds(res, length, force, effort, ctx) -> dict:
+    """The coarse rung: ``worst_kappa`` a certified lower bound, ``min_force`` an upper one,
+    ``singularity_free`` 0 only when a sample of the subset is singular (a certificate), else
+    1 (an upper bound: the exact pass may find one)."""
+    b = worst_bound(res.mechanism, res, length, force)
+    out = {"worst_kappa": finite(b.kappa_lower),
+           "min_force": finite(b.force_upper) if effort is not None else None,
+           "singularity_free": float(not b.singular)}
+    for n in ("worst_kappa", "min_force", "singularity_free"):
+        ctx.notes[n] = b.describe()
+    if b.singular:
+        ctx.notes["worst_kappa"] = f"a singular sample: {b.describe()}"
+    return out
 
 
 register_evaluator(Dexterity())
