@@ -62,8 +62,19 @@ from numba import types as nt
 from ...runtime.jit import cached_kernel, identity, jitable
 from . import columns as column_kernels
 from . import ik as _kernels
-from .branch import (BB_F, BB_STATUS, BB_X, BB_Y, BB_ZHI, BB_ZLO, EMPTY, FEASIBLE, STACK,
-                     UNDECIDED, branch_core)
+from .branch import (
+    BB_F,
+    BB_STATUS,
+    BB_X,
+    BB_Y,
+    BB_ZHI,
+    BB_ZLO,
+    EMPTY,
+    FEASIBLE,
+    STACK,
+    UNDECIDED,
+    branch_core,
+)
 from .tiles import DPAD  # DPAD: padding of distance ranges (mm)
 
 __all__ = ["make_branch_bound", "make_certify", "make_capability", "DPAD"]
@@ -274,15 +285,19 @@ def make_branch_bound(leg):
 
 @cache
 def make_certify(leg):
-    """``cert(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, out (2,))``: certification
-    of one point over the continuous box (module notes; ``PR`` the column profile or rows
-    with ``K < 0``); out = (status, cells)."""
+    """``cert(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, out (2,) or (5,))``:
+    certification of one point over the continuous box (module notes; ``PR`` the column
+    profile or rows with ``K < 0``); out = (status, cells) and, given room, the Euler angles
+    of the orientation that refuted the point (status 0)."""
     core = _core(leg)
     certify = core["certify"]
 
     def cert(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, out):
-        s, c = certify(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, np.empty(3))
+        bad = np.full(3, np.nan)
+        s, c = certify(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, bad)
         out[0], out[1] = s, c
+        if out.shape[0] >= 5:
+            out[2], out[3], out[4] = bad[0], bad[1], bad[2]
 
     f8 = nt.float64
     return cached_kernel(cert, nt.void(_F2, _F2, _F2, _F3, _F1, f8, f8, f8, f8, f8, nt.int64,
