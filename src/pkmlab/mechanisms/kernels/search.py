@@ -20,7 +20,10 @@ which states the method; in short:
   ``min_size`` mm. An empty tile list proves ``f < 0`` at every continuous position.
   Hardest orientations first: a bound stops as soon as it falls below the pruning threshold
   (it is still a bound), and the orientation that stopped it is tried first on the next
-  tile; the decisions and the best margin are those of the full evaluation.
+  tile; the decisions and the best margin are those of the full evaluation. A split tile
+  bounds its children and evaluates their centres over its *kept* pairs only, those that can
+  still give the maximum ``a`` or minimum ``b`` somewhere in it (:mod:`.branch`, exact:
+  the same tiles, decisions and outputs as over all pairs, bit for bit).
 * :func:`make_certify`: whether one point ``p`` keeps every leg within its stroke for *every*
   orientation of the continuous Euler box ``centre ± θ`` (not a sample). The box is split into
   cells of half-width ``δ``; over a cell ``w_i = R·u_i - b_i`` moves from its value at the
