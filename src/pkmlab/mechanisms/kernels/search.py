@@ -20,7 +20,10 @@ which states the method; in short:
   ``min_size`` mm. An empty tile list proves ``f < 0`` at every continuous position.
   Hardest orientations first: a bound stops as soon as it falls below the pruning threshold
   (it is still a bound), and the orientation that stopped it is tried first on the next
-  tile; the decisions and the best margin are those of the full evaluation.
+  tile; the decisions and the best margin are those of the full evaluation. A split tile
+  bounds its children and evaluates their centres over its *kept* pairs only, those that can
+  still give the maximum ``a`` or minimum ``b`` somewhere in it (:mod:`.branch`, exact:
+  the same tiles, decisions and outputs as over all pairs, bit for bit).
 * :func:`make_certify`: whether one point ``p`` keeps every leg within its stroke for *every*
   orientation of the continuous Euler box ``centre ± θ`` (not a sample). The box is split into
   cells of half-width ``δ``; over a cell ``w_i = R·u_i - b_i`` moves from its value at the
@@ -62,12 +65,23 @@ from numba import types as nt
 from ...runtime.jit import cached_kernel, identity, jitable
 from . import columns as column_kernels
 from . import ik as _kernels
-from .tiles import DPAD, tile_distances  # DPAD: padding of distance ranges (mm)
+from .branch import (
+    BB_F,
+    BB_STATUS,
+    BB_X,
+    BB_Y,
+    BB_ZHI,
+    BB_ZLO,
+    EMPTY,
+    FEASIBLE,
+    STACK,
+    UNDECIDED,
+    branch_core,
+)
+from .tiles import DPAD  # DPAD: padding of distance ranges (mm)
 
 __all__ = ["make_branch_bound", "make_certify", "make_capability", "DPAD"]
 
-#: a tile's upper bound must be below -UB_TOL (mm) to count as empty
-UB_TOL = 1e-9
 #: the best point of a sample is searched to this margin (mm) before it is certified
 MAX_EPS = 1e-2
 #: half-width (mm) of the region around the sample's witness searched for the point to certify
@@ -78,12 +92,6 @@ CUTS = 64
 CUTS_PER_LEVEL = 6
 #: padding (mm) of the second-order certification bounds against rounding
 TPAD = 1e-8
-#: initial capacity of the tile and cell stacks (grown when needed)
-STACK = 4096
-
-# out[] of the branch and bound
-BB_STATUS, BB_F, BB_X, BB_Y, BB_ZLO, BB_ZHI, BB_UB, BB_TILES = range(8)
-FEASIBLE, EMPTY, UNDECIDED = 1.0, 0.0, -1.0
 
 
 @cache
@@ -126,139 +134,6 @@ def _core(leg):
                 X[M + k, s, 0] = rr[0] * ux + rr[1] * uy + rr[2] * uz - Bp[s, 0]
                 X[M + k, s, 1] = rr[3] * ux + rr[4] * uy + rr[5] * uz - Bp[s, 1]
                 X[M + k, s, 2] = rr[6] * ux + rr[7] * uy + rr[8] * uz - Bp[s, 2]
-
-    def margin(x, y, W, M, P, thr, order):
-        """``(f, max a, min b)`` of the column (x, y) over the first M orientations of W,
-        exact when ``f >= thr``; otherwise some value below ``thr`` (the pairs are visited in
-        ``order`` and stop once the running margin is below it; the orientation that stopped
-        them moves to the front of ``order``)."""
-        lo, hi = -np.inf, np.inf
-        for k in range(M):
-            m = order[k]
-            for i in range(6):
-                a, b, ok = leg(x, y, W[m, i, 0], W[m, i, 1], W[m, i, 2],
-                               P[i, 0], P[i, 1], P[i, 2])
-                if not ok:
-                    order[k], order[0] = order[0], m
-                    return -np.inf, np.inf, -np.inf
-                lo = max(lo, a)
-                hi = min(hi, b)
-            if hi - lo < thr:
-                order[k], order[0] = order[0], m
-                return hi - lo, lo, hi
-        return hi - lo, lo, hi
-
-    def tile_ub(x0, x1, y0, y1, W, M, P, thr, order):
-        """Upper bound of the margin over the continuous tile; once it is below ``thr`` it may
-        stop early (the value returned is still an upper bound; ``order`` as in margin)."""
-        La, Ub = -np.inf, np.inf
-        for k in range(M):
-            m = order[k]
-            for i in range(6):
-                wx, wy, wz = W[m, i, 0], W[m, i, 1], W[m, i, 2]
-                dmin, dmax = tile_distances(x0, x1, y0, y1, -wx, -wy)
-                a1, b1, ok1 = leg(dmin - wx, -wy, wx, wy, wz, P[i, 0], P[i, 1], P[i, 2])
-                if not ok1:
-                    order[k], order[0] = order[0], m
-                    return -np.inf
-                a2, b2, ok2 = leg(dmax - wx, -wy, wx, wy, wz, P[i, 0], P[i, 1], P[i, 2])
-                La = max(La, min(a1, a2))
-                Ub = min(Ub, max(b1, b2))
-            if Ub - La < thr:
-                order[k], order[0] = order[0], m
-                return Ub - La
-        return Ub - La
-
-    def exit_below(decide, best, eps):
-        """Where a tile bound may stop early: below the pruning threshold, and in the
-        non-deciding mode while no witness is known also below -UB_TOL, so that a status
-        EMPTY (every bound below -UB_TOL) stays exact."""
-        if decide:
-            return -UB_TOL
-        return best + eps if best >= 0.0 else min(best + eps, -UB_TOL)
-
-    def branch_bound(W, M, P, box, h0, min_size, eps, decide, out):
-        """Branch and bound of the margin over continuous (x, y) in ``box`` (x0, x1, y0, y1);
-        see the module notes. Writes ``out[BB_*]``."""
-        nx = max(1, int(math.ceil((box[1] - box[0]) / h0)))
-        ny = max(1, int(math.ceil((box[3] - box[2]) / h0)))
-        cap = nx * ny + STACK
-        T = np.empty((cap, 5))
-        best, bx, by, bzl, bzh = -np.inf, np.nan, np.nan, np.nan, np.nan
-        gub = -np.inf                 # bound of the discarded tiles
-        n = 0
-        tiles = 0
-        # hardest orientations first: the one that last ended a bound is tried first; early
-        # exits below the pruning threshold never change a decision (exit_below)
-        first = np.arange(M)
-        for i in range(nx):
-            for j in range(ny):
-                x0 = box[0] + i * h0
-                y0 = box[2] + j * h0
-                x1 = min(x0 + h0, box[1])
-                y1 = min(y0 + h0, box[3])
-                ub = tile_ub(x0, x1, y0, y1, W, M, P,
-                             exit_below(decide, best, eps), first)
-                tiles += 1
-                if ub < -UB_TOL:
-                    gub = max(gub, ub)
-                    continue
-                f, zl, zh = margin(0.5 * (x0 + x1), 0.5 * (y0 + y1), W, M, P, best, first)
-                if f > best:
-                    best, bx, by, bzl, bzh = f, 0.5 * (x0 + x1), 0.5 * (y0 + y1), zl, zh
-                T[n, 0], T[n, 1], T[n, 2], T[n, 3], T[n, 4] = x0, x1, y0, y1, ub
-                n += 1
-        status = UNDECIDED
-        if decide and best >= 0.0:
-            status = FEASIBLE
-            n = 0
-        # the most promising tiles last on the stack (popped first)
-        order = np.argsort(T[:n, 4])
-        S = np.empty((cap, 5))
-        for k in range(n):
-            for c in range(5):
-                S[k, c] = T[order[k], c]
-        sp = n
-        undecided = 0
-        while sp > 0:
-            sp -= 1
-            x0, x1, y0, y1, ub = S[sp, 0], S[sp, 1], S[sp, 2], S[sp, 3], S[sp, 4]
-            thr = -UB_TOL if decide else best + eps
-            if ub < thr:
-                gub = max(gub, ub)
-                continue
-            if max(x1 - x0, y1 - y0) <= min_size:
-                gub = max(gub, ub)
-                undecided += 1
-                continue
-            xm, ym = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
-            if sp + 4 > S.shape[0]:
-                S2 = np.empty((2 * S.shape[0], 5))
-                S2[:sp] = S[:sp]
-                S = S2
-            for q in range(4):
-                cx0 = x0 if q // 2 == 0 else xm
-                cx1 = xm if q // 2 == 0 else x1
-                cy0 = y0 if q % 2 == 0 else ym
-                cy1 = ym if q % 2 == 0 else y1
-                cub = min(ub, tile_ub(cx0, cx1, cy0, cy1, W, M, P,
-                                      exit_below(decide, best, eps), first))
-                tiles += 1
-                f, zl, zh = margin(0.5 * (cx0 + cx1), 0.5 * (cy0 + cy1), W, M, P, best,
-                                   first)
-                if f > best:
-                    best, bx, by, bzl, bzh = f, 0.5 * (cx0 + cx1), 0.5 * (cy0 + cy1), zl, zh
-                S[sp, 0], S[sp, 1], S[sp, 2], S[sp, 3], S[sp, 4] = cx0, cx1, cy0, cy1, cub
-                sp += 1
-            if decide and best >= 0.0:
-                status = FEASIBLE
-                break
-        if status != FEASIBLE and decide:
-            status = EMPTY if undecided == 0 and best < 0.0 else UNDECIDED
-        if not decide:
-            status = FEASIBLE if best >= 0.0 else (EMPTY if gub < -UB_TOL else UNDECIDED)
-        out[BB_STATUS], out[BB_F], out[BB_X], out[BB_Y] = status, best, bx, by
-        out[BB_ZLO], out[BB_ZHI], out[BB_UB], out[BB_TILES] = bzl, bzh, max(gub, best), tiles
 
     def certify(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, bad):
         """1: ``(x, y, z)`` holds for every orientation of the box e0 ± theta; 0: refuted (an
@@ -378,19 +253,15 @@ def _core(leg):
                 sp += 1
         return status, cells
 
-    raw = (sample, sample_cuts, margin, tile_ub, exit_below, branch_bound, certify)
+    raw = (sample, sample_cuts, certify)
     ident = identity(*raw, extra=("search-core",))
     # the functions call each other through closure cells: rebinding the names makes those
     # cells hold the jitable versions
     sample = jitable(sample, ident, error_model="numpy")
     sample_cuts = jitable(sample_cuts, ident, error_model="numpy")
-    margin = jitable(margin, ident, error_model="numpy")
-    tile_ub = jitable(tile_ub, ident, error_model="numpy")
-    exit_below = jitable(exit_below, ident, error_model="numpy")
-    branch_bound = jitable(branch_bound, ident, error_model="numpy")
     certify = jitable(certify, ident, error_model="numpy")
-    return {"sample": sample, "sample_cuts": sample_cuts, "margin": margin, "tile_ub": tile_ub,
-            "exit_below": exit_below, "branch_bound": branch_bound, "certify": certify}
+    return branch_core(leg) | {"sample": sample, "sample_cuts": sample_cuts,
+                               "certify": certify}
 
 
 _F1, _F2, _F3 = nt.float64[::1], nt.float64[:, ::1], nt.float64[:, :, ::1]
@@ -417,15 +288,19 @@ def make_branch_bound(leg):
 
 @cache
 def make_certify(leg):
-    """``cert(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, out (2,))``: certification
-    of one point over the continuous box (module notes; ``PR`` the column profile or rows
-    with ``K < 0``); out = (status, cells)."""
+    """``cert(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, out (2,) or (5,))``:
+    certification of one point over the continuous box (module notes; ``PR`` the column
+    profile or rows with ``K < 0``); out = (status, cells) and, given room, the Euler angles
+    of the orientation that refuted the point (status 0)."""
     core = _core(leg)
     certify = core["certify"]
 
     def cert(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, out):
-        s, c = certify(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, np.empty(3))
+        bad = np.full(3, np.nan)
+        s, c = certify(U, Bp, P, PR, e0, theta, x, y, z, min_half, budget, bad)
         out[0], out[1] = s, c
+        if out.shape[0] >= 5:
+            out[2], out[3], out[4] = bad[0], bad[1], bad[2]
 
     f8 = nt.float64
     return cached_kernel(cert, nt.void(_F2, _F2, _F2, _F3, _F1, f8, f8, f8, f8, f8, nt.int64,
