@@ -13,9 +13,10 @@ import numpy as np
 from numba import njit
 
 from pkmlab.mechanisms.families import rss6
-from pkmlab.mechanisms.families.rss6 import (_AT0, _AT1, _AT2, _AT3, _AT4, _AT5, _AT6, _AT7,
-                                             _AT8, _AT9, _AT10, _ATANHI0, _ATANHI1, _ATANLO0,
-                                             _ATANLO1, _PI_HI, _PI_LO, _PIO2_HI, _PIO2_LO)
+
+_AT0, _AT1, _AT2, _AT3, _AT4, _AT5, _AT6, _AT7, _AT8, _AT9, _AT10 = rss6._AT
+_ATANHI0, _ATANHI1, _ATANLO0, _ATANLO1 = rss6._ATANHI0, rss6._ATANHI1, rss6._ATANLO0, rss6._ATANLO1
+_PIO2_HI, _PIO2_LO, _PI_HI, _PI_LO = rss6._PIO2_HI, rss6._PIO2_LO, rss6._PI_HI, rss6._PI_LO
 
 
 @njit(cache=True, error_model="numpy")
