@@ -139,3 +139,20 @@ def test_kind_kernels_match_the_dedicated_families(family):
         np.testing.assert_allclose(b.q, a.q, rtol=0, atol=1e-9)
     else:                   # the same per-leg kernel: bit for bit
         np.testing.assert_array_equal(b.q, a.q)
+
+
+@pytest.mark.parametrize("case", ["rss6", "rss6-dedicated"])
+def test_crank_legs_beyond_reach_and_invalid_poses(case):
+    """Poses far beyond every leg's reach (up to 1e308 mm, where E, F, G overflow) are
+    NO_SOLUTION with NaN on every leg, non-finite ones INVALID_INPUT, and the nominal pose
+    solves: the one-division atan2 (``rss6._atan2``) changes none of this."""
+    m = _cases()["rss6"] if case == "rss6" else _dedicated("rss6")
+    far = np.array([[1e4, 0, 0], [0, 0, -1e6], [1e150, 0, 0], [0, 1e300, 0],
+                    [1e308, -1e308, 1e308]])
+    X = np.concatenate([far, np.zeros((len(far), 3))], axis=1) + [0, 0, 0, *m.nominal_pose[3:]]
+    bad = m.nominal_pose + np.array([[np.inf, 0, 0, 0, 0, 0], [0, 0, 0, 0, np.nan, 0]])
+    res = m.inverse(np.concatenate([X, bad, m.nominal_pose[None]]))
+    assert np.all(res.leg_status[:len(far)] == K.NO_SOLUTION)
+    assert np.all(np.isnan(res.q[:len(far)]))
+    assert np.all(res.reason[len(far):-1] == K.INVALID_INPUT)
+    assert res.reason[-1] == K.OK and np.all(np.isfinite(res.q[-1]))

@@ -67,7 +67,10 @@ __all__ = ["RSS6"]
 
 # atan2 that LLVM can vectorise: fdlibm's atan (s_atan.c, Sun Microsystems 1993; argument
 # reduction at 7/16 and 11/16 and an 11-term polynomial, < 1 ulp) on min/max of |x|, |y|, then
-# the octant fix-up, all by selects. The quotient adds 1 ulp: within ~3e-16 rad of math.atan2.
+# the octant fix-up, all by selects. The reduced argument is formed from |x| and |y| with ONE
+# division (fdlibm divides twice: t = min/max, then (2t - 1)/(2 + t) or (t - 1)/(t + 1)). Within
+# 4.5e-16 rad of math.atan2 (tests/mechanisms/test_crank_atan2.py), and one division (the
+# crank legs' costliest operation after the polynomial) fewer per leg (issue 28).
 _ATANHI0, _ATANHI1 = 4.63647609000806093515e-01, 7.85398163397448278999e-01
 _ATANLO0, _ATANLO1 = 2.26987774529616870924e-17, 3.06161699786838301793e-17
 _AT = (3.33333333333329318027e-01, -1.99999999998764832476e-01, 1.42857142725034663711e-01,
@@ -85,14 +88,19 @@ def _atan2(y, x):
     ax, ay = abs(x), abs(y)
     mx = ax if ax > ay else ay
     mn = ay if ax > ay else ax
-    t = mn / mx if mx > 0.0 else 0.0                 # in [0, 1]
-    c0 = t < 0.4375
-    c1 = t < 0.6875
-    num = t if c0 else (2.0 * t - 1.0 if c1 else t - 1.0)
-    den = 1.0 if c0 else (2.0 + t if c1 else t + 1.0)
+    # t = mn/mx < 7/16, < 11/16 compared without the quotient: 16·mn against 7·mx and 11·mx,
+    # exact in the subnormal range, scaled by 1/32 (exact) above 1 so that nothing overflows;
+    # mx = 0 and NaN take the first range (t = 0), as fdlibm's t = mn/mx if mx > 0 else 0
+    sc = 0.03125 if mx > 1.0 else 1.0
+    sn, sx = sc * mn, sc * mx
+    c0 = not ((16.0 * sn >= 7.0 * sx) & (mx > 0.0))
+    c1 = 16.0 * sn < 11.0 * sx
+    # the reduced argument t, (2t - 1)/(2 + t) or (t - 1)/(t + 1) as ONE quotient of mn and mx
+    num = mn if c0 else (2.0 * sn - sx if c1 else sn - sx)
+    den = mx if c0 else (2.0 * sx + sn if c1 else sn + sx)
     hi = 0.0 if c0 else (_ATANHI0 if c1 else _ATANHI1)
     lo = 0.0 if c0 else (_ATANLO0 if c1 else _ATANLO1)
-    xr = num / den
+    xr = num / den if mx > 0.0 else 0.0
     z = xr * xr
     w = z * z
     s1 = z * (_AT0 + w * (_AT2 + w * (_AT4 + w * (_AT6 + w * (_AT8 + w * _AT10)))))
