@@ -26,7 +26,7 @@ $(STAMP): pyproject.toml uv.lock | $(UV)
 	@$(MAKE) --no-print-directory kernels
 	touch $(STAMP)
 
-# numba's disk cache of the demo study's kernels, filled once after installing (about 35 s of
+# numba's disk cache of the demo study's kernels, filled once after installing (about 90 s of
 # CPU), so that the first `make demo` loads them instead of compiling them in every worker;
 # kernels are keyed by their source, so after an edit only what changed compiles again
 kernels:

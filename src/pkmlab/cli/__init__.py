@@ -198,7 +198,7 @@ def run_cli() -> None:
 
 #: the kind of compile each command makes (:data:`pkmlab.runtime.compilenotice.ESTIMATES`)
 _KINDS = {"ik": "kinematics", "fk": "kinematics", "inspect": "kinematics",
-          "validate": "study", "run": "study", "report": "study"}
+          "validate": "kinematics", "run": "study", "report": "study"}
 
 
 def _compile_notice(argv: list[str]):

@@ -142,9 +142,10 @@ def _estimate_lines():
     as a ``pkmlab:`` line on stderr; the candidates' own log lines stay quiet."""
     import logging
 
-    # and what the run compiles (pkmlab.study.run, pkmlab.runtime.jit: the first run only)
+    # and what the run compiles, one line per group of kernels (pkmlab.study.run before the
+    # workers start, pkmlab.study.runners in a worker: the first run only)
     loggers = [logging.getLogger(n) for n in ("pkmlab.study.optimisers", "pkmlab.study.run",
-                                              "pkmlab.runtime.jit")]
+                                              "pkmlab.study.runners", "pkmlab.runtime.jit")]
     handler = logging.StreamHandler(sys.stderr)
     handler.setFormatter(logging.Formatter("pkmlab: %(message)s"))
     old = [lg.level for lg in loggers]

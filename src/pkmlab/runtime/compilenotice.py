@@ -7,10 +7,10 @@ miss (a cache load fires none), and on the first one says::
 
     compiling rss6 kernels, one-off (cached for later runs), about 1-5 min on 2 cores ...
 
-then every ``EVERY_S`` seconds while compiles continue ``still compiling (… s so far)``, and
-at the end ``compiled N numba function(s) in S s``. The estimate is :data:`ESTIMATES`, the
-cold-cache times measured for each kind of command (docs/validation.md, issue 26), as a
-range; on a loaded machine it takes longer, and the notice says so.
+then every ``EVERY_S`` seconds while compiles continue ``still compiling (… s so far; now
+<kernel>)``, and at the end ``compiled N numba function(s) in S s``. The estimate is
+:data:`ESTIMATES`, the cold-cache times measured for each kind of command (docs/validation.md,
+issue 26), as a range; on a loaded machine it takes longer, and the notice says so.
 """
 
 from __future__ import annotations
@@ -20,6 +20,8 @@ import threading
 import time
 
 from numba.core import event as _event
+
+from .jit import _short
 
 __all__ = ["ESTIMATES", "EVERY_S", "compile_notice", "estimate_text"]
 
@@ -48,6 +50,7 @@ class _Listener(_event.Listener):
         self.say, self.what, self.kind, self.every = say, what, kind, every
         self.depth = 0
         self.count = 0
+        self.now = "?"
         self.t0: float | None = None
         self.busy = 0.0
         self._started = 0.0
@@ -58,7 +61,7 @@ class _Listener(_event.Listener):
         with self._lock:
             if self.depth:
                 self.say(f"still compiling {self.what}kernels ({self.count} function(s), "
-                         f"{time.perf_counter() - self.t0:.0f} s so far)")
+                         f"{time.perf_counter() - self.t0:.0f} s so far; now {self.now})")
             self._arm()
 
     def _arm(self):
@@ -70,6 +73,8 @@ class _Listener(_event.Listener):
         with self._lock:
             if self.depth == 0:
                 self._started = time.perf_counter()
+                fn = getattr(event.data.get("dispatcher"), "py_func", None)
+                self.now = _short(getattr(fn, "__name__", "?"))
                 if self.t0 is None:
                     self.t0 = self._started
                     self.say(f"compiling {self.what}kernels, one-off (cached for later runs), "

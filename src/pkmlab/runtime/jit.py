@@ -79,7 +79,8 @@ log = logging.getLogger(__name__)
 #: seconds after which a kernel compile is announced (the progress rule: no silent step > 2 s)
 COMPILE_NOTICE_S = 1.5
 
-__all__ = ["cached_kernel", "identity", "jitable", "CACHE_SAFE", "CompileLog", "compile_log"]
+__all__ = ["cached_kernel", "identity", "jitable", "CACHE_SAFE", "CompileLog", "compile_log",
+           "compile_lines", "kernel_group"]
 
 #: True when kernels can be cached safely (numba's uid counter is where it is expected).
 CACHE_SAFE = isinstance(getattr(FunctionIdentity, "_unique_ids", None), itertools.count)
@@ -210,9 +211,10 @@ def cached_kernel(fn, sig, *, roots=(), extra=(), **options):
     ident = identity(fn, *roots, extra=(fn.__name__, str(sig), sorted(options.items()),
                                         tuple(extra)))
     kernel = _renamed(fn, f"{fn.__name__}_{ident[:16]}")
-    # a compile takes seconds (a cache load, on a loaded machine, may too): say so after
-    # COMPILE_NOTICE_S, once per kernel, and afterwards which of the two it was
-    notice = threading.Timer(COMPILE_NOTICE_S, log.info, ("loading or compiling the numba "
+    # a compile takes seconds (a cache load, on a loaded machine, may too): said at DEBUG
+    # after COMPILE_NOTICE_S, once per kernel, and afterwards which of the two it was; the
+    # command line says what compiles in one line per group (compile_lines, compilenotice)
+    notice = threading.Timer(COMPILE_NOTICE_S, log.debug, ("loading or compiling the numba "
                              "kernel %s (compiled on first use after an install or an edit; "
                              "cached for later runs)", fn.__name__))
     notice.daemon = True
@@ -231,23 +233,52 @@ def cached_kernel(fn, sig, *, roots=(), extra=(), **options):
     dt = time.perf_counter() - t0
     if rec.compiled:
         _COMPILING[0] += dt
-        log.log(logging.INFO if dt > COMPILE_NOTICE_S else logging.DEBUG,
-                "compiled %s in %.1f s", fn.__name__, dt)
+        log.debug("compiled %s in %.1f s", fn.__name__, dt)
     elif dt > COMPILE_NOTICE_S:
-        log.info("loaded %s from the cache in %.1f s", fn.__name__, dt)
+        log.debug("loaded %s from the cache in %.1f s", fn.__name__, dt)
     return compiled
+
+
+#: what a kernel's module computes, for the one line per group a first run prints
+#: (:func:`compile_lines`); modules not listed are named by their subpackage
+_GROUPS = (("pkmlab.mechanisms.kernels.ik", "kinematics"), ("pkmlab.mechanisms.families",
+           "kinematics"), ("pkmlab.mechanisms.kernels.search", "capability search"),
+           ("pkmlab.mechanisms.kernels", "workspace columns"), ("pkmlab.workspaces",
+           "workspace"), ("pkmlab.dexterity", "dexterity"), ("pkmlab.motion", "motion"))
+
+
+def kernel_group(module: str) -> str:
+    """The group a function of ``module`` is reported in: ``kinematics``, ``workspace
+    columns``, ``capability search``, ``dexterity`` ... (numba's own functions: ``numba``)."""
+    for prefix, group in _GROUPS:
+        if module == prefix or module.startswith(prefix + "."):
+            return group
+    parts = module.split(".")
+    return parts[1] if parts[0] == "pkmlab" and len(parts) > 1 else parts[0] or "?"
+
+
+def _short(name: str) -> str:
+    """A kernel's name without the identity suffix :func:`cached_kernel` gives it."""
+    head, _, tail = name.rpartition("_")
+    if head and len(tail) == 16 and all(c in "0123456789abcdef" for c in tail):
+        return head
+    return name
 
 
 class CompileLog(_event.Listener):
     """numba compiles (not cache loads) seen while :func:`compile_log` is active: numba fires
     its ``numba:compile`` event only after a cache miss. ``compiled`` holds ``(name, seconds)``
     of each outermost compile, in order (a function compiled while another compiles counts
-    inside it); ``name`` is the function's name without the identity suffix of
-    :func:`cached_kernel`."""
+    inside it), and ``entries`` the same with the function's group (:func:`kernel_group`);
+    ``name`` is the function's name without the identity suffix of :func:`cached_kernel`."""
 
     def __init__(self):
-        self.compiled: list[tuple[str, float]] = []
+        self.entries: list[tuple[str, float, str]] = []
         self._stack: list[float] = []
+
+    @property
+    def compiled(self) -> list[tuple[str, float]]:
+        return [(n, s) for n, s, _ in self.entries]
 
     def on_start(self, event):
         self._stack.append(time.perf_counter())
@@ -257,28 +288,44 @@ class CompileLog(_event.Listener):
         if self._stack:
             return
         fn = getattr(event.data.get("dispatcher"), "py_func", None)
-        name = getattr(fn, "__name__", "?")
-        head, _, tail = name.rpartition("_")
-        if head and len(tail) == 16 and all(c in "0123456789abcdef" for c in tail):
-            name = head
-        self.compiled.append((name, time.perf_counter() - t0))
+        self.entries.append((_short(getattr(fn, "__name__", "?")), time.perf_counter() - t0,
+                             kernel_group(getattr(fn, "__module__", None) or "?")))
 
     @property
     def seconds(self) -> float:
-        return sum(s for _, s in self.compiled)
+        return sum(s for _, s, _ in self.entries)
 
     def summary(self, top: int = 8) -> str:
         """One line: how many functions were compiled, in how long, the slowest by name."""
-        if not self.compiled:
+        if not self.entries:
             return "no numba kernel compiled (all loaded from the cache)"
         by: dict[str, float] = {}
-        for n, s in self.compiled:
+        for n, s, _ in self.entries:
             by[n] = by.get(n, 0.0) + s
         names = sorted(by, key=by.get, reverse=True)
         shown = ", ".join(f"{n} {by[n]:.1f} s" for n in names[:top])
         more = f", and {len(names) - top} more" if len(names) > top else ""
-        return (f"compiled {len(self.compiled)} numba function(s) in {self.seconds:.1f} s "
+        return (f"compiled {len(self.entries)} numba function(s) in {self.seconds:.1f} s "
                 f"({shown}{more})")
+
+
+def compile_lines(entries, where: str) -> list[str]:
+    """One line per group of the compiles ``entries`` (``(name, seconds, group)``, as in
+    :attr:`CompileLog.entries`), slowest group first, e.g. ``compiled the dexterity kernels
+    for the baseline in 128.0 s (cell_bounds_loop 78.6 s, fused_at_loop 27.7 s, ...)``;
+    ``where`` says for what (``for the baseline``, ``in a worker``)."""
+    groups: dict[str, dict[str, float]] = {}
+    for name, seconds, group in entries:
+        by = groups.setdefault(group, {})
+        by[name] = by.get(name, 0.0) + seconds
+    lines = []
+    for group, by in sorted(groups.items(), key=lambda kv: -sum(kv[1].values())):
+        names = sorted(by, key=by.get, reverse=True)
+        shown = ", ".join(f"{n} {by[n]:.1f} s" for n in names[:4])
+        more = f", and {len(names) - 4} more" if len(names) > 4 else ""
+        lines.append(f"compiled the {group} kernels {where} in {sum(by.values()):.1f} s "
+                     f"({shown}{more})")
+    return lines
 
 
 @contextlib.contextmanager

@@ -29,8 +29,7 @@ class ProgressLines:
         self.done = 0
         self.t0 = self.last = time.perf_counter()
         self.step = max(1, self.total // 10)
-        self._write(f"pkmlab: evaluating ~{self.total} {what} (the first evaluation also "
-                    "compiles the kinematics kernels)")
+        self._write(f"pkmlab: evaluating ~{self.total} {what}")
 
     def _write(self, line: str) -> None:
         self.stream.write(line + "\n")

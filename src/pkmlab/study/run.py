@@ -15,7 +15,7 @@ from pathlib import Path
 
 from .. import __version__
 from ..errors import CandidateError, ParameterError, Shown
-from ..runtime.jit import compile_log
+from ..runtime.jit import compile_lines, compile_log
 from ..runtime.memory import BudgetError
 from .definition import Study
 from .evaluators import check_budget, evaluate_design
@@ -110,19 +110,27 @@ def run_study(study: Study, runner, *, resume: bool = False, overwrite: bool = F
 WARM_RETIME_S = 1.0
 
 
-def compile_baseline(space, evaluation, seed: int) -> dict:
-    """Evaluate the baseline design in this process and log (INFO) what numba compiled.
+def compile_baseline(space, evaluation, seed: int, *, every: bool = False,
+                     where: str = "before the workers start") -> dict:
+    """Evaluate the baseline design in this process and log (INFO) what numba compiled, one
+    line per group of kernels.
 
     A study's workers are separate processes, and each would otherwise compile the same
     kernels at the same time (about 35 s of CPU each on the demo study): evaluated here first,
     the baseline leaves every kernel its evaluation uses in numba's disk cache, so the workers
-    load them. With a warm cache (``make`` fills it after installing) nothing compiles here.
+    load them. The kernels that other designs use and the baseline does not
+    (:func:`.warm.extra_kernels`) are built too when the baseline compiled anything (a cold
+    cache) or ``every``. With a warm cache (``make`` fills it after installing) nothing
+    compiles here.
     """
+    from .warm import extra_kernels
+
     with compile_log() as compiled:
         result = evaluate_design(space, None, evaluation, seed)
-    if compiled.compiled:
-        log.info("%s (first run after an install or an edit; cached for later runs)",
-                 compiled.summary())
+        if every or compiled.entries:
+            extra_kernels(type(space.decode(None)))
+    for line in compile_lines(compiled.entries, where):
+        log.info("%s", line)
     return result
 
 

@@ -85,12 +85,33 @@ def _tune_malloc() -> None:
 
 
 def _call(fn, task_id, args, parent=None, worker=False):
+    """``(task_id, fn(*args), compiles)``; in a worker, ``compiles`` lists the numba compiles
+    (``(name, seconds, group)``) the task made, which the parent reports (:func:`_result`):
+    the parent loads or compiles every kernel before the workers start, so a compile in a
+    worker means a kernel the warm-up missed."""
     if parent is not None:
         _watch_parent(parent)
-    if worker:
-        single_thread_worker()      # the workers fill the cores; one numba thread each
-        _tune_malloc()
-    return task_id, fn(*args)
+    if not worker:
+        return task_id, fn(*args), ()
+    single_thread_worker()          # the workers fill the cores; one numba thread each
+    _tune_malloc()
+    from ..runtime.jit import compile_log
+
+    with compile_log() as compiled:
+        result = fn(*args)
+    return task_id, result, tuple(compiled.entries)
+
+
+def _result(item) -> tuple:
+    """``(task_id, result)`` of :func:`_call`'s triple, logging (INFO, one line per group) what
+    the worker compiled."""
+    task_id, result, compiles = item
+    if compiles:
+        from ..runtime.jit import compile_lines
+
+        for line in compile_lines(compiles, "in a worker (not in the cache yet)"):
+            log.info("%s", line)
+    return task_id, result
 
 
 class SerialRunner:
@@ -123,7 +144,8 @@ class JoblibRunner:
         from joblib import delayed
 
         parent = os.getpid()
-        yield from self.pool(delayed(_call)(fn, tid, args, parent, True) for tid, args in tasks)
+        for item in self.pool(delayed(_call)(fn, tid, args, parent, True) for tid, args in tasks):
+            yield _result(item)
 
     def close(self) -> None:
         pass
@@ -164,7 +186,7 @@ class DaskRunner:
         futures = [self.client.submit(_call, fn, tid, args, None, True, pure=False)
                    for tid, args in tasks]
         for fut in as_completed(futures):
-            yield fut.result()
+            yield _result(fut.result())
 
     def close(self) -> None:
         if self._own:
