@@ -65,7 +65,7 @@ demo: bytecode
 # fixtures are built once; most of a cold run is numba compiling, which is single-threaded
 TEST_JOBS ?= 2
 test: lock-check bytecode $(BROWSER)
-	$(PY) -m pytest -n $(TEST_JOBS) --dist loadfile
+	$(PY) -m pytest -n $(TEST_JOBS) --dist loadfile --durations=25
 
 bench: bytecode
 	$(PY) benchmarks/bench_kinematics.py
