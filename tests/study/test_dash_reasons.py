@@ -66,7 +66,7 @@ def test_every_dash_has_a_reason_and_the_least_violating_are_listed(tmp_path):
             cells = [c.strip() for c in ln.strip("|").split("|")]
             for col, cell in zip(head[1:], cells[1:]):
                 if cell == "—":
-                    name = col.split(" (")[0]
+                    name = col.split(" (")[0]           # escaped, as in the notes
                     assert any(n.startswith(f"- {cells[0]}, {name}: ") for n in notes), \
                         (cells[0], name)
     # the least-violating designs' margins are in the requirement margins table
@@ -75,7 +75,7 @@ def test_every_dash_has_a_reason_and_the_least_violating_are_listed(tmp_path):
 
     least = least_violating(s, recs, s.top)
     assert least and all(f"| #{r['seq']} |" in margins for r in least)
-    assert "- #1, actuator_torque_speed_margin: S-2Nm: no torque–speed curve" in text
+    assert "- #1, actuator\\_torque\\_speed\\_margin: S-2Nm: no torque–speed curve" in text
     # the variable's name is a user string: escaped for Markdown (renders as free_ratio)
     assert "- baseline, free\\_ratio: a free parameter" in text
 

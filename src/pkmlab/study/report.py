@@ -203,7 +203,7 @@ def _summary(study: Study, records, front, baseline) -> str:
              "Constraints: " + (", ".join(c.describe() for c in study.constraints) or "none"),
              "", "| design | " + " | ".join(
                  [f"{md(v.name)} ({v.unit})" if v.unit else md(v.name) for v in study.variables]
-                 + [METRICS[m].label for m in metrics]) + " |",
+                 + [md(METRICS[m].label) for m in metrics]) + " |",
              "|---" * (1 + len(study.variables) + len(metrics)) + "|"]
     notes = []
 
@@ -267,7 +267,7 @@ def _requirement_margins(study: Study, baseline, front, shown, notes: list) -> l
              and not all(_other_kind(r, m) for _, r in rows)]
     if not names:
         return []
-    head = [f"{METRICS[m].label}" for m in names]
+    head = [markdown_text(METRICS[m].label) for m in names]
     out = ["", "Requirement margins (task: mm and deg of room left; actuators: % of the "
            "limit left, negative = exceeded; see `pkmlab metrics`):", "",
            "| design | " + " | ".join(head) + " |", "|---" * (1 + len(names)) + "|"]
@@ -277,7 +277,7 @@ def _requirement_margins(study: Study, baseline, front, shown, notes: list) -> l
         for m in names:
             if r["metrics"].get(m) is None and m not in shown:
                 why = r.get("notes", {}).get(m) or _no_value(r, m)
-                notes.append(f"- {label}, {m}: {why}")
+                notes.append(f"- {label}, {markdown_text(m)}: {markdown_text(why)}")
     return out
 
 
