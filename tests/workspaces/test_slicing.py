@@ -200,3 +200,23 @@ def test_auto_window_also_shows_the_task_overlay(small):
         small, "paper").window
     assert sections_layout(small, overlay, window=80.0).window == 80.0
     assert sections_layout(small, lambda z: []).window == plain.window      # nothing to cover
+
+
+def test_a_long_title_wraps_inside_the_figure_and_above_the_panels(small):
+    """The task overlay's note made the title's line wider than the figure: it was clipped at
+    both edges of a study's kappa_slices.png. Every title line now fits the figure, and the
+    title stays above the panels (the top margin grows with its lines)."""
+    note = ("the task region (required positions)\nnote: the task's orientations (±30, ±30, "
+            "±30° Euler box) reach beyond the workspace drawn (±15, ±15, ±15° Euler box): the "
+            "outline is not a containment check on these slices (task_contained is)")
+    for long in (False, True):
+        fig = slice_figure(small, overlay=lambda z: [], overlay_label=note if long else "x")
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+        FigureCanvasAgg(fig).draw()
+        r = fig.canvas.get_renderer()
+        box = fig._suptitle.get_window_extent(r)
+        assert box.x0 >= 0 and box.x1 <= fig.bbox.width, (box, fig.bbox)
+        top = max(ax.get_tightbbox(r).y1 for ax in fig.axes if ax.get_visible())
+        assert box.y0 >= top - 1, (box.y0, top)
+        assert box.y1 <= fig.bbox.height

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import io
 import math
+import textwrap
 from pathlib import Path
 from typing import NamedTuple
 
@@ -100,7 +101,12 @@ class _Sections:
         lay = sections_layout(result, overlay, layout, window, spacing, centre, max_panels)
         self.result, self.levels = result, lay.levels
         h = result.resolution
-        self.fig, self.axes = _panel_grid(lay, columns, 2.2, 0.8)
+        name = getattr(result.mechanism, "name", "") or result.mechanism.family
+        empty = " (empty)" if result.empty else ""
+        drawn = f"; red: {overlay_label}" if overlay is not None and overlay_label else ""
+        self.fig, self.axes = _panel_grid(
+            lay, columns, 2.2, 0.8,
+            title=f"{name}: {result.kind} workspace{empty}\n{lay.describe()}{drawn}")
         self.extent = (result.xs[0] - h / 2, result.xs[-1] + h / 2, result.ys[0] - h / 2,
                        result.ys[-1] + h / 2) if len(result.xs) else (0, 1, 0, 1)
         for z, ax in zip(self.levels, self.axes.ravel()):
@@ -109,15 +115,10 @@ class _Sections:
                     ax.plot(poly[:, 0], poly[:, 1], "r.", ms=3, zorder=3)
                 else:
                     ax.plot(poly[:, 0], poly[:, 1], "r-", lw=1, zorder=3)
-        name = getattr(result.mechanism, "name", "") or result.mechanism.family
         if result.empty:
             first = self.axes.ravel()[0]
             first.text(0.5, 0.5, "empty: no position satisfies\nthe constraints",
                        ha="center", va="center", transform=first.transAxes, fontsize=8)
-        empty = " (empty)" if result.empty else ""
-        drawn = f"; red: {overlay_label}" if overlay is not None and overlay_label else ""
-        self.fig.suptitle(f"{name}: {result.kind} workspace{empty}\n{lay.describe()}{drawn}",
-                          fontsize=9)
         self._painted: list = []                 # the images of the current colouring
         self._bar = None
         # where the panels are before a colour bar shrinks and re-anchors them
@@ -165,10 +166,11 @@ class _Sections:
 
 
 def _panel_grid(lay: SliceLayout, columns: int | None, size: float, top: float,
-                bottom: float = 0.0):
+                bottom: float = 0.0, title: str = "", fontsize: float = 9):
     """A figure of square panels of ``size`` inches, one per section of ``lay`` (``columns``
     per row, default about the square root of their number), with fixed margins: ``top``
-    inches of height for the title and ``bottom`` for a legend. Every used panel has its title
+    inches of height for the title (more when ``title``, wrapped to the figure's width, needs
+    it) and ``bottom`` for a legend. Every used panel has its title
     (the height) and the layout's window, ticks on the outer panels only
     (:func:`_outer_ticks`); the panels left over are hidden. Fixed margins and outer ticks
     only draw several times faster than a constrained layout with every panel's own ticks:
@@ -180,8 +182,16 @@ def _panel_grid(lay: SliceLayout, columns: int | None, size: float, top: float,
     n = max(len(lay.levels), 1)
     cols = columns or int(math.ceil(math.sqrt(n)))
     rows = int(math.ceil(n / cols))
-    W, H = size * cols, size * rows + top + bottom
+    W = size * cols
+    # a line of the title wraps at the figure's width (about 0.55 em per character)
+    chars = max(int(W * 72 / (0.55 * fontsize)), 20)
+    title = "\n".join(textwrap.fill(line, chars) or line for line in title.split("\n"))
+    # the lines, their gap to the figure's edge and the panels' own titles below them
+    top = max(top, 0.45 + (title.count("\n") + 1) * 1.3 * fontsize / 72) if title else top
+    H = size * rows + top + bottom
     fig = Figure(figsize=(W, H))
+    if title:
+        fig.suptitle(title, fontsize=fontsize)
     axes = fig.subplots(rows, cols, squeeze=False)
     fig.subplots_adjust(left=0.45 / W, right=1 - 0.15 / W, bottom=(0.3 + bottom) / H,
                         top=1 - top / H, wspace=0.12, hspace=0.25)
@@ -259,7 +269,8 @@ def overlay_figure(results: list, labels: list[str], layout: str = "auto",
     lay = slice_layout(list(results), layout, window, spacing, None, max_panels)
     colours = ["#0072B2", "#E69F00", "#009E73", "#CC79A7", "#D55E00", "#56B4E9", "#F0E442",
                "#000000"]
-    fig, axes = _panel_grid(lay, None, 2.4, 0.95, 0.4)
+    fig, axes = _panel_grid(lay, None, 2.4, 0.95, 0.4,
+                            title=(title + "\n" if title else "") + lay.describe())
     for z, ax in zip(lay.levels, axes.ravel()):
         for k, w in enumerate(results):
             if w.empty or len(w.xs) < 2 or len(w.ys) < 2:
@@ -272,5 +283,4 @@ def overlay_figure(results: list, labels: list[str], layout: str = "auto",
                for k, lab in enumerate(labels)]
     fig.legend(handles=handles, loc="lower center", ncol=min(len(labels), 4), fontsize=8,
                frameon=False)
-    fig.suptitle((title + "\n" if title else "") + lay.describe(), fontsize=9)
     return fig
