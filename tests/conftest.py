@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -10,7 +11,7 @@ import pytest
 from scipy.optimize import minimize
 
 import pkmlab
-from pkmlab.mechanisms import NO_STROKE, REGISTRY, Luzi3
+from pkmlab.mechanisms import NO_STROKE, REGISTRY, Luzi3, register_family
 from pkmlab.poses import euler_to_matrix
 from pkmlab.testing import random_valid_poses  # noqa: F401 (used by the test modules)
 
@@ -109,3 +110,18 @@ def same_result(a, b) -> bool:
     if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
         return True
     return a == b
+
+
+@contextmanager
+def family_registered(cls):
+    """``cls`` registered for the block, and the registry as it was afterwards (another test
+    module of the same process may have registered it too: it stays registered then)."""
+    before = REGISTRY.get(cls.family)
+    register_family(cls)
+    try:
+        yield cls
+    finally:
+        if before is None:
+            REGISTRY.pop(cls.family, None)
+        else:
+            REGISTRY[cls.family] = before

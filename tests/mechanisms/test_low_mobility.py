@@ -14,11 +14,11 @@ import yaml
 import pkmlab
 from pkmlab import dexterity as dx
 from pkmlab.errors import ParameterError
-from pkmlab.mechanisms import REGISTRY, register_family
 from pkmlab.workspaces import OrientationSet
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "data" / "plugin3"))
 import pkmlab_tri3_family as tri3  # noqa: E402
+from conftest import family_registered  # noqa: E402
 
 H = 20.0                       # mm: a coarse grid keeps the file fast (about 1 s per workspace)
 B, U = tri3.circle(300.0), tri3.circle(60.0)
@@ -27,9 +27,8 @@ STROKE = (250.0, 600.0)
 
 @pytest.fixture(scope="module")
 def tripod():
-    register_family(tri3.Tri3)
-    yield tri3.reporters_tripod()
-    REGISTRY.pop("tri3", None)
+    with family_registered(tri3.Tri3):
+        yield tri3.reporters_tripod()
 
 
 @pytest.fixture(scope="module")

@@ -19,13 +19,13 @@ from pkmlab.testing import run_contract
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "data" / "plugin3"))
 import pkmlab_tri3_family as tri3  # noqa: E402
+from conftest import family_registered  # noqa: E402
 
 
 @pytest.fixture(scope="module")
 def tripod():
-    register_family(tri3.Tri3)
-    yield tri3.reporters_tripod()
-    REGISTRY.pop("tri3", None)
+    with family_registered(tri3.Tri3):
+        yield tri3.reporters_tripod()
 
 
 def test_the_three_leg_family_passes_the_contract_suite(tripod):

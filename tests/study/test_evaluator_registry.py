@@ -17,14 +17,13 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import MECH_DIR
+from conftest import MECH_DIR, family_registered
 from pydantic import BaseModel, ConfigDict, Field
 from typer.testing import CliRunner
 
 from pkmlab import load_mechanism
 from pkmlab.cli import app
 from pkmlab.errors import ParameterError
-from pkmlab.mechanisms import REGISTRY, register_family
 from pkmlab.study import load_study, study_schema
 from pkmlab.study.evaluators import (
     EVALUATORS,
@@ -90,9 +89,8 @@ def test_schema_types_every_evaluate_block_from_its_model():
 
 @pytest.fixture
 def tri3_family():
-    register_family(tri3.Tri3)
-    yield
-    REGISTRY.pop("tri3", None)
+    with family_registered(tri3.Tri3):
+        yield
 
 
 def tri3_study(tmp_path, evaluate: dict, objective: str = "base_outer_radius") -> dict:
