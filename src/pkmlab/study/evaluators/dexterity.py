@@ -81,9 +81,11 @@ class Dexterity(Evaluator):
                "(singular poses count 0); standard error in gci_std_error"),
         metric("gci_std_error", "", "sampled", "standard error of gci"),
         metric("sampled_max_kappa", "", "sampled",
-               "largest κ among the GCI's random poses (a sample statistic, ≤ worst_kappa)"),
+               "largest κ among the GCI's random poses (a sample statistic; the poses are "
+               "continuous, so it may exceed worst_kappa, the extreme over the grid samples)"),
         metric("sampled_min_force", "N", "sampled",
-               "smallest all-direction force among the GCI's random poses (≥ min_force)"),
+               "smallest all-direction force among the GCI's random poses (continuous "
+               "poses: it may fall below min_force, the extreme over the grid samples)"),
     )
 
     def written(self, plan):
