@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ... import dexterity as dx
+from ...dexterity.aggregate import _units, _voxels
 
 __all__ = ["WorstBound", "worst_bound", "ALLOWANCE"]
 
@@ -51,18 +52,6 @@ class WorstBound:
         return (f"certified bound from {self.poses} of the worst case's (unit, orientation) "
                 "samples (extreme units × the orientation set's corner, edge and face "
                 "samples); the exact worst case is computed when the candidate is re-certified")
-
-
-def _units(result, column_invariant: bool) -> np.ndarray:
-    """Unit positions ``(U, 3)`` as the worst case forms them (voxel centres, or each (x, y)
-    column's first voxel in lexicographic order)."""
-    idx = np.argwhere(result.occupancy)
-    pos = np.stack([result.xs[idx[:, 0]], result.ys[idx[:, 1]], result.zs[idx[:, 2]]], axis=1)
-    if column_invariant and len(idx):
-        new = np.ones(len(idx), dtype=bool)
-        np.any(idx[1:, :2] != idx[:-1, :2], axis=1, out=new[1:])
-        pos = pos[new]
-    return pos
 
 
 def _extreme_units(pos: np.ndarray) -> np.ndarray:
@@ -88,7 +77,8 @@ def worst_bound(mech, result, length, effort) -> WorstBound:
     """Certified bounds of :func:`pkmlab.dexterity.worst_case` ``(mech, result, length,
     effort)`` (module notes; ``mech`` is ``result.mechanism``, as the worst case's);
     ``effort``: its force limit (None: no force bound)."""
-    pos = _units(result, bool(mech.column_invariant))
+    idx, centres = _voxels(result)
+    pos = _units(mech, idx, centres)[0]           # the worst case's own units
     Rs = result.orientations.rotations()
     if not len(pos) or not len(Rs):
         return WorstBound(-math.inf, math.inf, False, 0)

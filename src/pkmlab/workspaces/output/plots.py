@@ -185,7 +185,7 @@ def _panel_grid(lay: SliceLayout, columns: int | None, size: float, top: float,
     W = size * cols
     # a line of the title wraps at the figure's width (about 0.55 em per character)
     chars = max(int(W * 72 / (0.55 * fontsize)), 20)
-    title = "\n".join(textwrap.fill(line, chars) or line for line in title.split("\n"))
+    title = "\n".join(textwrap.fill(line, chars) for line in title.split("\n"))
     # the lines, their gap to the figure's edge and the panels' own titles below them
     top = max(top, 0.45 + (title.count("\n") + 1) * 1.3 * fontsize / 72) if title else top
     H = size * rows + top + bottom
