@@ -22,6 +22,7 @@ from .definition import Study
 from .export import export_designs
 from .flags import design_flags
 from .flags import label as design_label
+from .ladder import coarse_view
 from .metrics import METRICS
 from .run import BASELINE, feasible, objective_matrix, provenance
 from .selection import non_dominated
@@ -144,7 +145,13 @@ def _plot(path: Path, study: Study, records, front) -> None:
     my = objs[1].metric if len(objs) > 1 else None
     x = vals(cand, mx)
     y = vals(cand, my) if my else np.arange(len(cand))
-    ax.scatter(x[~ok], y[~ok], s=8, c="0.75", label="infeasible")
+    pruned = np.array([r["status"] == "pruned" for r in cand], dtype=bool)
+    ax.scatter(x[~ok & ~pruned], y[~ok & ~pruned], s=8, c="0.75", label="infeasible")
+    if pruned.any():            # the tolerance ladder's: drawn at the coarse values it pruned
+        coarse = [coarse_view(r) for r, p in zip(cand, pruned, strict=True) if p]
+        ax.scatter(vals(coarse, mx), vals(coarse, my) if my else np.flatnonzero(pruned),
+                   s=14, marker="x", c="0.45", linewidths=0.8,
+                   label="pruned by the tolerance ladder (coarse values)")
     ax.scatter(x[ok], y[ok], s=10, c="tab:blue", label="feasible")
     if front:
         fx, fy = vals(front, mx), vals(front, my) if my else np.arange(len(front))

@@ -10,7 +10,12 @@ holds (:func:`pkmlab.study.run.feasible`). :func:`violations` lists what stops i
   ``value − max``, > 0);
 * a constraint or objective metric undefined: ``amount`` ``None``, ``reason`` the
   evaluator's note (or "not computed");
-* a failed evaluation: ``what`` = its status, ``reason`` the first line of its reason.
+* a failed evaluation: ``what`` = its status, ``reason`` the first line of its reason;
+* a candidate the tolerance ladder pruned (status ``pruned``, :mod:`.ladder`): each
+  constraint its certified coarse bounds violate whatever the fine value, with the certified
+  least amount (``reason`` says it is certified by the coarse rung), else ``what`` =
+  :data:`DOMINATED` and the reason naming the candidate that certainly dominates it (its
+  feasibility at the fine tolerance is not known, and not needed: it is not on the front).
 
 The least-violating ranking (:func:`least_violating`) orders evaluated candidates by the number
 of violations, then by the sum of the crossed amounts each divided by the largest amount of
@@ -22,9 +27,13 @@ from __future__ import annotations
 
 import math
 
+from . import ladder
 from .definition import Study
 
-__all__ = ["violations", "violated_text", "tally", "least_violating"]
+__all__ = ["violations", "violated_text", "tally", "least_violating", "DOMINATED"]
+
+#: the tally's line for candidates the tolerance ladder pruned as certainly dominated
+DOMINATED = "certainly dominated (tolerance ladder, not re-certified)"
 
 
 def _value(record: dict, metric: str):
@@ -38,6 +47,8 @@ def _why(record: dict, metric: str) -> str:
 
 def violations(study: Study, record: dict) -> list[tuple[str, float | None, str]]:
     """What keeps ``record`` from being feasible (module docstring); empty when feasible."""
+    if record["status"] == "pruned":
+        return _pruned(study, record)
     if record["status"] != "ok":
         why = (record.get("reason") or "").splitlines()
         return [(record["status"], None, why[0] if why else "")]
@@ -61,11 +72,38 @@ def violations(study: Study, record: dict) -> list[tuple[str, float | None, str]
     return out
 
 
+def _pruned(study: Study, record: dict) -> list[tuple[str, float | None, str]]:
+    """A pruned candidate's certain violations from its coarse bounds (:func:`.ladder.bounds`
+    on the values the coarse pass stored), else the dominance that pruned it."""
+    coarse = ladder.coarse_view(record)
+    out: list[tuple[str, float | None, str]] = []
+    for c in study.constraints:
+        lo, hi = ladder.bounds(coarse, c.metric)
+        for bound, sign in (("min", "≥"), ("max", "≤")):
+            b = getattr(c, bound)
+            if b is None:
+                continue
+            what = f"{c.metric} {sign} {b:g}"
+            if math.isnan(lo):
+                out.append((what, None, "undefined at the coarse tolerance"))
+                continue
+            amount = (b - hi) if bound == "min" else (lo - b)
+            if amount > 0:
+                out.append((what, amount, "certified coarse bound"))
+    if out:
+        return out
+    why = (record.get("reason") or "").splitlines()
+    text = why[0] if why else ""
+    return [(DOMINATED, None, text.split("certainly dominated ", 1)[-1])]
+
+
 def violated_text(study: Study, record: dict) -> str:
     """One cell: ``"task_contained ≥ 1 by 1; actuators_fit ≥ 1 by 1"``, ``""`` if feasible."""
     parts = []
     for what, amount, why in violations(study, record):
-        if amount is not None:
+        if amount is not None and why:          # a certified least amount (pruned)
+            parts.append(f"{what} by at least {amount:.4g} ({why})")
+        elif amount is not None:
             parts.append(f"{what} by {amount:.4g}")
         else:
             parts.append(f"{what}: {why}" if why else what)
