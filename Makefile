@@ -27,8 +27,9 @@ $(STAMP): pyproject.toml uv.lock | $(UV)
 	touch $(STAMP)
 
 # numba's disk cache of the demo study's kernels, filled once after installing (about 90 s of
-# CPU), so that the first `make demo` loads them instead of compiling them in every worker;
-# kernels are keyed by their source, so after an edit only what changed compiles again
+# CPU, compiled in two processes), so that the first `make demo` loads them instead of
+# compiling them in every worker; kernels are keyed by their source, so after an edit only
+# what changed compiles again
 kernels:
 	@$(PY) -m pkmlab.study.warm || echo "note: the kernel cache was not warmed; the first run compiles"
 

@@ -1,0 +1,43 @@
+"""The dexterity kernels' warmers (:mod:`pkmlab.runtime.warmers`): the worst case's cell
+bounds and cell pass (:mod:`._cells`), the fused per-pose pass at listed poses
+(:mod:`._fused`), the pose sweep and the parallel singular values (:mod:`._linalg`, a large
+design's κ export). Each calls the factory the evaluation calls, with the same arguments.
+Weights: CPU seconds of a cold compile for the 6-PSU family (2 cores; the two cell kernels
+measured, the others scaled from wall time at load 5; relative only).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..runtime.warmers import register_warmer
+from . import _cells, _fused, _linalg
+
+__all__: list[str] = []
+
+
+def _spatial(mech) -> bool:
+    return mech.mobility.is_spatial
+
+
+def _bounds(mech) -> None:
+    jac, g = mech.jacobian_kernel()
+    _cells._bounds_kernel(jac, type(mech)._jac_box, len(g))
+
+
+def _cell_pass(mech) -> None:
+    jac, g = mech.jacobian_kernel()
+    _cells._eval_kernel(jac, len(g))
+
+
+def _fused_at(mech) -> None:
+    jac, g = mech.jacobian_kernel()
+    _fused._kernel_at(jac, len(g))
+
+
+register_warmer("worst case: cell bounds", 32.4, _cells.cells_available, _bounds)
+register_warmer("worst case: cell pass", 21.2, _cells.cells_available, _cell_pass)
+register_warmer("worst case: fused pass at poses", 14.5, _fused.fused_available, _fused_at)
+register_warmer("pose sweep", 8.0, _spatial, lambda mech: _linalg._sweep())
+register_warmer("parallel singular values", 1.4, lambda mech: True,
+                lambda mech: _linalg.singular_values(np.zeros((_linalg._PARALLEL_FROM, 6, 6))))
