@@ -92,3 +92,30 @@ def test_the_pareto_plot_draws_pruned_candidates_at_their_coarse_values(tmp_path
     assert drawn[key] == ([24.0], [70.0])
     assert drawn["infeasible"] == ([], [])
     assert (tmp_path / "pareto.png").stat().st_size > 0
+
+
+def test_the_browser_report_groups_pruning_reasons_and_draws_pruned_candidates(tmp_path):
+    from pkmlab.webreport.data import candidate_rows, failure_counts
+    from pkmlab.webreport.study_page import _points
+
+    s = _study(tmp_path)
+    ok = {"status": "ok", "role": "candidate", "seq": 2, "notes": {}, "reason": "",
+          "params": {"link_length": 230.0},
+          "metrics": {"orientation_capability": 30.0, "needed_stroke": 50.0}}
+    pruned = [_pruned(seq, 24.0 + seq, 25.0 + seq, 70.0 + seq,
+                      f"certainly dominated by evaluation 2: best case (o {seq}) vs (30, 50)")
+              for seq in (5, 6, 7)]
+    pruned.append(_pruned(8, 17.0, 18.5, 60.0, "orientation_capability <= 18.5 < 20 "
+                          "(certified)"))
+    for r in pruned:
+        r["params"] = {"link_length": 240.0}
+    _, groups = failure_counts([ok, *pruned])
+    assert [(g["reason"], g["count"], g["example"]) for g in groups] == [
+        (REASON + "certainly dominated by a refined candidate", 3,
+         "evaluation 2: best case (o 5) vs (30, 50)"),
+        (REASON + "orientation_capability < 20 (certified bound)", 1, "upper bound 18.5")]
+    rows = candidate_rows(s, [ok, *pruned], [ok], {})
+    pts = {p["seq"]: p for p in _points(s, rows)}
+    assert pts[5]["group"] == "pruned"
+    assert pts[5]["values"] == {"orientation_capability": 29.0, "needed_stroke": 75.0}
+    assert pts[2]["group"] == "pareto"

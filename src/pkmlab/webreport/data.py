@@ -8,6 +8,7 @@ files :func:`pkmlab.study.export.export_designs` wrote.
 from __future__ import annotations
 
 import math
+import re
 from collections import Counter
 
 from ..errors import ParameterError
@@ -116,6 +117,8 @@ def candidate_rows(study: Study, records: list[dict], front: list[dict],
             row["group"] = "baseline"
         elif row["pareto_rank"]:
             row["group"] = "pareto"
+        elif r["status"] == "pruned":
+            row["group"] = "pruned"
         else:
             row["group"] = "feasible" if f else "infeasible"
         status = ("feasible" if f else ("infeasible" if r["status"] == "ok" else r["status"]))
@@ -202,9 +205,22 @@ def derived_rows(study: Study, params: dict, rounded: dict) -> list[dict]:
     return rows
 
 
+#: the tolerance ladder's pruning reasons (:mod:`pkmlab.study.ladder`): certainly dominated
+#: by a named candidate, or a constraint violated by a certified bound
+_DOMINATED = re.compile(r"^(.*certainly dominated by) (evaluation \d+: .*)$")
+_CERTIFIED = re.compile(r"^(.*?)(\w+) (>=|<=) (\S+) ([<>]) (\S+) \(certified\)$")
+
+
 def _reason_kind(reason: str) -> tuple[str, str]:
-    """``(kind, example)``: a reason without its values (``field: must be …``), and the
-    values it was given."""
+    """``(kind, example)``: a reason without its values (``field: must be …``; a ladder's
+    pruning without the dominating candidate or the bound), and the values it was given."""
+    m = _DOMINATED.match(reason)
+    if m:
+        return f"{m[1]} a refined candidate", m[2]
+    m = _CERTIFIED.match(reason)
+    if m:
+        return (f"{m[1]}{m[2]} {m[5]} {m[6]} (certified bound)",
+                f"{'lower' if m[3] == '>=' else 'upper'} bound {m[4]}")
     head, sep, got = reason.partition("; got ")
     return head, (sep.lstrip("; ") + got if sep else "")
 

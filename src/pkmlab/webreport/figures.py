@@ -23,6 +23,9 @@ PALETTE = ("#0072B2", "#E69F00", "#009E73", "#CC79A7", "#D55E00", "#56B4E9", "#F
 _STYLE = {  # group → (label, marker)
     "infeasible": ("infeasible", dict(color="#b8b8b8", size=5, symbol="x-thin",
                                       line=dict(width=1, color="#9a9a9a"))),
+    "pruned": ("pruned by the tolerance ladder (coarse values)",
+               dict(color="#777777", size=6, symbol="cross-thin",
+                    line=dict(width=1, color="#777777"))),
     "feasible": ("feasible", dict(color="#6baed6", size=6, line=dict(width=0))),
     "pareto": ("Pareto front", dict(color="#d62728", size=8, line=dict(width=0.5,
                                                                       color="#7f0000"))),
@@ -47,8 +50,9 @@ def pareto_matrix(axes: list[dict], points: list[dict]):
     Args:
         axes: one ``{"key", "label"}`` per objective (label with unit and sense).
         points: ``{"seq", "group", "values": {key: float | None}, "hover": str,
-            "text": str}``; ``group`` is one of infeasible, feasible, pareto, exported,
-            baseline (an exported design is drawn twice: as a Pareto point and ringed).
+            "text": str}``; ``group`` is one of infeasible, pruned (by a tolerance ladder,
+            drawn at its coarse values), feasible, pareto, exported, baseline (an exported
+            design is drawn twice: as a Pareto point and ringed).
     """
     import plotly.graph_objects as go
     from plotly.subplots import make_subplots
@@ -68,7 +72,8 @@ def pareto_matrix(axes: list[dict], points: list[dict]):
     for r in range(n):
         for c in range(r + 1):
             ax, ay = axes[c], axes[r + 1]
-            for group in ("infeasible", "feasible", "pareto", "exported", "baseline"):
+            for group in ("infeasible", "pruned", "feasible", "pareto", "exported",
+                          "baseline"):
                 pts = [p for p in points if p["group"] == group
                        and p["values"].get(ax["key"]) is not None
                        and p["values"].get(ay["key"]) is not None]

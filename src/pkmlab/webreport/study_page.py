@@ -16,6 +16,7 @@ from ..export import exporters
 from ..study.definition import Study
 from ..study.export import read_index
 from ..study.flags import design_flags
+from ..study.ladder import coarse_view
 from ..study.metrics import METRICS
 from ..study.violations import least_violating, tally, violated_text
 from . import data as D
@@ -72,9 +73,11 @@ def _runs(out: Path) -> list[dict]:
 def _points(study: Study, rows: list[dict]) -> list[dict]:
     pts = []
     for r in rows:
-        if r["status"] != "ok":
+        if r["status"] not in ("ok", "pruned"):
             continue
-        values = {o.metric: r["metrics"].get(o.metric) for o in study.objectives}
+        # a candidate the tolerance ladder pruned: at the coarse values it was pruned with
+        metrics = coarse_view(r)["metrics"] if r["status"] == "pruned" else r["metrics"]
+        values = {o.metric: metrics.get(o.metric) for o in study.objectives}
         pts.append({"seq": r["seq"], "group": r["group"], "values": values,
                     "hover": r["hover"]})
         if r["design"]:
