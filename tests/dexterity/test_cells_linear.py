@@ -7,7 +7,6 @@
 * the cell bounds are certified (exact κ <= K, force >= F, sign of ``det J``) at every
   feasible sample of 80 random certified cells and 20 random poses in each box, and the same
   check finds violations when ``K`` is lowered 15 % or ``F`` raised 10 %, or the sign flipped;
-* they are tighter than the interval bounds on the same cells;
 * ``worst_case`` with them (cells of 3 and 6 columns) equals the pass over every sample.
 """
 
@@ -58,7 +57,7 @@ def test_linear_form_encloses_the_jacobian():
         worst_ratio = max(worst_ratio, float(np.max(rem / W)))
         assert np.any(rem > 0.0 * W + 1e-12)              # W = 0 (first order only) fails
     # the remainder is not vacuous: the sampled remainder reaches a good part of W
-    assert worst_ratio > 0.2, worst_ratio
+    assert worst_ratio > 0.4, worst_ratio                   # measured 0.497
 
 
 def test_linear_remainder_is_second_order():
@@ -90,20 +89,6 @@ def test_linear_cell_bounds_are_certified(monkeypatch, tile):
     for K, F, S in ((plan.K * 0.85, plan.F, plan.S), (plan.K, plan.F * 1.1, plan.S),
                     (plan.K, plan.F, -plan.S)):
         assert _violations(*args, K, F, S, n_cells=80)[0] > 0
-
-
-def test_linear_bounds_are_tighter_than_the_intervals(monkeypatch):
-    """Same cells (3 columns), both kernels: the first-order K is lower and F higher on most
-    certified cells."""
-    res = workspace(PSU, "dexterous", OrientationSet.box(np.radians([15] * 3), samples=3), 5.0)
-    monkeypatch.setattr(_cells, "LINEAR_TILE", _cells.TILE)
-    lin = _plan(PSU, res)[0]
-    monkeypatch.setattr(_cells, "LINEAR", False)
-    box = _plan(PSU, res)[0]
-    both = lin.certified & box.certified
-    assert both.sum() > 0.9 * box.certified.sum()
-    assert np.mean(lin.K[both] < box.K[both]) > 0.9
-    assert np.mean(lin.F[both] > box.F[both]) > 0.9
 
 
 @pytest.mark.parametrize("tile", [3, 6])
