@@ -1,9 +1,11 @@
 """The exact worst case (issue 28 item 2), on sampled designs of the demo study, in one run:
 the pass of the previous stop (the fused kernel, every sample evaluated, ``worst.CELLS =
-False``) and the branch and bound over cells (:mod:`pkmlab.dexterity._cells`).
+False``) and the branch and bound over cells (:mod:`pkmlab.dexterity._cells`), with the
+interval cell bounds only (``_cells.LINEAR = False``, the previous session's cells) and with
+the first-order bounds (the default).
 
 For each valid design of a Sobol sample of the demo study's space: its ±15° dexterous
-workspace (the study's request), then ``pkmlab.dexterity.worst_case`` in the two modes,
+workspace (the study's request), then ``pkmlab.dexterity.worst_case`` in the three modes,
 alternately, ``--repeats`` times each. Reported: CPU time (``time.process_time``, one numba
 thread as in a study worker) per design, the median ratios, the load average, and whether the
 outputs are identical (the whole ``WorstCase.as_dict()`` but its wall time, compared with
@@ -26,7 +28,7 @@ import numpy as np
 from scipy.stats import qmc
 
 from pkmlab import dexterity as dx
-from pkmlab.dexterity import worst
+from pkmlab.dexterity import _cells, worst
 from pkmlab.errors import ParameterError
 from pkmlab.runtime.threads import single_thread_worker
 from pkmlab.study import load_study
@@ -59,11 +61,14 @@ def summary(wc, exact=True) -> dict:
     return d
 
 
-MODES = {"before": False, "cells": True}
+#: mode -> (worst.CELLS, _cells.LINEAR): every sample; cells with the interval bounds only
+#: (the previous stop's bound, on 3-column cells); cells with the first-order bounds where the
+#: family has them (the default)
+MODES = {"before": (False, False), "interval": (True, False), "cells": (True, True)}
 
 
 def _mode(name):
-    worst.CELLS = MODES[name]
+    worst.CELLS, _cells.LINEAR = MODES[name]
 
 
 def main() -> None:
@@ -90,7 +95,7 @@ def main() -> None:
         _mode(name)
         dx.worst_case(mech, res, L, 150.0)
     cpu = {name: [] for name in MODES}
-    identical = {"cells": 0, "cells, every field": 0}
+    identical = {"cells": 0, "cells, every field": 0, "interval": 0}
     sizes = []
     for mech, res, L in cases:
         t = {name: [] for name in MODES}
@@ -105,6 +110,8 @@ def main() -> None:
             cpu[name].append(min(t[name]))
         identical["cells"] += same(summary(out["before"], False), summary(out["cells"], False))
         identical["cells, every field"] += same(summary(out["before"]), summary(out["cells"]))
+        identical["interval"] += same(summary(out["before"], False),
+                                      summary(out["interval"], False))
         sizes.append(out["before"].poses)
     _mode("cells")
     a = np.array(cpu["before"])
@@ -112,7 +119,8 @@ def main() -> None:
           f"{np.median(sizes):,.0f} poses: units and column ends x orientations), best of "
           f"{repeats} per design, 1 numba thread; load average "
           f"{load0[0]:.2f} -> {os.getloadavg()[0]:.2f} (2 cores)")
-    for name, label in (("before", "every sample (before)"), ("cells", "cells (now)")):
+    for name, label in (("before", "every sample (before)"),
+                        ("interval", "cells, interval bounds"), ("cells", "cells (now)")):
         b = np.array(cpu[name])
         print(f"  {label:28s} {1e3 * np.median(b):6.1f} ms CPU per design (median), "
               f"{1e3 * b.sum():6.0f} ms in all; speed-up {np.median(a / b):.2f}x per design "

@@ -26,6 +26,24 @@ gets certified bounds over all its samples:
   ``min_c fmax_c / ‖(J(s)⁻¹)_{0:3, c}‖`` below by ``F``; and ``J_h₀ + t (J_h(s) - J_h₀)`` is
   non-singular for ``t ∈ [0, 1]``, so ``det J(s)`` has the sign of ``det J₀``.
 
+**First-order cells** (families with ``_jac_lin``, the 6-PSU; cells of :data:`LINEAR_TILE`
+units per axis, and for a column-invariant family the columns' z does not split a cell). The
+interval bound's slack grows like the cell (``|J_h₀⁻¹| D_h`` takes absolute values, so the
+legs' first-order changes never cancel). ``_jac_lin`` gives ``A_k`` and ``W`` with ``|J(s) -
+J₀ - Σ_k Δ_k A_k| <= W`` entrywise (``Δ = s - centre``, ``|Δ_k| <= h_k``; ``W`` is second
+order in the cell, plus the rounding allowance). With ``N_k = J_h₀⁻¹ A_k H`` (``H`` the
+homogenising column scale), ``Q = |J_h₀⁻¹| W H`` and ``E(s) = J_h₀⁻¹ (J_h(s) - J_h₀) = Σ_k
+Δ_k N_k + J_h₀⁻¹ (rem)``:
+
+* ``‖E(s)‖₂ <= μ = max_corners ‖Σ_k Δ_k N_k‖_F + ‖Q‖_F`` (a convex function of ``Δ`` is
+  largest at a corner of the box; ``‖Σ Δ_k N_k‖_F²`` from the Gram matrix of the ``N_k``),
+  and ``‖J_h(s) - J_h₀‖₂ <= δ_h = max_corners ‖Σ_k Δ_k A_k H‖_F + ‖W H‖_F``; ``K`` as above;
+* ``J_h(s)⁻¹ e_c = (I + E)⁻¹ b_c = b_c - E b_c + E² (I + E)⁻¹ b_c``, so the first three
+  entries have norm at most ``max_corners ‖g_c - Σ_k Δ_k (N_k b_c)_{0:3}‖ + ‖(Q |b_c|)_{0:3}‖
+  + μ² ‖b_c‖ / (1 - μ)`` (``g_c = (b_c)_{0:3}``): the first-order change of the force is
+  exact, only the remainder and the second-order term are bounded by norms. ``F`` follows, and
+  ``μ < 1`` gives the sign of ``det J`` as above.
+
 Every bound is multiplied (or divided) by ``1 + KAPPA_ROUND`` per rounded quantity, and a cell
 with ``K >= 1e8`` is never pruned (:func:`._linalg.kappa_upper`'s range). The box Jacobians'
 own allowance covers the round-off of the enclosure and of the per-pose kernel's ``J``.
@@ -67,6 +85,17 @@ TILE = 3
 #: cells evaluated first (largest K, smallest F) for the incumbents
 _SEED = 8
 _KMAX = 1e8
+#: use the family's first-order form (``_jac_lin``) for the cell bounds where it has one
+LINEAR = True
+#: grid units per axis in a cell bounded by the first-order form
+LINEAR_TILE = 5
+
+
+def _lin_of(mech):
+    """The family's first-order form ``_jac_lin``, declared by the class that declares its
+    ``_jac_one``, or None."""
+    owner = next(c for c in type(mech).__mro__ if "_jac_one" in vars(c))
+    return vars(owner).get("_jac_lin")
 
 
 def cells_available(mech) -> bool:
@@ -167,6 +196,158 @@ def _bounds_kernel(jac, box, ng: int):
 
 
 @cache
+def _lin_bounds_kernel(jac, lin, ng: int):
+    """:func:`_bounds_kernel` with the family's first-order form ``_jac_lin`` (module notes,
+    "first-order cells"): ``K``, ``F``, ``S`` with the same meaning."""
+
+    def cell_lin_bounds_loop(P, R, order, start, feas, g, L, fmax, K, F, S):
+        T, M = start.shape[0] - 1, R.shape[0]
+        r = 1.0 + KAPPA_ROUND
+        for t in prange(T):
+            J = np.empty((1, 6, 6))
+            Ad = np.empty((3, 6, 6))
+            W = np.empty((6, 6))
+            N = np.empty((3, 6, 6))
+            A = np.empty((6, 6))
+            B = np.empty((6, 6))
+            G = np.empty((6, 6))
+            Tm = np.empty((6, 6))
+            piv = np.empty(6, np.int64)
+            q = np.empty((1, 6))
+            plo = np.empty(3)
+            phi = np.empty(3)
+            pc = np.empty(3)
+            hk = np.empty(3)
+            gn = np.empty((3, 3))
+            ga = np.empty((3, 3))
+            v = np.empty((3, 3))
+            for m in range(M):
+                K[t, m], F[t, m], S[t, m] = -np.inf, np.inf, 0
+                n = 0
+                for c in range(3):
+                    plo[c], phi[c] = np.inf, -np.inf
+                for j in range(start[t], start[t + 1]):
+                    u = order[j]
+                    if feas[u, m]:
+                        n += 1
+                        for c in range(3):
+                            plo[c] = min(plo[c], P[u, c])
+                            phi[c] = max(phi[c], P[u, c])
+                if n == 0:
+                    continue                            # nothing to evaluate in the cell
+                K[t, m], F[t, m] = np.inf, 0.0          # not certified, until shown
+                for c in range(3):
+                    pc[c] = 0.5 * (plo[c] + phi[c])
+                if not lin(plo, phi, pc, R[m], g, Ad, W):
+                    continue
+                jac(pc[0], pc[1], pc[2], R[m, 0, 0], R[m, 0, 1], R[m, 0, 2], R[m, 1, 0],
+                    R[m, 1, 1], R[m, 1, 2], R[m, 2, 0], R[m, 2, 1], R[m, 2, 2], g, q, J, 0)
+                la, lb, f0, d0 = sweep_core(J[0], L, fmax, A, B, G, Tm, piv)
+                if not (la > 0.0 and lb > 0.0 and d0 != 0.0):
+                    continue
+                sigma, iota = math.sqrt(la) * r, math.sqrt(lb) * r    # B = J_h0⁻¹
+                for k in range(3):                  # half-widths; directions J depends on
+                    hk[k] = max(phi[k] - pc[k], pc[k] - plo[k]) * (1.0 + 1e-12)
+                    nz = False
+                    for i in range(6):
+                        for c in range(6):
+                            if c >= 3:
+                                Ad[k, i, c] /= L                # A_k·H, H = diag(1, 1, 1, 1/L..)
+                            if Ad[k, i, c] != 0.0:
+                                nz = True
+                    if not nz:
+                        hk[k] = 0.0
+                w2 = 0.0
+                for i in range(6):
+                    for c in range(3, 6):
+                        W[i, c] /= L
+                    for c in range(6):
+                        w2 += W[i, c] * W[i, c]
+                for k in range(3):                  # N_k = J_h0⁻¹ A_k H
+                    if hk[k] == 0.0:
+                        continue
+                    for i in range(6):
+                        for c in range(6):
+                            x = 0.0
+                            for l in range(6):
+                                x += B[i, l] * Ad[k, l, c]
+                            N[k, i, c] = x
+                for k in range(3):                  # Gram matrices of the N_k and the A_k H
+                    for l in range(k, 3):
+                        sn, sa = 0.0, 0.0
+                        if hk[k] > 0.0 and hk[l] > 0.0:
+                            for i in range(6):
+                                for c in range(6):
+                                    sn += N[k, i, c] * N[l, i, c]
+                                    sa += Ad[k, i, c] * Ad[l, i, c]
+                        gn[k, l], gn[l, k], ga[k, l], ga[l, k] = sn, sn, sa, sa
+                mn, ma = 0.0, 0.0                   # max over the corners ‖Σ Δ_k N_k‖_F²
+                for s1 in (-1.0, 1.0):
+                    for s2 in (-1.0, 1.0):
+                        d0_ = (hk[0], s1 * hk[1], s2 * hk[2])
+                        xn, xa = 0.0, 0.0
+                        for k in range(3):
+                            for l in range(3):
+                                xn += d0_[k] * d0_[l] * gn[k, l]
+                                xa += d0_[k] * d0_[l] * ga[k, l]
+                        mn, ma = max(mn, xn), max(ma, xa)
+                q2 = 0.0                            # Q = |J_h0⁻¹| W_h, stored in A
+                for i in range(6):
+                    for c in range(6):
+                        x = 0.0
+                        for l in range(6):
+                            x += abs(B[i, l]) * W[l, c]
+                        A[i, c] = x
+                        q2 += x * x
+                mu = (math.sqrt(max(mn, 0.0)) * r + math.sqrt(q2) * r) * r
+                dh = (math.sqrt(max(ma, 0.0)) * r + math.sqrt(w2) * r) * r
+                if not mu < 1.0:
+                    continue
+                kb = (sigma + dh) * iota / (1.0 - mu) * r * r * r
+                if not kb < _KMAX:
+                    continue
+                fb = np.inf
+                for c in range(6):
+                    bc = 0.0
+                    for i in range(6):
+                        bc += B[i, c] * B[i, c]
+                    qc = 0.0                        # ‖(Q |b_c|)_{0:3}‖
+                    for i in range(3):
+                        x = 0.0
+                        for l in range(6):
+                            x += A[i, l] * abs(B[l, c])
+                        qc += x * x
+                    for k in range(3):              # v_k = (N_k b_c)_{0:3}
+                        for i in range(3):
+                            x = 0.0
+                            if hk[k] > 0.0:
+                                for l in range(6):
+                                    x += N[k, i, l] * B[l, c]
+                            v[k, i] = x
+                    worst = 0.0                     # max over the corners ‖g_c - Σ Δ_k v_k‖
+                    for s0 in (-1.0, 1.0):
+                        for s1 in (-1.0, 1.0):
+                            for s2 in (-1.0, 1.0):
+                                x = 0.0
+                                for i in range(3):
+                                    y = (B[i, c] - s0 * hk[0] * v[0, i] - s1 * hk[1] * v[1, i]
+                                         - s2 * hk[2] * v[2, i])
+                                    x += y * y
+                                worst = max(worst, x)
+                    e = (math.sqrt(worst) * r + math.sqrt(qc) * r
+                         + mu * mu * math.sqrt(bc) / (1.0 - mu) * r * r) * r
+                    fb = min(fb, fmax[c] / (e * r))
+                K[t, m], F[t, m], S[t, m] = kb, fb / r, 1 if d0 > 0.0 else -1
+
+    f8, f1, f2, f3 = nt.float64, nt.float64[::1], nt.float64[:, ::1], nt.float64[:, :, ::1]
+    i1 = nt.int64[::1]
+    return cached_kernel(cell_lin_bounds_loop,
+                         nt.void(f2, f3, i1, i1, nt.boolean[:, ::1], nt.UniTuple(nt.float64, ng),
+                                 f8, f1, f2, f2, nt.int8[:, ::1]),
+                         parallel=True, error_model="numpy")
+
+
+@cache
 def _eval_kernel(jac, ng: int):
     """The per-chunk pass over the cells: each cell × orientation either pruned (its samples
     get ``-inf``, ``inf`` and the certified sign), or its feasible samples evaluated — in
@@ -226,10 +407,15 @@ def _eval_kernel(jac, ng: int):
                          parallel=True, error_model="numpy")
 
 
-def _tiles(unit_pos: np.ndarray, h: float):
-    """Units grouped into cells of :data:`TILE` grid steps per axis: ``(order, start)``,
-    the units of cell ``t`` being ``order[start[t]:start[t + 1]]``, and the cell of each unit."""
-    idx = np.floor((unit_pos - unit_pos.min(axis=0)) / h + 0.5).astype(np.int64) // TILE
+def _tiles(unit_pos: np.ndarray, h: float, planar: bool = False, tile: int | None = None):
+    """Units grouped into cells of ``tile`` (:data:`TILE`) grid steps per axis: ``(order,
+    start)``, the units of cell ``t`` being ``order[start[t]:start[t + 1]]``, and the cell of
+    each unit. ``planar``: the units are (x, y) columns of a family whose Jacobian does not
+    depend on z, so their z (a column's lowest voxel) does not split the cells."""
+    idx = (np.floor((unit_pos - unit_pos.min(axis=0)) / h + 0.5).astype(np.int64)
+           // (tile or TILE))
+    if planar:
+        idx[:, 2] = 0
     n = idx.max(axis=0) + 1                      # one integer key per cell, in the row order
     _, cell = np.unique((idx[:, 0] * n[1] + idx[:, 1]) * n[2] + idx[:, 2], return_inverse=True)
     cell = cell.ravel()
@@ -250,16 +436,20 @@ class CellPlan:
         self.fmax = np.require(np.broadcast_to(fmax, (6,)), np.float64, ("C", "A", "W"))
         self.feas = np.require(feas, np.bool_, ("C", "A", "W"))
         U, M = feas.shape
-        self.order, start, self.cell = _tiles(self.P, h)
+        lin = _lin_of(mech) if LINEAR else None
+        self.order, start, self.cell = _tiles(
+            self.P, h, bool(getattr(mech, "column_invariant", False)),
+            LINEAR_TILE if lin is not None else TILE)
         self.start = start
         T = len(start) - 1
         self.K, self.F = np.empty((T, M)), np.empty((T, M))
         self.S = np.empty((T, M), dtype=np.int8)
         jac, g = mech.jacobian_kernel()
+        kernel = (_lin_bounds_kernel(jac, lin, len(g)) if lin is not None
+                  else _bounds_kernel(jac, type(mech)._jac_box, len(g)))
         with threads_for(T * M * 4):
-            _bounds_kernel(jac, type(mech)._jac_box, len(g))(
-                self.P, self.R, self.order, start, self.feas, g, self.L, self.fmax, self.K,
-                self.F, self.S)
+            kernel(self.P, self.R, self.order, start, self.feas, g, self.L, self.fmax, self.K,
+                   self.F, self.S)
         self.certified = np.isfinite(self.K) & (self.S != 0)
         self.k_low, self.f_inc = -math.inf, math.inf
         self.evaluated = 0

@@ -108,6 +108,75 @@ def _psu_jac_box(plo, phi, Rlo, Rhi, g, Jlo, Jhi):
     return True
 
 
+@register_jitable(inline="always")
+def _psu_jac_lin(plo, phi, pc, R, g, A, W):
+    """First-order form of :func:`_psu_jac_one` over the positions ``plo <= p <= phi`` at the
+    rotation ``R`` (:mod:`..kernels.boxes`): for every such ``p`` the per-pose kernel's ``J(p)``
+    satisfies ``|J(p) - J(pc) - Σ_k (p_k - pc_k) A[k]| <= W`` entrywise (``A (3, 6, 6)``,
+    ``W (6, 6)``; ``A[2] = 0``: J does not depend on z).
+
+    Row i is ``c + t_x e1 + t_y e2`` with ``t = a_xy / a_z``, ``e1 = [1, 0, 0, 0, r_z,
+    -r_y]``, ``e2 = [0, 1, 0, -r_z, 0, r_x]``, and ``a_xy`` moves with ``p_xy``; the gradient
+    of ``t`` is ``T = (I + t tᵀ) / a_z``. ``A`` holds ``T`` at the centre's ``a`` (``T₀``);
+    by the mean value theorem per component, ``t(p) - t(pc) = T(ξ) Δ``, so the remainder is
+    at most ``max |[T] - T₀| · |Δ|`` with ``[T]`` the interval enclosure of ``T`` over the
+    box, plus an allowance ``3 · ROUND_REL · (1 + |J|)`` for the round-off of both kernel
+    Jacobians and of ``A`` (the box Jacobians' premise). False where ``a_z`` may fall below
+    1e-2 of the link."""
+    hx = max(phi[0] - pc[0], pc[0] - plo[0]) * (1.0 + 1e-12)
+    hy = max(phi[1] - pc[1], pc[1] - plo[1]) * (1.0 + 1e-12)
+    for i in range(6):
+        ux, uy, uz = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]
+        rx = R[0, 0] * ux + R[0, 1] * uy + R[0, 2] * uz
+        ry = R[1, 0] * ux + R[1, 1] * uy + R[1, 2] * uz
+        rz = R[2, 0] * ux + R[2, 1] * uy + R[2, 2] * uz
+        ax0, ax1 = plo[0] + rx - g[3 * i], phi[0] + rx - g[3 * i]
+        ay0, ay1 = plo[1] + ry - g[3 * i + 1], phi[1] + ry - g[3 * i + 1]
+        ll = g[36 + i]
+        sx0, sx1 = _box.isq(ax0, ax1)
+        sy0, sy1 = _box.isq(ay0, ay1)
+        h0, h1 = ll * ll - sx1 - sy1, ll * ll - sx0 - sy0
+        if not h0 >= 1e-4 * ll * ll:
+            return False
+        iz0, iz1 = 1.0 / math.sqrt(h1), 1.0 / math.sqrt(h0)      # 1 / a_z
+        tx0, tx1 = _box.imul(ax0, ax1, iz0, iz1)
+        tx0, tx1 = _box.widen(tx0, tx1)
+        ty0, ty1 = _box.imul(ay0, ay1, iz0, iz1)
+        ty0, ty1 = _box.widen(ty0, ty1)
+        qx0, qx1 = _box.isq(tx0, tx1)
+        qy0, qy1 = _box.isq(ty0, ty1)
+        txx0, txx1 = _box.imul(1.0 + qx0, 1.0 + qx1, iz0, iz1)
+        txx0, txx1 = _box.widen(txx0, txx1)
+        tyy0, tyy1 = _box.imul(1.0 + qy0, 1.0 + qy1, iz0, iz1)
+        tyy0, tyy1 = _box.widen(tyy0, tyy1)
+        p0, p1 = _box.imul(tx0, tx1, ty0, ty1)
+        txy0, txy1 = _box.imul(p0, p1, iz0, iz1)
+        txy0, txy1 = _box.widen(txy0, txy1)
+        cx, cy = pc[0] + rx - g[3 * i], pc[1] + ry - g[3 * i + 1]
+        z = math.sqrt(ll * ll - cx * cx - cy * cy)
+        vx, vy = cx / z, cy / z
+        Txx, Tyy, Txy = (1.0 + vx * vx) / z, (1.0 + vy * vy) / z, vx * vy / z
+        wxx = max(txx1 - Txx, Txx - txx0, 0.0)                  # |T(ξ) - T₀|, entrywise
+        wyy = max(tyy1 - Tyy, Tyy - tyy0, 0.0)
+        wxy = max(txy1 - Txy, Txy - txy0, 0.0)
+        ex = wxx * hx + wxy * hy                                # |Δt_x - (T₀ Δ)_x|
+        ey = wxy * hx + wyy * hy
+        tmx = max(abs(tx0), abs(tx1))
+        tmy = max(abs(ty0), abs(ty1))
+        e1 = (1.0, 0.0, 0.0, 0.0, rz, -ry)
+        e2 = (0.0, 1.0, 0.0, -rz, 0.0, rx)
+        c0 = (0.0, 0.0, 1.0, ry, -rx, 0.0)
+        for j in range(6):
+            A[0, i, j] = Txx * e1[j] + Txy * e2[j]
+            A[1, i, j] = Txy * e1[j] + Tyy * e2[j]
+            A[2, i, j] = 0.0
+            big = abs(c0[j]) + tmx * abs(e1[j]) + tmy * abs(e2[j])   # >= |J| in the box
+            W[i, j] = ((ex * abs(e1[j]) + ey * abs(e2[j])) * (1.0 + 1e-12)
+                       + 3.0 * _box.ROUND_REL * (1.0 + big + abs(A[0, i, j]) * hx
+                                                 + abs(A[1, i, j]) * hy))
+    return True
+
+
 @njit(inline="always")
 def _psu_column_leg(x, y, wx, wy, wz, l2, qmin, qmax):
     """Along a column q = z + w_z - sqrt(l² - |a_xy|²) with a_xy = (x, y) + w_xy: the stroke
@@ -160,6 +229,7 @@ class PSU6(Mechanism):
     _ik_one = _psu_one
     _jac_one = _psu_jac_one
     _jac_box = _psu_jac_box
+    _jac_lin = _psu_jac_lin
 
     def __post_init__(self):
         set_ = object.__setattr__
