@@ -407,6 +407,15 @@ def _eval_kernel(jac, ng: int):
                          parallel=True, error_model="numpy")
 
 
+def bounds_kernel(mech):
+    """The cell-bound kernel for ``mech``: the first-order one where the family has
+    ``_jac_lin`` (and :data:`LINEAR`), else the box one (also what the warm-up builds)."""
+    jac, g = mech.jacobian_kernel()
+    lin = _lin_of(mech) if LINEAR else None
+    return (_lin_bounds_kernel(jac, lin, len(g)) if lin is not None
+            else _bounds_kernel(jac, type(mech)._jac_box, len(g)))
+
+
 def _tiles(unit_pos: np.ndarray, h: float, planar: bool = False, tile: int | None = None):
     """Units grouped into cells of ``tile`` (:data:`TILE`) grid steps per axis: ``(order,
     start)``, the units of cell ``t`` being ``order[start[t]:start[t + 1]]``, and the cell of
@@ -444,9 +453,8 @@ class CellPlan:
         T = len(start) - 1
         self.K, self.F = np.empty((T, M)), np.empty((T, M))
         self.S = np.empty((T, M), dtype=np.int8)
-        jac, g = mech.jacobian_kernel()
-        kernel = (_lin_bounds_kernel(jac, lin, len(g)) if lin is not None
-                  else _bounds_kernel(jac, type(mech)._jac_box, len(g)))
+        kernel = bounds_kernel(mech)
+        g = mech.jacobian_kernel()[1]
         with threads_for(T * M * 4):
             kernel(self.P, self.R, self.order, start, self.feas, g, self.L, self.fmax, self.K,
                    self.F, self.S)

@@ -21,8 +21,7 @@ def _spatial(mech) -> bool:
 
 
 def _bounds(mech) -> None:
-    jac, g = mech.jacobian_kernel()
-    _cells._bounds_kernel(jac, type(mech)._jac_box, len(g))
+    _cells.bounds_kernel(mech)
 
 
 def _cell_pass(mech) -> None:
