@@ -128,7 +128,8 @@ def compile_baseline(space, evaluation, seed: int, *, every: bool = False,
     with compile_log() as compiled:
         result = evaluate_design(space, None, evaluation, seed)
         if every or compiled.entries:
-            extra_kernels(type(space.decode(None)))
+            mech = space.decode(None)
+            extra_kernels(type(mech), mech)
     for line in compile_lines(compiled.entries, where):
         log.info("%s", line)
     return result

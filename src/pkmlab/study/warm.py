@@ -43,16 +43,20 @@ def warm_study(path) -> tuple[float, list[str]]:
     return time.perf_counter() - t0, compile_lines(compiled.entries, "into the cache")
 
 
-def extra_kernels(family) -> None:
+def extra_kernels(family, mech=None) -> None:
     """The kernels that designs other than the baseline may use and the baseline does not:
     the family's column and search kernels (the tiled column kernel serves large footprints
-    only, for example) and the parallel singular values (stacks of 50,000 matrices and more:
-    the κ of a large design's export)."""
+    only, for example), the parallel singular values (stacks of 50,000 matrices and more:
+    the κ of a large design's export) and, given the baseline ``mech``, its family's fused
+    κ kernels (:func:`pkmlab.dexterity._fused_exact.warm`: the κ maps of an export, a
+    trajectory check the baseline does not reach)."""
     import numpy as np
 
-    from ..dexterity import _linalg
+    from ..dexterity import _fused_exact, _linalg
 
     _linalg.singular_values(np.zeros((_linalg._PARALLEL_FROM, 6, 6)))
+    if mech is not None:
+        _fused_exact.warm(mech)
     if getattr(family, "column_method", None) not in ("linear", "quadratic"):
         return
     from ..mechanisms.kernels import columns, search, tiles
