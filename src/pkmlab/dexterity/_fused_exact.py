@@ -33,10 +33,10 @@ import math
 from functools import cache
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 from numba import types as nt
 
-from ..runtime.jit import cached_kernel
+from ..runtime.jit import cached_kernel, identity, jitable
 from ..runtime.threads import threads_for
 from ._fused import _TASK, fused_available, fused_sweep
 from ._linalg import KAPPA_ROUND, _one, kappa_upper, sweep_one
@@ -64,7 +64,6 @@ def serves(mech) -> bool:
     return FUSED and fused_available(mech)
 
 
-@njit(cache=True, error_model="numpy")
 def _kappa_h(Jm, L, H, sv, A, d):
     """Exact κ of ``Jm (6, 6)`` homogenised with ``L``: ``H (1, 6, 6)``, ``sv (1, 6)``,
     ``A (6, 6)``, ``d (6,)`` scratch. :func:`~pkmlab.dexterity.condition_number`'s arithmetic:
@@ -80,7 +79,6 @@ def _kappa_h(Jm, L, H, sv, A, d):
     return np.inf
 
 
-@njit(cache=True, error_model="numpy")
 def _singular_bound(Jm, L, A, B, G, T, piv, ones):
     """True when the certified κ bound of :func:`._linalg.sweep_one` on ``Jm``, made safe as
     :func:`._linalg.kappa_upper` does, is below :data:`~pkmlab.dexterity.KAPPA_SINGULAR`
@@ -88,6 +86,16 @@ def _singular_bound(Jm, L, A, B, G, T, piv, ones):
     kup = sweep_one(Jm, L, ones, A, B, G, T, piv)[0]
     ku = np.inf if kup > _KUP_FINITE else kup * _KUP_SAFE
     return ku < KAPPA_SINGULAR
+
+
+# The two helpers are compiled into each family's loop as functions of their own, not inlined
+# (inlined, ``sweep_one`` alone took the loop's compile from 3.7 to 18.9 s of CPU), and not as
+# ``njit(cache=True)`` functions: their cache would be keyed by this file only, and would keep
+# stale code after an edit of ``_linalg``, which they inline. ``jitable`` names them after
+# ``_HELPERS``, which covers both (and, through them, ``_linalg``).
+_HELPERS = identity(_kappa_h, _singular_bound, extra=("fused-exact helpers",))
+_kappa_h = jitable(_kappa_h, _HELPERS, error_model="numpy")
+_singular_bound = jitable(_singular_bound, _HELPERS, error_model="numpy")
 
 
 @cache
