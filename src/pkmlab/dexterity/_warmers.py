@@ -1,9 +1,11 @@
 """The dexterity kernels' warmers (:mod:`pkmlab.runtime.warmers`): the worst case's cell
 bounds and cell pass (:mod:`._cells`), the fused per-pose pass at listed poses
-(:mod:`._fused`), the pose sweep and the parallel singular values (:mod:`._linalg`, a large
+(:mod:`._fused`), the fused exact κ of the maps, GCI and trajectory check
+(:mod:`._fused_exact`), the pose sweep and the parallel singular values (:mod:`._linalg`, a large
 design's κ export). Each calls the factory the evaluation calls, with the same arguments.
 Weights: CPU seconds of a cold compile for the 6-PSU family (2 cores; the two cell kernels
-measured: the 6-PSU's first-order bound 34.8 s, the pass 21.2 s; the others scaled from wall time at load 5; relative only).
+measured: the 6-PSU's first-order bound 34.8 s, the pass 21.2 s; the others scaled from
+wall time at load 5; relative only).
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..runtime.warmers import register_warmer
-from . import _cells, _fused, _linalg
+from . import _cells, _fused, _fused_exact, _linalg
 
 __all__: list[str] = []
 
@@ -37,6 +39,10 @@ def _fused_at(mech) -> None:
 register_warmer("worst case: cell bounds", 34.8, _cells.cells_available, _bounds)
 register_warmer("worst case: cell pass", 21.2, _cells.cells_available, _cell_pass)
 register_warmer("worst case: fused pass at poses", 14.5, _fused.fused_available, _fused_at)
+# the κ maps of an export and a trajectory check the baseline does not reach: the family's
+# exact-κ loop (10.6 s) and the fused worst-case loop it takes (about 13.5 s)
+register_warmer("fused exact κ (maps, GCI, trajectory check)", 24.1, _fused.fused_available,
+                _fused_exact.warm)
 register_warmer("pose sweep", 8.0, _spatial, lambda mech: _linalg._sweep())
 register_warmer("parallel singular values", 1.4, lambda mech: True,
                 lambda mech: _linalg.singular_values(np.zeros((_linalg._PARALLEL_FROM, 6, 6))))

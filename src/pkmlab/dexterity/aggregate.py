@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
+from . import _fused_exact
 from .metrics import CharacteristicLength, condition_number, lci, resolve_length
 
 log = logging.getLogger(__name__)
@@ -147,17 +148,35 @@ def kappa_grid(mech, result, L: float | CharacteristicLength | None = None) -> K
     else:
         inv = np.arange(V)
         eval_pos = pos
-    Ve = len(eval_pos)
+    kap_e = _kappa_units(mech, eval_pos, Rs, L, V)
+    for m0, k, pv, Rv in orientation_batches(pos, Rs):
+        valid[:, m0:m0 + k] = _ik_valid(mech, pv, Rv).reshape(k, V).T
+    kap = np.where(valid, kap_e[inv], np.inf)
+    return KappaGrid(kap, valid, pos, idx, Rs, L, length)
+
+
+def _kappa_units(mech, eval_pos, Rs, L, V: int) -> np.ndarray:
+    """``(Ve, M)`` exact κ at every position × rotation: the Jacobian fused with κ in one
+    numba loop where the family has one (:mod:`._fused_exact`, the same values bit for bit),
+    else NumPy Jacobians in chunks of about ``_CHUNK`` poses (``V`` the voxels per rotation)."""
+    if _fused_exact.serves(mech):
+        return _fused_exact.fused_kappa_grid(mech, eval_pos, Rs, L)
+    Ve, M = len(eval_pos), len(Rs)
     kap_e = np.empty((Ve, M))
     step = max(1, _CHUNK // V)                         # V >= Ve poses per orientation
     for m0 in range(0, M, step):
         k = len(Rs[m0:m0 + step])
         J = mech.jacobian((np.tile(eval_pos, (k, 1)), np.repeat(Rs[m0:m0 + step], Ve, axis=0)))
         kap_e[:, m0:m0 + k] = condition_number(J, L).reshape(k, Ve).T
-    for m0, k, pv, Rv in orientation_batches(pos, Rs):
-        valid[:, m0:m0 + k] = _ik_valid(mech, pv, Rv).reshape(k, V).T
-    kap = np.where(valid, kap_e[inv], np.inf)
-    return KappaGrid(kap, valid, pos, idx, Rs, L, length)
+    return kap_e
+
+
+def _lci(mech, p, R, L) -> np.ndarray:
+    """``1/κ`` at the poses ``(p, R)`` (in pairs): fused where the family allows
+    (:func:`._fused_exact.fused_kappa`, bit for bit), else :func:`.lci` of NumPy Jacobians."""
+    if _fused_exact.serves(mech):
+        return 1.0 / _fused_exact.fused_kappa(mech, p, R, L)
+    return lci(mech.jacobian((p, R)), L)
 
 
 @dataclass(frozen=True)
@@ -320,7 +339,7 @@ def gci_monte_carlo(mech, result, L: float | CharacteristicLength | None = None,
     if poses is not None:
         p, R = poses
         valid = _ik_valid(mech, p, R)
-        vals = lci(mech.jacobian((p[valid], R[valid])), length.length)
+        vals = _lci(mech, p[valid], R[valid], length.length)
         return _summarise(vals, len(p) - len(vals), "monte-carlo", length)
     samples = int(samples)
     if samples < 1:
@@ -330,7 +349,7 @@ def gci_monte_carlo(mech, result, L: float | CharacteristicLength | None = None,
         return _summarise(np.empty(0), 0, "monte-carlo", length)
     p, R = sample_poses(result, samples, rng)
     valid = _ik_valid(mech, p, R)
-    vals = lci(mech.jacobian((p[valid], R[valid])), length.length)
+    vals = _lci(mech, p[valid], R[valid], length.length)
     return _summarise(vals, samples - len(vals), "monte-carlo", length)
 
 

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
+from . import _fused_exact
 from ._linalg import kappa_upper
 from .aggregate import _CHUNK, _ik_valid, _units, _voxels, orientation_batches
 from .force import max_force_all_directions
@@ -148,7 +149,11 @@ def _unit_kappa_max(mech, unit_pos, R, L) -> np.ndarray:
     Every pose gets the certified bound of :func:`._linalg.sweep_bounds` (one LU per pose,
     made safe against rounding by :func:`._linalg.kappa_upper`); each unit's exact κ at its
     largest bound is a lower bound on its maximum, so only the poses whose bound reaches it
-    need the exact κ (singular values): on the demo designs about a fifth of them."""
+    need the exact κ (singular values): on the demo designs about a fifth of them. A family
+    with a numba per-pose Jacobian runs the same algorithm with the Jacobian fused into each
+    pass (:func:`._fused_exact.fused_kappa_max`: the same values, bit for bit)."""
+    if _fused_exact.serves(mech):
+        return _fused_exact.fused_kappa_max(mech, unit_pos, R, L)
     U, M = len(unit_pos), len(R)
     if U == 0 or M == 0:
         return np.full(U, -np.inf)

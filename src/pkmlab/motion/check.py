@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..dexterity import _fused_exact
 from ..dexterity.metrics import CharacteristicLength, condition_number, resolve_length
 from ..dexterity.sweep import singular
 from ..errors import ParameterError
@@ -327,9 +328,13 @@ def trajectory_fit(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
             and bool(np.all(np.isfinite(np.gradient(q, t, axis=0)))))
     if fits:
         length = resolve_length(mech, characteristic_length)
-        with np.errstate(all="ignore"):
-            J = mech.jacobian(X)
-        fits = not bool(np.any(singular(J, length.length, mech.mobility)))
+        if _fused_exact.serves(mech):          # the same decisions, Jacobians fused in
+            fits = not bool(np.any(_fused_exact.fused_singular(mech, *mech._frames(X),
+                                                               length.length)))
+        else:
+            with np.errstate(all="ignore"):
+                J = mech.jacobian(X)
+            fits = not bool(np.any(singular(J, length.length, mech.mobility)))
     return TrajectoryFit(fits, low, high)
 
 
@@ -410,11 +415,18 @@ def check_trajectory(mech: Mechanism, t: np.ndarray, poses: np.ndarray, *,
     # --- statics -----------------------------------------------------------------------------
     finite_pose = np.all(np.isfinite(X), axis=1)
     J = np.full((T, n_act, mob.width), np.nan)
-    if np.any(finite_pose):
-        with np.errstate(all="ignore"):
-            J[finite_pose] = mech.jacobian(X[finite_pose])
+    if _fused_exact.serves(mech):           # J and κ in one numba loop, the same values
+        condition = np.full(T, np.inf)
+        Jf = np.empty((int(finite_pose.sum()), n_act, mob.width))
+        condition[finite_pose] = _fused_exact.fused_kappa(
+            mech, *mech._frames(X[finite_pose]), L, jacobians=Jf)
+        J[finite_pose] = Jf
+    else:
+        if np.any(finite_pose):
+            with np.errstate(all="ignore"):
+                J[finite_pose] = mech.jacobian(X[finite_pose])
+        condition = condition_number(J, L)                      # inf: singular or undefined
     j_finite = np.all(np.isfinite(J), axis=(1, 2))
-    condition = condition_number(J, L)                          # inf: singular or undefined
     j_ok = np.isfinite(condition)
 
     wrench = np.full((T, POSE_SIZE), np.nan)
