@@ -98,6 +98,13 @@ class Evaluation:
         return (self.tolerances or FINE).length
 
     @property
+    def coarse(self) -> bool:
+        """The evaluation of a tolerance ladder's coarse rung (:mod:`.ladder`): each of its
+        candidates is re-certified at the fine tolerances or pruned, so a check that changes
+        no metric (the capability point's random-rotation check) waits for the fine rung."""
+        return self.tolerances is not None
+
+    @property
     def worst_case_exact(self) -> bool:
         """The dexterity's worst case over every sample (else certified bounds from a
         subset: a tolerance ladder's coarse rung)."""
