@@ -100,7 +100,7 @@ from .kernels import ik_free as _ik_free
 from .kernels import tiles as _tiles
 from .mobility import SPATIAL, Mobility
 from .results import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult
-from .solvers import bracketed_root, forward_newton, multistart_modes
+from .solvers import forward_newton, mid_stroke_pose, multistart_modes
 from .validation import as_points, as_positive, as_stroke, as_vector3
 
 log = logging.getLogger(__name__)
@@ -521,43 +521,7 @@ class Mechanism(JointsMixin):
 
     def _mid_stroke_pose(self) -> np.ndarray:
         """Level, centred pose whose mean actuator value is mid-stroke (highest such z)."""
-        lo, hi = self.stroke
-        mid = 0.5 * (lo + hi)
-        yaw = self._level_yaw()
-        Rz = np.array([[[np.cos(yaw), -np.sin(yaw), 0.0], [np.sin(yaw), np.cos(yaw), 0.0],
-                        [0.0, 0.0, 1.0]]])
-
-        # the root search evaluates one pose ~40 times (to 1e-12 mm): one driver and one set
-        # of buffers for all of them: the same kernel, arithmetic and leg check as _run_ik
-        g, L = self._ik_geometry, self.n_actuators
-        frames = _kernels.make_driver(self._ik_kernel(), len(g), "frames", L)
-        P, Rc = np.zeros((1, 3)), _kernels.carray(Rz)
-        q, st, reason = np.empty((1, L)), np.empty((1, L), np.int8), np.empty(1, np.int8)
-        q_lo, q_hi = (float(v) for v in NO_STROKE)
-
-        def mean_q(z: float) -> float:
-            P[0, 2] = z
-            frames(P, Rc, g, q_lo, q_hi, q, st, reason)
-            if reason[0] == _kernels.LEG_FAULT:
-                self._check_legs(reason)
-            return float(np.mean(q[0])) - mid if reason[0] == _kernels.OK else np.nan
-
-        S = self.scale
-        zs = np.linspace(3.0 * S + hi, -S, 801)
-        scan = self._run_ik(np.stack([np.zeros(801), np.zeros(801), zs], axis=1),
-                            np.ascontiguousarray(np.broadcast_to(Rz, (801, 3, 3))), *NO_STROKE)
-        vals = np.where(scan.valid, scan.q.mean(axis=1) - mid, np.nan)
-        a, b = vals[:-1], vals[1:]
-        # the first scan interval whose ends are finite and change sign (or touch zero)
-        hit = np.flatnonzero(np.isfinite(a) & np.isfinite(b) & (a * b <= 0))
-        if len(hit):
-            k = int(hit[0])
-            with threads_for(1):
-                z = bracketed_root(mean_q, zs[k + 1], zs[k], xtol=TOL.nominal_z_mm)
-            return np.array([0.0, 0.0, z, 0.0, 0.0, yaw])
-        raise ParameterError("stroke", "a window whose mid-point is reachable by a level, "
-                             "centred platform (the nominal pose: give 'nominal' or change the "
-                             "stroke or the link lengths)", list(self.stroke))
+        return mid_stroke_pose(self)
 
     def _random_starts(self, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
         rng = np.random.default_rng(seed)
