@@ -156,3 +156,74 @@ def test_the_coarse_rung_skips_only_the_point_check(demo, monkeypatch):
         EVALUATORS["orientation_capability"](mech, Context(study.evaluation, 1, choices={}))
         assert len(checks) == 1                          # the fine rung checks the point
         checks.clear()
+
+
+# ---- evaluators no objective or constraint reads wait for the re-certification -------------
+
+def _sobol_study(tmp, name, ladder=None):
+    from conftest import MECH_DIR
+    import yaml
+
+    data = {
+        "study": "deferred", "mechanism": {"file": str(MECH_DIR / "hopkins-williams-6psu.yaml")},
+        "design": {"platform_outer_radius": {"low": "55 mm", "high": "90 mm"},
+                   "link_length": {"low": "200 mm", "high": "260 mm"}},
+        "evaluate": {"workspace": {"kind": "dexterous", "box": ["5 deg"] * 3, "samples": 3,
+                                   "semantics": "simultaneous", "resolution": "10 mm"},
+                     "orientation_capability": True, "dexterity": {"gci_samples": 200},
+                     "trajectory": {"paper_motion": True}},
+        "objectives": [{"maximize": "orientation_capability"}, {"maximize": "gci"}],
+        "constraints": [{"worst_kappa": {"max": 4.5}}],
+        "optimizer": {"method": "sobol", "samples": 12}, "seed": 3,
+        "output": str(tmp / name), "top": 3}
+    if ladder:
+        data["tolerance_ladder"] = ladder
+    p = tmp / f"{name}.yaml"
+    p.write_text(yaml.safe_dump(data))
+    return load_study(p)
+
+
+def test_a_deferred_evaluator_runs_only_for_re_certified_candidates(tmp_path, monkeypatch):
+    """The paper motion (no objective or constraint reads it) is not computed on the coarse
+    rung: re-certified candidates get it exactly as a run without the ladder computes it (the
+    Pareto records and the exported designs are the plain run's, every metric ==), pruned
+    ones keep it null with a note, and it runs once per re-certified candidate only."""
+    from pkmlab.study import SerialRunner, run_study
+    from pkmlab.study.export import chosen_designs
+    from pkmlab.study.ladder import NOT_COMPUTED, coarse_evaluation, deferred
+    from pkmlab.study.report import pareto_records
+
+    s0 = _sobol_study(tmp_path, "plain")
+    store = run_study(s0, SerialRunner())
+    r0 = store.all()
+    store.close()
+    s1 = _sobol_study(tmp_path, "ladder", {"coarse": {"angle": "1 deg"}})
+    assert deferred(s1) == ("trajectory",)
+    assert "trajectory" not in coarse_evaluation(s1).evaluators
+    runs = []
+    traj = EVALUATORS["trajectory"]
+    real = traj.compute
+    monkeypatch.setattr(traj, "compute", lambda mech, ctx: runs.append(1) or real(mech, ctx))
+    store = run_study(s1, SerialRunner())
+    r1, meta = store.all(), store.get_meta("ladder")
+    store.close()
+    f0, f1 = pareto_records(s0, r0), pareto_records(s1, r1)
+    assert len(f0) >= 2 and [r["params"] for r in f0] == [r["params"] for r in f1]
+    for a, b in zip(f0, f1, strict=True):
+        assert {m: b["metrics"][m] for m in a["metrics"]} == a["metrics"]
+        assert b["metrics"]["paper_motion_fits"] is not None
+    e0, e1 = chosen_designs(s0, f0), chosen_designs(s1, f1)
+    assert [(r["params"], k) for r, k, _ in e0] == [(r["params"], k) for r, k, _ in e1]
+    fine = {str(r["params"]): r for r in r0}
+    pruned = [r for r in r1 if r["status"] == "pruned"]
+    assert pruned and meta["pruned"] == len(pruned)
+    for r in pruned:
+        assert r["metrics"]["paper_motion_fits"] is None
+        assert r["notes"]["paper_motion_fits"] == NOT_COMPUTED
+    for r in r1:
+        if r["status"] == "ok":          # re-certified: the plain run's values and notes
+            ref = fine[str(r["params"])]
+            for m in ("paper_motion_fits", "paper_motion_margin"):
+                assert r["metrics"][m] == ref["metrics"][m]
+                assert r["notes"].get(m) == ref["notes"].get(m)
+    assert len(runs) == meta["refined"]   # baseline and re-certified candidates only

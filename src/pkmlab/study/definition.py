@@ -59,6 +59,8 @@ class Evaluation:
     plans: Mapping[str, Any]
     request: dict | None = None
     tolerances: Any = None
+    #: evaluators a tolerance ladder's coarse rung leaves to the re-certification (.ladder)
+    deferred: frozenset = frozenset()
 
     def __post_init__(self):
         object.__setattr__(self, "plans", MappingProxyType(dict(self.plans)))
@@ -76,16 +78,19 @@ class Evaluation:
 
     def __getstate__(self):
         return {"plans": dict(self.plans), "request": self.request,
-                "tolerances": self.tolerances}
+                "tolerances": self.tolerances, "deferred": self.deferred}
 
     def __setstate__(self, state):
         object.__setattr__(self, "plans", MappingProxyType(state["plans"]))
         object.__setattr__(self, "request", state["request"])
         object.__setattr__(self, "tolerances", state.get("tolerances"))
+        object.__setattr__(self, "deferred", state.get("deferred", frozenset()))
 
-    def with_tolerances(self, tolerances) -> Evaluation:
-        """This evaluation with other certified tolerances (:class:`.ladder.Tolerances`)."""
-        return Evaluation(self.plans, self.request, tolerances)
+    def with_tolerances(self, tolerances, deferred=()) -> Evaluation:
+        """This evaluation with other certified tolerances (:class:`.ladder.Tolerances`),
+        without the evaluators ``deferred`` (a tolerance ladder's coarse rung leaves them to
+        the re-certification: :func:`.ladder.deferred`)."""
+        return Evaluation(self.plans, self.request, tolerances, frozenset(deferred))
 
     @property
     def angle_tolerance_deg(self) -> float:
@@ -113,7 +118,8 @@ class Evaluation:
     @property
     def evaluators(self) -> tuple[str, ...]:
         """Evaluator names in evaluation order (the registry's order)."""
-        return tuple(n for n, ev in EVALUATORS.items() if ev.runs(self))
+        return tuple(n for n, ev in EVALUATORS.items() if ev.runs(self)
+                     and n not in self.deferred)
 
     @property
     def metrics(self) -> tuple[str, ...]:
