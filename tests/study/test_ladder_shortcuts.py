@@ -11,7 +11,9 @@ Each shortcut is compared with the computation it replaces, with no tolerance (`
   recomputed over the same poses with the full rule;
 * the ladder's coarse rung skips the capability point's random-rotation check (notes only):
   the coarse capability's metrics equal the checked search's, the check does not run on the
-  coarse rung and does run on the fine one.
+  coarse rung and does run on the fine one;
+* evaluators no objective or constraint reads wait for the re-certification: a Sobol study
+  with the paper motion deferred exports the plain run's Pareto records and designs.
 """
 
 from __future__ import annotations
@@ -23,6 +25,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
+from conftest import MECH_DIR
 from scipy.stats import qmc
 
 from pkmlab import dexterity as dx
@@ -161,9 +165,6 @@ def test_the_coarse_rung_skips_only_the_point_check(demo, monkeypatch):
 # ---- evaluators no objective or constraint reads wait for the re-certification -------------
 
 def _sobol_study(tmp, name, ladder=None):
-    from conftest import MECH_DIR
-    import yaml
-
     data = {
         "study": "deferred", "mechanism": {"file": str(MECH_DIR / "hopkins-williams-6psu.yaml")},
         "design": {"platform_outer_radius": {"low": "55 mm", "high": "90 mm"},

@@ -15,14 +15,20 @@ worst case replaced by certified bounds from a subset of its samples
 (:mod:`.evaluators.worst_bound`: ``worst_kappa`` a lower bound, ``min_force`` an upper one,
 ``singularity_free`` 0 only on a singular sample). Every other metric does not depend on them.
 
+**Deferred evaluators** (:func:`deferred`). A standalone evaluator whose metrics no
+objective or constraint reads (the paper motion, the task) is not run on the coarse rung: the
+optimiser and the pruning never read it. Its metrics are null with a note until the candidate
+is re-certified, where it runs exactly as in a run without the ladder; a pruned candidate
+keeps them null, noted as not computed.
+
 **Refinement** (:func:`refine`, after the optimiser). The stored candidates are re-certified at
 the fine tolerances (the study's own: exactly what a run without the ladder computes), front by
 front of their coarse values, best first, one batch of workers at a time (within a front, the
 candidates whose certified worst case dominates the most others' best cases first). Only the
-laddered metrics are computed again (:data:`LADDERED`; the dexterity's worst-case metrics
-alone); their fine values replace the coarse ones, and the coarse ones stay in the record as
-``<metric>_coarse``. A failure at the fine tolerance (an invalid design, a declared numerical
-failure) is stored as that status, with the reason and the coarse values.
+laddered metrics (:data:`LADDERED`; the dexterity's worst-case metrics alone) and the deferred
+evaluators' are computed; the fine values replace the coarse ones, and the coarse ones stay in
+the record as ``<metric>_coarse``. A failure at the fine tolerance (an invalid design, a
+declared numerical failure) is stored as that status, with the reason and the coarse values.
 
 **Certified pruning.** Each laddered metric's fine value is bracketed by the coarse run's proofs
 (:func:`bounds`): the fine ``orientation_capability`` lies at most at the coarse
