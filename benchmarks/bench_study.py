@@ -20,12 +20,17 @@ length: 0.1 mm, worst_case: W}}`` (``--coarse A W``: A in deg, default 0.1; W ``
 default, or ``exact``); it reports the CPU time per candidate of each (the ladder's includes
 its re-certification), the ratio in that one run, how many candidates were refined and pruned,
 and whether every candidate both runs evaluated has identical final metrics (issue 28).
+``--ladder-compare SRC [G]`` runs ``--ladder`` in fresh processes alternately with the sources
+in ``SRC`` and this checkout's (twice each, after a round that fills the kernel caches) and
+reports both rates of each and the ratios in that one run, and whether the ladder runs' Pareto
+records are identical (issue 28, session 5).
 ``--ladder-sobol N`` does the same with the demo's evaluation on N Sobol candidates instead
 of its NSGA-II (the same candidates in both runs: the fronts and the exported designs must be
 the same).
 
     python benchmarks/bench_study.py [--full | --cpu [N] | --compare SRC [N] | --ladder [G]
-                                      | --ladder-sobol N] [--coarse A W]
+                                      | --ladder-compare SRC [G] | --ladder-sobol N]
+                                      [--coarse A W]
 """
 
 from __future__ import annotations
@@ -128,7 +133,8 @@ def _run_demo(tmp: Path, name: str, generations: int | None, ladder: dict | None
     return cpu, records, pareto_records(study, records), meta
 
 
-def ladder_mode(generations: int | None, coarse: dict, sobol: int | None = None) -> None:
+def ladder_mode(generations: int | None, coarse: dict, sobol: int | None = None,
+                json_out: bool = False) -> None:
     import tempfile
 
     from pkmlab.runtime.threads import single_thread_worker
@@ -152,6 +158,12 @@ def ladder_mode(generations: int | None, coarse: dict, sobol: int | None = None)
     fsame = [fine[k]["metrics"] == final(r) for r in f1
              if (k := json.dumps(r["params"], sort_keys=True)) in fine]
     n0, n1 = len(r0), len(r1)
+    if json_out:
+        print(json.dumps({"plain": c0 / n0, "ladder": c1 / n1, "n": [n0, n1], "meta": meta,
+                          "same": [sum(same), len(same)], "load": [min(loads), max(loads)],
+                          "pareto": {json.dumps(r["params"], sort_keys=True): final(r)
+                                     for r in f1}}, default=str))
+        return
     how = (f"{sobol} Sobol candidates" if sobol else
            f"NSGA-II, {generations or 'its own'} generations")
     print(f"demo study ({how}), one numba thread, CPU per candidate; ladder {coarse}; load "
@@ -167,6 +179,40 @@ def ladder_mode(generations: int | None, coarse: dict, sobol: int | None = None)
           f"{sorted(_key(r) for r in f0) == sorted(_key(r) for r in f1)}")
 
 
+def ladder_compare(base_src: str, generations: int | None, rounds: int = 2) -> None:
+    """``--ladder`` in fresh processes, alternately with the sources in ``base_src`` and this
+    checkout's (own kernel caches; a first round fills them), ``rounds`` times each."""
+    here = str(ROOT / "src")
+    runs = {"before": [], "now": []}
+    args = [str(generations)] if generations else []
+    for rep in range(rounds + 1):
+        for name, src in (("before", base_src), ("now", here)):
+            env = {**os.environ, "PYTHONPATH": src,
+                   "NUMBA_CACHE_DIR": f"/tmp/numba-bench-study-{name}-{os.getuid()}"}
+            proc = subprocess.run([sys.executable, __file__, "--ladder-json", *args], env=env,
+                                  capture_output=True, text=True, check=True)
+            if rep:
+                runs[name].append(json.loads(proc.stdout.splitlines()[-1]))
+    loads = [x for v in runs.values() for r in v for x in r["load"]]
+    print(f"demo study (NSGA-II, {generations or 'its own'} generations), one numba thread, CPU "
+          f"per candidate, {rounds} runs of each source alternating, fresh processes; load "
+          f"average {min(loads):.2f}-{max(loads):.2f} (2 cores)")
+    med = {}
+    for name, src in (("before", base_src), ("now", here)):
+        v = runs[name]
+        plain = float(np.median([r["plain"] for r in v]))
+        lad = float(np.median([r["ladder"] for r in v]))
+        med[name] = (plain, lad)
+        print(f"  {name:6s} ({src}): without the ladder {1e3 * plain:.1f} ms ({2 / plain:.1f}/s), "
+              f"with it {1e3 * lad:.1f} ms ({2 / lad:.1f}/s, {plain / lad:.2f}x); runs "
+              + ", ".join(f"{1e3 * r['plain']:.1f}/{1e3 * r['ladder']:.1f} ms {r['meta']}"
+                          for r in v))
+    print(f"  now / before: without the ladder {med['before'][0] / med['now'][0]:.2f}x, with it "
+          f"{med['before'][1] / med['now'][1]:.2f}x; identical ladder Pareto records (designs "
+          f"and final metrics) before and now in every run: "
+          f"{all(a['pareto'] == b['pareto'] for a, b in zip(runs['before'], runs['now']))}")
+
+
 def _key(r) -> str:
     return json.dumps(r["params"], sort_keys=True)
 
@@ -178,6 +224,16 @@ def main() -> None:
         coarse.update(angle=f"{sys.argv[i + 1]} deg", worst_case=sys.argv[i + 2])
     if "--ladder-sobol" in sys.argv:
         ladder_mode(None, coarse, int(sys.argv[sys.argv.index("--ladder-sobol") + 1]))
+        return
+    if "--ladder-compare" in sys.argv:
+        i = sys.argv.index("--ladder-compare")
+        g = sys.argv[i + 2] if len(sys.argv) > i + 2 else ""
+        ladder_compare(sys.argv[i + 1], int(g) if g.isdigit() else None)
+        return
+    if "--ladder-json" in sys.argv:
+        i = sys.argv.index("--ladder-json")
+        g = sys.argv[i + 1] if len(sys.argv) > i + 1 else ""
+        ladder_mode(int(g) if g.isdigit() else None, coarse, json_out=True)
         return
     if "--ladder" in sys.argv:
         i = sys.argv.index("--ladder")

@@ -91,13 +91,17 @@ def _payload(payload, n: int) -> np.ndarray:
     return np.broadcast_to(w, (n, POSE_SIZE)).copy()
 
 
-def transpose_inverse(J: np.ndarray, L: float | None = None
+def transpose_inverse(J: np.ndarray, L: float | None = None, *,
+                      singular: np.ndarray | None = None
                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``G = J⁻ᵀ`` for a stack of square Jacobians, with masks.
 
     Args:
         J: ``(N, 6, 6)`` twist-to-joint Jacobians (or ``(N, w, w)``, a lower mobility's).
         L: characteristic length (mm) of the singular rule; ``None``: ``J`` as given.
+        singular: ``(N,)`` :func:`pkmlab.dexterity.is_singular` ``(J, L)`` when the caller
+            already has it (from κ of the same ``J`` with the same ``L``): the singular values
+            are then not computed again. It must be that rule's result.
 
     Returns:
         ``(G, finite, singular)``: ``G (N, 6, 6)`` (NaN where not computed), ``finite (N,)``
@@ -106,7 +110,8 @@ def transpose_inverse(J: np.ndarray, L: float | None = None
     """
     J = _jac(J, any_width=True)
     finite = np.all(np.isfinite(J), axis=(1, 2))
-    singular = finite & is_singular(J, L)
+    singular = finite & (is_singular(J, L) if singular is None
+                         else np.asarray(singular, dtype=bool))
     G = np.full(J.shape, np.nan)
     good = finite & ~singular
     if np.any(good):
@@ -114,8 +119,8 @@ def transpose_inverse(J: np.ndarray, L: float | None = None
     return G, finite, singular
 
 
-def _isotropic(J, f_max, rotational: bool, L, mobility=None) -> np.ndarray:
-    G, finite, singular = transpose_inverse(J, L)
+def _isotropic(J, f_max, rotational: bool, L, mobility=None, singular=None) -> np.ndarray:
+    G, finite, singular = transpose_inverse(J, L, singular=singular)
     cols = block_columns(G, mobility, rotational)
     if not isinstance(cols, slice) and len(cols) == 0:
         raise ParameterError("mobility", "a mechanism with a free "
@@ -130,7 +135,8 @@ def _isotropic(J, f_max, rotational: bool, L, mobility=None) -> np.ndarray:
 
 
 def max_force_all_directions(J: np.ndarray, f_max, L: float | None = None,
-                             mobility=None) -> np.ndarray:
+                             mobility=None, *, singular: np.ndarray | None = None
+                             ) -> np.ndarray:
     """Largest force magnitude (N) that can be held in *every* direction with zero moment.
 
     ``F_iso = min_i f_max_i / ‖(J⁻ᵀ)_{i,0:3}‖`` (exact for a square invertible J; see the
@@ -144,13 +150,15 @@ def max_force_all_directions(J: np.ndarray, f_max, L: float | None = None,
         L: characteristic length (mm) of the singular rule; ``None``: ``J`` as given.
         mobility: the mechanism's :class:`~pkmlab.mechanisms.Mobility` (needed unless J has
             six columns).
+        singular: the singular rule's ``(N,)`` result for these ``J`` and ``L``, when the
+            caller has it (:func:`transpose_inverse`).
 
     Returns:
         ``(N,)`` force in N; 0 where J is singular (a parallel singularity leaves some wrench
         unbalanced — reported conservatively as no capability); NaN exactly where J has a
         non-finite entry.
     """
-    return _isotropic(J, f_max, False, L, mobility)
+    return _isotropic(J, f_max, False, L, mobility, singular)
 
 
 def max_moment_all_directions(J: np.ndarray, f_max, L: float | None = None,

@@ -454,6 +454,24 @@ def resolve_length(mech, L=None) -> CharacteristicLength:
         k = condition_number(J, CharacteristicLength(val, 0.0, False, False, rotational=cols))
         return CharacteristicLength(val, float(k[0]), False, False, "given",
                                     f"L = {val:.6g} mm given by the caller", cols)
+    # the default is a property of the (frozen) mechanism: one Angeles search per instance,
+    # however many evaluators ask (three per study candidate: dexterity, task, paper motion)
+    memo = getattr(mech, "__dict__", None)
+    if memo is not None and _DEFAULT_LENGTH in memo:
+        return memo[_DEFAULT_LENGTH]
+    cl = _default_length(mech, spatial, rot)
+    if memo is not None:
+        memo[_DEFAULT_LENGTH] = cl
+    return cl
+
+
+#: where :func:`resolve_length` keeps a mechanism's default length (its instance ``__dict__``,
+#: as ``functools.cached_property`` does)
+_DEFAULT_LENGTH = "_pkmlab_default_length"
+
+
+def _default_length(mech, spatial: bool, rot) -> CharacteristicLength:
+    """Angeles' length at the nominal pose, or the joint-radius fallback (resolve_length)."""
     cl = characteristic_length(mech)
     if cl.ok:
         return cl

@@ -100,7 +100,7 @@ from .kernels import ik_free as _ik_free
 from .kernels import tiles as _tiles
 from .mobility import SPATIAL, Mobility
 from .results import LEG_STATUS, NO_STROKE, AssemblyModes, FKResult, IKResult
-from .solvers import bracketed_root, forward_newton, multistart_modes
+from .solvers import forward_newton, mid_stroke_pose, multistart_modes
 from .validation import as_points, as_positive, as_stroke, as_vector3
 
 log = logging.getLogger(__name__)
@@ -521,29 +521,7 @@ class Mechanism(JointsMixin):
 
     def _mid_stroke_pose(self) -> np.ndarray:
         """Level, centred pose whose mean actuator value is mid-stroke (highest such z)."""
-        lo, hi = self.stroke
-        mid = 0.5 * (lo + hi)
-        yaw = self._level_yaw()
-        Rz = np.array([[[np.cos(yaw), -np.sin(yaw), 0.0], [np.sin(yaw), np.cos(yaw), 0.0],
-                        [0.0, 0.0, 1.0]]])
-
-        def mean_q(z: float) -> float:
-            r = self._run_ik(np.array([[0.0, 0.0, z]]), Rz, *NO_STROKE)
-            return float(np.mean(r.q[0])) - mid if r.valid[0] else np.nan
-
-        S = self.scale
-        zs = np.linspace(3.0 * S + hi, -S, 801)
-        scan = self._run_ik(np.stack([np.zeros(801), np.zeros(801), zs], axis=1),
-                            np.ascontiguousarray(np.broadcast_to(Rz, (801, 3, 3))), *NO_STROKE)
-        vals = np.where(scan.valid, scan.q.mean(axis=1) - mid, np.nan)
-        for k in range(len(zs) - 1):
-            a, b = vals[k], vals[k + 1]
-            if np.isfinite(a) and np.isfinite(b) and a * b <= 0:
-                z = bracketed_root(mean_q, zs[k + 1], zs[k], xtol=TOL.nominal_z_mm)
-                return np.array([0.0, 0.0, z, 0.0, 0.0, yaw])
-        raise ParameterError("stroke", "a window whose mid-point is reachable by a level, "
-                             "centred platform (the nominal pose: give 'nominal' or change the "
-                             "stroke or the link lengths)", list(self.stroke))
+        return mid_stroke_pose(self)
 
     def _random_starts(self, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
         rng = np.random.default_rng(seed)

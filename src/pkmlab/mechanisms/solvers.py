@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..poses import POSE_SIZE, as_frames, frames_to_poses, log_so3
+from ..runtime.threads import threads_for
 from ..tolerances import TOL
 from .kernels import ik as _kernels
 from .results import NO_STROKE, AssemblyModes, FKResult, step_frames
@@ -37,6 +38,49 @@ def bracketed_root(f, a: float, b: float, xtol: float) -> float:
         else:
             b = m
     return float(0.5 * (a + b))
+
+
+def mid_stroke_pose(mech) -> np.ndarray:
+    """The level, centred pose whose mean actuator value is mid-stroke (highest such z):
+    a scan of z on the axis, then bisection to ``TOL.nominal_z_mm`` in the first interval
+    that changes sign (``Mechanism._mid_stroke_pose``)."""
+    lo, hi = mech.stroke
+    mid = 0.5 * (lo + hi)
+    yaw = mech._level_yaw()
+    Rz = np.array([[[np.cos(yaw), -np.sin(yaw), 0.0], [np.sin(yaw), np.cos(yaw), 0.0],
+                    [0.0, 0.0, 1.0]]])
+
+    # the root search evaluates one pose ~40 times (to 1e-12 mm): one driver and one set
+    # of buffers for all of them: the same kernel, arithmetic and leg check as _run_ik
+    g, L = mech._ik_geometry, mech.n_actuators
+    frames = _kernels.make_driver(mech._ik_kernel(), len(g), "frames", L)
+    P, Rc = np.zeros((1, 3)), _kernels.carray(Rz)
+    q, st, reason = np.empty((1, L)), np.empty((1, L), np.int8), np.empty(1, np.int8)
+    q_lo, q_hi = (float(v) for v in NO_STROKE)
+
+    def mean_q(z: float) -> float:
+        P[0, 2] = z
+        frames(P, Rc, g, q_lo, q_hi, q, st, reason)
+        if reason[0] == _kernels.LEG_FAULT:
+            mech._check_legs(reason)
+        return float(np.mean(q[0])) - mid if reason[0] == _kernels.OK else np.nan
+
+    S = mech.scale
+    zs = np.linspace(3.0 * S + hi, -S, 801)
+    scan = mech._run_ik(np.stack([np.zeros(801), np.zeros(801), zs], axis=1),
+                        np.ascontiguousarray(np.broadcast_to(Rz, (801, 3, 3))), *NO_STROKE)
+    vals = np.where(scan.valid, scan.q.mean(axis=1) - mid, np.nan)
+    a, b = vals[:-1], vals[1:]
+    # the first scan interval whose ends are finite and change sign (or touch zero)
+    hit = np.flatnonzero(np.isfinite(a) & np.isfinite(b) & (a * b <= 0))
+    if len(hit):
+        k = int(hit[0])
+        with threads_for(1):
+            z = bracketed_root(mean_q, zs[k + 1], zs[k], xtol=TOL.nominal_z_mm)
+        return np.array([0.0, 0.0, z, 0.0, 0.0, yaw])
+    raise ParameterError("stroke", "a window whose mid-point is reachable by a level, "
+                         "centred platform (the nominal pose: give 'nominal' or change the "
+                         "stroke or the link lengths)", list(mech.stroke))
 
 
 def _solve(G: np.ndarray, f: np.ndarray) -> np.ndarray:

@@ -59,6 +59,8 @@ class Evaluation:
     plans: Mapping[str, Any]
     request: dict | None = None
     tolerances: Any = None
+    #: evaluators a tolerance ladder's coarse rung leaves to the re-certification (.ladder)
+    deferred: frozenset = frozenset()
 
     def __post_init__(self):
         object.__setattr__(self, "plans", MappingProxyType(dict(self.plans)))
@@ -76,16 +78,19 @@ class Evaluation:
 
     def __getstate__(self):
         return {"plans": dict(self.plans), "request": self.request,
-                "tolerances": self.tolerances}
+                "tolerances": self.tolerances, "deferred": self.deferred}
 
     def __setstate__(self, state):
         object.__setattr__(self, "plans", MappingProxyType(state["plans"]))
         object.__setattr__(self, "request", state["request"])
         object.__setattr__(self, "tolerances", state.get("tolerances"))
+        object.__setattr__(self, "deferred", state.get("deferred", frozenset()))
 
-    def with_tolerances(self, tolerances) -> Evaluation:
-        """This evaluation with other certified tolerances (:class:`.ladder.Tolerances`)."""
-        return Evaluation(self.plans, self.request, tolerances)
+    def with_tolerances(self, tolerances, deferred=()) -> Evaluation:
+        """This evaluation with other certified tolerances (:class:`.ladder.Tolerances`),
+        without the evaluators ``deferred`` (a tolerance ladder's coarse rung leaves them to
+        the re-certification: :func:`.ladder.deferred`)."""
+        return Evaluation(self.plans, self.request, tolerances, frozenset(deferred))
 
     @property
     def angle_tolerance_deg(self) -> float:
@@ -98,6 +103,13 @@ class Evaluation:
         return (self.tolerances or FINE).length
 
     @property
+    def coarse(self) -> bool:
+        """The evaluation of a tolerance ladder's coarse rung (:mod:`.ladder`): each of its
+        candidates is re-certified at the fine tolerances or pruned, so a check that changes
+        no metric (the capability point's random-rotation check) waits for the fine rung."""
+        return self.tolerances is not None
+
+    @property
     def worst_case_exact(self) -> bool:
         """The dexterity's worst case over every sample (else certified bounds from a
         subset: a tolerance ladder's coarse rung)."""
@@ -106,7 +118,8 @@ class Evaluation:
     @property
     def evaluators(self) -> tuple[str, ...]:
         """Evaluator names in evaluation order (the registry's order)."""
-        return tuple(n for n, ev in EVALUATORS.items() if ev.runs(self))
+        return tuple(n for n, ev in EVALUATORS.items() if ev.runs(self)
+                     and n not in self.deferred)
 
     @property
     def metrics(self) -> tuple[str, ...]:

@@ -15,14 +15,20 @@ worst case replaced by certified bounds from a subset of its samples
 (:mod:`.evaluators.worst_bound`: ``worst_kappa`` a lower bound, ``min_force`` an upper one,
 ``singularity_free`` 0 only on a singular sample). Every other metric does not depend on them.
 
+**Deferred evaluators** (:func:`deferred`). A standalone evaluator whose metrics no
+objective or constraint reads (the paper motion, the task) is not run on the coarse rung: the
+optimiser and the pruning never read it. Its metrics are null with a note until the candidate
+is re-certified, where it runs exactly as in a run without the ladder; a pruned candidate
+keeps them null, noted as not computed.
+
 **Refinement** (:func:`refine`, after the optimiser). The stored candidates are re-certified at
 the fine tolerances (the study's own: exactly what a run without the ladder computes), front by
 front of their coarse values, best first, one batch of workers at a time (within a front, the
 candidates whose certified worst case dominates the most others' best cases first). Only the
-laddered metrics are computed again (:data:`LADDERED`; the dexterity's worst-case metrics
-alone); their fine values replace the coarse ones, and the coarse ones stay in the record as
-``<metric>_coarse``. A failure at the fine tolerance (an invalid design, a declared numerical
-failure) is stored as that status, with the reason and the coarse values.
+laddered metrics (:data:`LADDERED`; the dexterity's worst-case metrics alone) and the deferred
+evaluators' are computed; the fine values replace the coarse ones, and the coarse ones stay in
+the record as ``<metric>_coarse``. A failure at the fine tolerance (an invalid design, a
+declared numerical failure) is stored as that status, with the reason and the coarse values.
 
 **Certified pruning.** Each laddered metric's fine value is bracketed by the coarse run's proofs
 (:func:`bounds`): the fine ``orientation_capability`` lies at most at the coarse
@@ -53,11 +59,13 @@ from .definition import FINE, Tolerances
 from .evaluators import EVALUATORS
 from .evaluators.dexterity import worst_metrics
 from .evaluators.registry import Context
+from .metrics import METRICS, metrics_of
 from .objectives import feasible, objective_matrix
 from .selection import non_dominated
 
 __all__ = ["Tolerances", "ToleranceLadder", "LADDERED", "FINE", "bounds", "refine",
-           "ladder_from_spec", "coarse_name", "coarse_view"]
+           "ladder_from_spec", "coarse_name", "coarse_view", "deferred", "deferred_metrics",
+           "coarse_evaluation"]
 
 
 @dataclass(frozen=True)
@@ -130,6 +138,15 @@ _NEEDS = {"dexterity": ("workspace",)}
 #: dexterity's other metrics (GCI, sampled statistics) do not depend on the rung
 _REFINE = {"dexterity": worst_metrics}
 _BOUNDS = {m: b for ms in LADDERED.values() for m, b in ms.items()}
+#: evaluators that read nothing another evaluator leaves in the context and leave nothing
+#: another reads, but for the evaluators listed (the task's placed centre: ``motions``): the
+#: coarse rung can leave them to the re-certification when no objective or constraint reads
+#: their metrics (:func:`deferred`)
+_STANDALONE = {"trajectory": (), "task": ("motions",)}
+#: the note of a deferred metric: before the re-certification, and on a pruned candidate
+PENDING = "computed when the candidate is re-certified at the fine tolerance (tolerance ladder)"
+NOT_COMPUTED = ("not computed: the candidate was pruned before its re-certification (tolerance "
+                "ladder); no objective or constraint reads this metric")
 
 
 def coarse_name(metric: str) -> str:
@@ -151,6 +168,32 @@ def bounds(record: dict, metric: str, names=None) -> tuple[float, float]:
         return default if v is None else float(v)
     # an open end (upper None: the search's largest box had a position) bounds nothing
     return value(lo, -math.inf), value(hi, math.inf)
+
+
+def deferred(study) -> tuple[str, ...]:
+    """The evaluators of ``study`` that its ladder's coarse rung leaves to the
+    re-certification, in evaluation order: standalone ones (:data:`_STANDALONE`) whose
+    metrics no objective or constraint reads and that no other evaluator of the study waits
+    for. A pruned candidate needs only what proves it pruned; a re-certified one gets them
+    computed exactly as a run without the ladder does."""
+    ev = study.evaluation
+    used = {o.metric for o in study.objectives} | {c.metric for c in study.constraints}
+    runs = ev.evaluators
+    return tuple(n for n in runs if n in _STANDALONE and not used & set(metrics_of(n))
+                 and not any(r in runs for r in _STANDALONE[n])
+                 and not any(n in EVALUATORS[m].after or n in EVALUATORS[m].requires
+                             for m in runs))
+
+
+def deferred_metrics(study) -> list[str]:
+    """The metrics of :func:`deferred` evaluators that the study's evaluation writes."""
+    d = deferred(study)
+    return [m for m in study.evaluation.metrics if METRICS[m].evaluator in d]
+
+
+def coarse_evaluation(study):
+    """The evaluation the optimiser's candidates get on the ladder's coarse rung."""
+    return study.evaluation.with_tolerances(study.tolerance_ladder.coarse, deferred(study))
 
 
 def laddered(evaluation, ladder: ToleranceLadder) -> list[str]:
@@ -218,8 +261,11 @@ def refine(study, runner, store) -> dict:
     """Re-certify the stored candidates at the fine tolerances, pruning those certainly
     dominated (module notes) → ``{"refined": n, "pruned": n}``."""
     ladder = study.tolerance_ladder
-    evaluators = tuple(laddered(study.evaluation, ladder))
-    names = [m for n in evaluators for m in LADDERED[n]]
+    later = deferred(study)
+    evaluators = tuple(n for n in study.evaluation.evaluators
+                       if n in laddered(study.evaluation, ladder) or n in later)
+    names = [m for n in evaluators if n in LADDERED for m in LADDERED[n]]
+    pending = deferred_metrics(study)
     ok = [r for r in store.all() if r["status"] == "ok"]
     fresh = [not any(coarse_name(m) in r["metrics"] for m in names) for r in ok]
     todo = [r for r, f in zip(ok, fresh, strict=True) if f]
@@ -255,7 +301,7 @@ def refine(study, runner, store) -> dict:
                         why = (f"certainly dominated by evaluation {dominators[j]['seq']}: best "
                                f"case {_text(study, best)} vs {_text(study, Fd[j])}")
             if why:
-                _prune(store, r, names, why)
+                _prune(store, r, names, why, pending)
                 counts["pruned"] += 1
             elif i in front or r["role"] == "baseline":
                 batch.append(r)
@@ -272,7 +318,7 @@ def refine(study, runner, store) -> dict:
                              seed, evaluators)) for r in batch]
         by_key = {r["key"]: r for r in batch}
         for key, res in runner.map(refine_design, tasks):
-            rec = _refined(store, by_key[key], names, res)
+            rec = _refined(store, by_key[key], names, res, pending)
             if rec["role"] == "candidate" and feasible(study, [rec])[0]:
                 dominators.append(rec)
             counts["refined"] += 1
@@ -320,25 +366,30 @@ def _text(study, row) -> str:
                            for o, v in zip(study.objectives, row, strict=True)) + ")"
 
 
-def _refined(store, record, names, res) -> dict:
+def _refined(store, record, names, res, pending=()) -> dict:
     metrics = dict(record["metrics"])
     for m in names:
         metrics[coarse_name(m)] = metrics.get(m)
         if res["status"] != "ok":
             metrics[m] = None
     metrics.update(res["metrics"])
-    notes = {k: v for k, v in record["notes"].items() if k not in names}
-    notes.update({k: v for k, v in res["notes"].items() if k in names})
+    fresh = set(names) | set(pending)     # the re-certification's metrics and their notes
+    notes = {k: v for k, v in record["notes"].items() if k not in fresh}
+    notes.update({k: v for k, v in res["notes"].items() if k in fresh})
     extra = {} if res["status"] == "ok" else {
         "status": res["status"], "reason": f"at the fine tolerance: {res['reason']}"}
     return store.update(record["key"], metrics=metrics, notes=notes,
                         seconds=record["seconds"] + res["seconds"], **extra)
 
 
-def _prune(store, record, names, why: str) -> dict:
+def _prune(store, record, names, why: str, pending=()) -> dict:
     metrics = dict(record["metrics"])
     for m in names:
         metrics[coarse_name(m)] = metrics.pop(m, None)
         metrics[m] = None
-    return store.update(record["key"], metrics=metrics, status="pruned",
+    notes = dict(record["notes"])
+    for m in pending:                     # deferred to a re-certification that never runs
+        metrics[m] = None
+        notes[m] = NOT_COMPUTED
+    return store.update(record["key"], metrics=metrics, notes=notes, status="pruned",
                         reason=f"not re-certified at the fine tolerance: {why}")

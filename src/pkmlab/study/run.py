@@ -20,7 +20,7 @@ from ..runtime.memory import BudgetError
 from .definition import Study
 from .evaluators import check_budget, evaluate_design
 from .folder import OutputLock, check_output, claim, clear_for_overwrite
-from .ladder import coarse_view, refine
+from .ladder import PENDING, coarse_evaluation, coarse_view, deferred_metrics, refine
 from .objectives import feasible, objective_matrix
 from .optimisers import OPTIMISERS, check_time
 from .store import Store, candidate_key
@@ -156,13 +156,18 @@ def _run(study: Study, runner, store: Store, fp: str, progress) -> None:
                                     "resumed": bool(runs)}])
     space, seed = study.space, study.seed
     ladder = study.tolerance_ladder
-    # with a tolerance ladder the optimiser sees the coarse tolerances (.ladder)
-    ev = study.evaluation if ladder is None else study.evaluation.with_tolerances(ladder.coarse)
+    # with a tolerance ladder the optimiser sees the coarse tolerances (.ladder), and the
+    # evaluators no objective or constraint reads wait for the re-certification (null, noted)
+    ev = study.evaluation if ladder is None else coarse_evaluation(study)
+    pending = [] if ladder is None else deferred_metrics(study)
 
     def commit(key, role, params, result):
         if result["status"] == "budget":       # the environment's limit: stop, store nothing
             m = result["metrics"]
             raise BudgetError(m["field"], m["allowed"], Shown(m["got"]))
+        if pending and result["status"] == "ok":
+            result = {**result, "metrics": {**result["metrics"], **dict.fromkeys(pending)},
+                      "notes": {**result["notes"], **dict.fromkeys(pending, PENDING)}}
         store.put(key, role, params, result)
         if progress:
             progress(1)

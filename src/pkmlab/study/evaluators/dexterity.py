@@ -137,9 +137,12 @@ class Dexterity(Evaluator):
         out["gci_std_error"] = finite(g.std_error) if g.ok else None
         out["sampled_max_kappa"] = finite(g.sampled_max_kappa) if g.ok else None
         valid = mech.inverse((p, R)).valid
-        F = dx.max_force_all_directions(mech.jacobian((p[valid], R[valid])),
-                                        plan.force_limit if effort is None else effort, L=L,
-                                        mobility=mech.mobility)
+        J = mech.jacobian((p[valid], R[valid]))
+        # the GCI found no singular pose among these (same poses, J and L): the force's
+        # singular rule need not compute the singular values again
+        known = np.zeros(len(J), bool) if g.ok and g.singular == 0 else None
+        F = dx.max_force_all_directions(J, plan.force_limit if effort is None else effort, L=L,
+                                        mobility=mech.mobility, singular=known)
         out["sampled_min_force"] = float(np.min(F)) if len(F) and effort is not None else None
         if effort is None:
             ctx.notes["sampled_min_force"] = _SERVO

@@ -30,6 +30,7 @@ import numpy as np
 
 from ... import dexterity as dx
 from ...dexterity.aggregate import _units, _voxels
+from ...poses import POSE_SIZE
 
 __all__ = ["WorstBound", "worst_bound", "ALLOWANCE"]
 
@@ -94,8 +95,15 @@ def worst_bound(mech, result, length, effort) -> WorstBound:
     singular = bool(np.any(~np.isfinite(kap)))
     k_low = math.inf if singular else float(np.max(kap)) * (1.0 - ALLOWANCE)
     f_up = math.inf
-    if effort is not None:
-        F = dx.max_force_all_directions(J, effort, L=length.length, mobility=mech.mobility)
+    if effort is not None and singular:
+        f_up = 0.0                                    # the worst case's force there: 0
+    elif effort is not None:
+        # no sample is singular by κ: the force's singular rule (the same singular values
+        # when both homogenise the same way) need not run again
+        same = length.length is None or (J.shape[-1] == POSE_SIZE and
+                                          length.rotational in (None, (3, 4, 5)))
+        F = dx.max_force_all_directions(J, effort, L=length.length, mobility=mech.mobility,
+                                        singular=np.zeros(len(J), bool) if same else None)
         F = np.where(np.isfinite(F), F, 0.0)          # the worst case's rule: 0 there
-        f_up = 0.0 if singular else float(np.min(F)) * (1.0 + ALLOWANCE)
+        f_up = float(np.min(F)) * (1.0 + ALLOWANCE)
     return WorstBound(k_low, f_up, singular, int(valid.sum()))

@@ -197,9 +197,12 @@ def _require(mech, constraints=None):
 
 
 def orientation_capability(mech, samples: int = 7, tol_deg: float = CAPABILITY_TOL_DEG,
-                           max_deg: float = CAPABILITY_MAX_DEG) -> OptimumBracket:
+                           max_deg: float = CAPABILITY_MAX_DEG, *,
+                           check: bool = True) -> OptimumBracket:
     """The orientation capability over continuous positions, bracketed (module notes), in one
-    compiled search."""
+    compiled search. ``check``: the reported point's check at random rotations (a check that
+    can fail, not part of the proof; False skips it and the method says so: a caller that
+    reports no point, such as a tolerance ladder's coarse rung)."""
     require_spatial(mech, "orientation capability")
     _require(mech)
     if not (isinstance(samples, int) and samples >= 2):
@@ -251,7 +254,9 @@ def orientation_capability(mech, samples: int = 7, tol_deg: float = CAPABILITY_T
             else:
                 notes.append(f"the sphere argument proves no point (best slack {slack:.4f} mm):"
                              " the upper end is 180°, the lower end what the cells certified")
-    fails = point_failures(mech, point, math.radians(lower))
+    fails = point_failures(mech, point, math.radians(lower)) if check else 0
+    if not check:
+        method += "; the point's check at random rotations skipped"
     if fails:
         notes.append(f"the point {tuple(round(v, 4) for v in point)} fails {fails} of "
                      f"{CHECK_ROTATIONS:,} random rotations of the ±{lower:g}° box: not "
