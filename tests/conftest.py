@@ -125,3 +125,30 @@ def family_registered(cls):
             REGISTRY.pop(cls.family, None)
         else:
             REGISTRY[cls.family] = before
+
+
+def sampled_designs(study, seed: int, n: int = 16):
+    """``(mech, result)`` for each valid design of ``n`` scrambled Sobol points of
+    ``study``'s space (seed ``seed``) whose workspace (the study's request) is not empty."""
+    import warnings
+
+    from scipy.stats import qmc
+
+    from pkmlab.errors import ParameterError
+    from pkmlab.study.evaluators import EVALUATORS
+    from pkmlab.study.evaluators.registry import Context
+
+    space = study.space
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        u = qmc.Sobol(d=len(space.variables), scramble=True, seed=seed).random(n)
+    for r in u:
+        try:
+            mech = space.decode(space.from_unit(r))
+            _ = mech.nominal_pose
+        except ParameterError:
+            continue
+        ctx = Context(study.evaluation, 1, choices={})
+        EVALUATORS["workspace"](mech, ctx)
+        if not ctx.result.empty:
+            yield mech, ctx.result

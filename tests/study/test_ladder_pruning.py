@@ -12,20 +12,15 @@
 from __future__ import annotations
 
 import math
-import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
-from conftest import MECH_DIR
-from scipy.stats import qmc
+from conftest import MECH_DIR, sampled_designs
 
 from pkmlab import dexterity as dx
-from pkmlab.errors import ParameterError
 from pkmlab.study import SerialRunner, load_study, run_study
-from pkmlab.study.evaluators import EVALUATORS
-from pkmlab.study.evaluators.registry import Context
 from pkmlab.study.evaluators.worst_bound import worst_bound
 from pkmlab.study.export import chosen_designs
 from pkmlab.study.ladder import refine
@@ -39,23 +34,8 @@ def test_the_coarse_worst_case_bounds_the_exact_one_on_demo_designs():
     """8 sampled valid designs of the demo study (±15° dexterous workspace, 2.5 mm grid):
     bound κ ≤ worst_kappa and bound force ≥ min_force exactly; the bound is tight (within
     5 % of the worst κ on the median design: the subset holds the extreme samples)."""
-    study = load_study(DEMO)
-    space = study.space
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UserWarning)
-        u = qmc.Sobol(d=len(space.variables), scramble=True, seed=11).random(16)
     ratios = []
-    for r in u:
-        try:
-            mech = space.decode(space.from_unit(r))
-            _ = mech.nominal_pose
-        except ParameterError:
-            continue
-        ctx = Context(study.evaluation, 1, choices={})
-        EVALUATORS["workspace"](mech, ctx)
-        res = ctx.result
-        if res.empty:
-            continue
+    for mech, res in sampled_designs(load_study(DEMO), 11):
         length = dx.resolve_length(mech, None)
         b = worst_bound(res.mechanism, res, length, 150.0)
         wc = dx.worst_case(res.mechanism, res, length, 150.0)

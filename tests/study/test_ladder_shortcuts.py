@@ -20,17 +20,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
-from conftest import MECH_DIR
-from scipy.stats import qmc
+from conftest import MECH_DIR, sampled_designs
 
 from pkmlab import dexterity as dx
-from pkmlab.errors import ParameterError
 from pkmlab.study import load_study
 from pkmlab.study.evaluators import EVALUATORS
 from pkmlab.study.evaluators import worst_bound as wb
@@ -45,21 +42,9 @@ DEMO = Path(__file__).resolve().parents[2] / "studies" / "hopkins-6psu-redesign.
 def demo():
     """The demo study and 5 of its valid sampled designs whose workspace is not empty."""
     study = load_study(DEMO)
-    space = study.space
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UserWarning)
-        u = qmc.Sobol(d=len(space.variables), scramble=True, seed=5).random(16)
     mechs = []
-    for r in u:
-        try:
-            mech = space.decode(space.from_unit(r))
-            _ = mech.nominal_pose
-        except ParameterError:
-            continue
-        ctx = Context(study.evaluation, 1, choices={})
-        EVALUATORS["workspace"](mech, ctx)
-        if not ctx.result.empty:
-            mechs.append((mech, ctx.result))
+    for mech, res in sampled_designs(study, 5):
+        mechs.append((mech, res))
         if len(mechs) == 5:
             break
     assert len(mechs) == 5

@@ -72,6 +72,7 @@ from functools import cache
 import numpy as np
 from numba import prange
 from numba import types as nt
+from numba.extending import register_jitable
 
 from ..runtime.jit import cached_kernel
 from ..runtime.threads import threads_for
@@ -108,6 +109,23 @@ def cells_available(mech) -> bool:
     return vars(owner).get("_jac_box") is not None
 
 
+@register_jitable(inline="always")
+def _feasible_box(P, order, j0, j1, feas, m, plo, phi):
+    """The box ``plo``–``phi`` of the positions of the units ``order[j0:j1]`` feasible at
+    orientation ``m`` → their count (the box is empty, ``inf``/``-inf``, when none is)."""
+    n = 0
+    for c in range(3):
+        plo[c], phi[c] = np.inf, -np.inf
+    for j in range(j0, j1):
+        u = order[j]
+        if feas[u, m]:
+            n += 1
+            for c in range(3):
+                plo[c] = min(plo[c], P[u, c])
+                phi[c] = max(phi[c], P[u, c])
+    return n
+
+
 @cache
 def _bounds_kernel(jac, box, ng: int):
     def cell_bounds_loop(P, R, order, start, feas, g, L, fmax, K, F, S):
@@ -128,16 +146,7 @@ def _bounds_kernel(jac, box, ng: int):
             pc = np.empty(3)
             for m in range(M):
                 K[t, m], F[t, m], S[t, m] = -np.inf, np.inf, 0
-                n = 0
-                for c in range(3):
-                    plo[c], phi[c] = np.inf, -np.inf
-                for j in range(start[t], start[t + 1]):
-                    u = order[j]
-                    if feas[u, m]:
-                        n += 1
-                        for c in range(3):
-                            plo[c] = min(plo[c], P[u, c])
-                            phi[c] = max(phi[c], P[u, c])
+                n = _feasible_box(P, order, start[t], start[t + 1], feas, m, plo, phi)
                 if n == 0:
                     continue                            # nothing to evaluate in the cell
                 K[t, m], F[t, m] = np.inf, 0.0          # not certified, until shown
@@ -223,16 +232,7 @@ def _lin_bounds_kernel(jac, lin, ng: int):
             v = np.empty((3, 3))
             for m in range(M):
                 K[t, m], F[t, m], S[t, m] = -np.inf, np.inf, 0
-                n = 0
-                for c in range(3):
-                    plo[c], phi[c] = np.inf, -np.inf
-                for j in range(start[t], start[t + 1]):
-                    u = order[j]
-                    if feas[u, m]:
-                        n += 1
-                        for c in range(3):
-                            plo[c] = min(plo[c], P[u, c])
-                            phi[c] = max(phi[c], P[u, c])
+                n = _feasible_box(P, order, start[t], start[t + 1], feas, m, plo, phi)
                 if n == 0:
                     continue                            # nothing to evaluate in the cell
                 K[t, m], F[t, m] = np.inf, 0.0          # not certified, until shown

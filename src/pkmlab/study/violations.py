@@ -52,23 +52,35 @@ def violations(study: Study, record: dict) -> list[tuple[str, float | None, str]
     if record["status"] != "ok":
         why = (record.get("reason") or "").splitlines()
         return [(record["status"], None, why[0] if why else "")]
+
+    def exact(metric):
+        v = _value(record, metric)
+        return (math.nan, math.nan) if v is None else (v, v)
+    out = _crossed(study, exact, lambda metric: _why(record, metric), "")
+    for o in study.objectives:
+        if _value(record, o.metric) is None:
+            out.append((f"{o.sense} {o.metric}", None, _why(record, o.metric)))
+    return out
+
+
+def _crossed(study: Study, bounds, undefined, note: str) -> list[tuple[str, float | None, str]]:
+    """Each constraint bound that ``bounds(metric)`` (its ``(low, high)``; NaN: undefined)
+    crosses whatever the value in it, with the least amount and ``note``; an undefined
+    metric with ``undefined(metric)``."""
     out: list[tuple[str, float | None, str]] = []
     for c in study.constraints:
-        v = _value(record, c.metric)
+        lo, hi = bounds(c.metric)
         for bound, sign in (("min", "≥"), ("max", "≤")):
             b = getattr(c, bound)
             if b is None:
                 continue
             what = f"{c.metric} {sign} {b:g}"
-            if v is None:
-                out.append((what, None, _why(record, c.metric)))
-            else:
-                amount = (b - v) if bound == "min" else (v - b)
-                if amount > 0:
-                    out.append((what, amount, ""))
-    for o in study.objectives:
-        if _value(record, o.metric) is None:
-            out.append((f"{o.sense} {o.metric}", None, _why(record, o.metric)))
+            if math.isnan(lo):
+                out.append((what, None, undefined(c.metric)))
+                continue
+            amount = (b - hi) if bound == "min" else (lo - b)
+            if amount > 0:
+                out.append((what, amount, note))
     return out
 
 
@@ -76,20 +88,8 @@ def _pruned(study: Study, record: dict) -> list[tuple[str, float | None, str]]:
     """A pruned candidate's certain violations from its coarse bounds (:func:`.ladder.bounds`
     on the values the coarse pass stored), else the dominance that pruned it."""
     coarse = ladder.coarse_view(record)
-    out: list[tuple[str, float | None, str]] = []
-    for c in study.constraints:
-        lo, hi = ladder.bounds(coarse, c.metric)
-        for bound, sign in (("min", "≥"), ("max", "≤")):
-            b = getattr(c, bound)
-            if b is None:
-                continue
-            what = f"{c.metric} {sign} {b:g}"
-            if math.isnan(lo):
-                out.append((what, None, "undefined at the coarse tolerance"))
-                continue
-            amount = (b - hi) if bound == "min" else (lo - b)
-            if amount > 0:
-                out.append((what, amount, "certified coarse bound"))
+    out = _crossed(study, lambda metric: ladder.bounds(coarse, metric),
+                   lambda metric: "undefined at the coarse tolerance", "certified coarse bound")
     if out:
         return out
     why = (record.get("reason") or "").splitlines()

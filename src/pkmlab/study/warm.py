@@ -19,6 +19,7 @@ its kernels are compiled by the baseline's evaluation instead.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import multiprocessing
 import os
@@ -92,23 +93,20 @@ def warm_study(path, jobs: int | None = None) -> tuple[float, list[str]]:
         mech = study.space.decode(None)
         here, *others = partition(applicable(mech), jobs)
         others = [b for b in others if b]
-        if others:
-            ctx = multiprocessing.get_context("spawn")      # no numba state forked
-            with ProcessPoolExecutor(len(others), mp_context=ctx) as pool:
-                futures = [pool.submit(_build, study.space, [w.name for w in b])
-                           for b in others]
-                for w in here:
-                    w.build(mech)
-                for f, b in zip(futures, others, strict=True):
-                    try:
-                        entries += f.result()
-                    except Exception as exc:  # noqa: BLE001 - the baseline compiles them
-                        log.warning("a kernel warm-up process failed (%s: %s); its kernels "
-                                    "(%s) compile with the baseline", type(exc).__name__, exc,
-                                    ", ".join(w.name for w in b))
-        else:
+        # spawn: no numba state forked; no other process when every warmer stays here
+        pool = (ProcessPoolExecutor(len(others), mp_context=multiprocessing.get_context("spawn"))
+                if others else contextlib.nullcontext())
+        with pool:
+            futures = [pool.submit(_build, study.space, [w.name for w in b]) for b in others]
             for w in here:
                 w.build(mech)
+            for f, b in zip(futures, others, strict=True):
+                try:
+                    entries += f.result()
+                except Exception as exc:  # noqa: BLE001 - the baseline compiles them
+                    log.warning("a kernel warm-up process failed (%s: %s); its kernels (%s) "
+                                "compile with the baseline", type(exc).__name__, exc,
+                                ", ".join(w.name for w in b))
         compile_baseline(study.space, study.evaluation, study.seed, where="into the cache")
     entries += compiled.entries
     return time.perf_counter() - t0, compile_lines(entries, "into the cache")
