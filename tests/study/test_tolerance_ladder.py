@@ -127,3 +127,12 @@ def test_ladder_is_typed_with_units_and_refused_when_meaningless(tmp_path):
     p.write_text(yaml.safe_dump(d))
     with pytest.raises(ParameterError, match="orientation_capability"):
         load_study(p)
+
+
+def test_the_run_summary_counts_pruned_candidates_apart_from_failures(runs, tmp_path):
+    """``write_report``'s counts (the CLI's "N evaluations (F invalid or failed, P pruned by
+    the tolerance ladder)" line): a pruned candidate is not a failed evaluation."""
+    _, (s1, r1, meta) = runs
+    info = write_report(tmp_path / "rep", s1, r1)
+    assert info["pruned"] == meta["pruned"] > 0
+    assert info["failed"] == sum(r["status"] not in ("ok", "pruned") for r in r1)

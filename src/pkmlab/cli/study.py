@@ -233,8 +233,10 @@ def run(
     if as_json:
         _emit(info)
         return
+    pruned = (f", {info['pruned']} pruned by the tolerance ladder" if info["pruned"] else "")
     out.print(escape(f"{study.name}: {info['evaluations']} evaluations ({info['failed']} "
-                     f"invalid or failed) in {elapsed:.1f} s, {info['pareto']} Pareto designs"),
+                     f"invalid or failed{pruned}) in {elapsed:.1f} s, {info['pareto']} Pareto "
+                     "designs"),
               highlight=False)
     _print_markdown((outp / "summary.md").read_text())
     for p in problems:

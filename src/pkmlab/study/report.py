@@ -116,7 +116,8 @@ def write_report(out: Path, study: Study, records: list[dict]) -> dict:
     for r in records:
         counts[r["status"]] = counts.get(r["status"], 0) + 1
     return {"evaluations": len(records), "pareto": len(front), "statuses": counts,
-            "failed": sum(r["status"] != "ok" for r in records)}
+            "failed": sum(r["status"] not in ("ok", "pruned") for r in records),
+            "pruned": counts.get("pruned", 0)}
 
 
 def _plain(obj):
