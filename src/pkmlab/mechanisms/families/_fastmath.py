@@ -25,7 +25,7 @@ _PI_HI, _PI_LO = 3.14159265358979311600e+00, 1.22464679914735317720e-16
 _TAN_PI8 = 0.41421356237309503
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def atan2(y, x):
     """``math.atan2(y, x)`` for finite inputs, in (-π, π]; 0 at (0, 0)."""
     ax, ay = abs(x), abs(y)

@@ -82,7 +82,7 @@ _PIO2_HI, _PIO2_LO = 1.57079632679489655800e+00, 6.12323399573676603587e-17
 _PI_HI, _PI_LO = 3.1415926535897931160e+00, 1.2246467991473531772e-16
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _atan2(y, x):
     """``atan2(y, x)`` in (-π, π], branch-free (0 for x = y = 0)."""
     ax, ay = abs(x), abs(y)
@@ -115,7 +115,7 @@ def _atan2(y, x):
 # threshold 1e-24·a⁴ on ρ² 78-83, branch 84-89.
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _rss_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, bx, by, bz, tx, ty, tz,
              ux, uy, uz, vx, vy, vz, c, eps, b, qmin, qmax):
     """One leg: ``(α, status)``, α NaN where there is no real solution. ``u``, ``v`` come

@@ -41,7 +41,7 @@ __all__ = ["L", "ik_function"]
 L = 16
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _slider_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, bx, by, bz, tx, ty, tz,
                 ex, ey, ez, l2, side, b, qmin, qmax):
     """One slider leg: ``(q, status)``, ``q = d·e + b·h`` with ``h = sqrt(l² - |d⊥|²)`` (NaN
@@ -61,7 +61,7 @@ def _slider_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, bx, by,
     return (qs if real else np.nan), ss
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _prismatic(x, g, o, qmin, qmax):
     """Leg at offset ``o`` of ``g``, prismatic, at the pose ``x = (px, py, pz, r00, ..., r22)``."""
     px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22 = x
@@ -69,7 +69,7 @@ def _prismatic(x, g, o, qmin, qmax):
                     g[o], g[o + 1], g[o + 2], g[o + 3], g[o + 4], g[o + 5], g[o + 15], qmin, qmax)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _slider(x, g, o, qmin, qmax):
     px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22 = x
     return _slider_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22,
@@ -77,7 +77,7 @@ def _slider(x, g, o, qmin, qmax):
                        g[o + 8], g[o + 9], g[o + 13], g[o + 14], g[o + 15], qmin, qmax)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _crank(x, g, o, qmin, qmax):
     px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22 = x
     return _rss_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22,
@@ -86,7 +86,7 @@ def _crank(x, g, o, qmin, qmax):
                     qmin, qmax)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _linear(x, g, o, qmin, qmax):
     """Prismatic or slider, as declared (both evaluated, the declared one selected)."""
     vp, cp = _prismatic(x, g, o, qmin, qmax)
@@ -95,7 +95,7 @@ def _linear(x, g, o, qmin, qmax):
     return (vp if prism else vs), (cp if prism else cs)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _any(x, g, o, qmin, qmax):
     """Any kind, as declared (the three evaluated, the declared one selected)."""
     vp, cp = _prismatic(x, g, o, qmin, qmax)
@@ -106,7 +106,7 @@ def _any(x, g, o, qmin, qmax):
             (cp if kind == 0.0 else (cs if kind == 1.0 else cc)))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _put(q, st, i, j, vc):
     k = i * _kernels.ROW + j
     q[k] = vc[0]

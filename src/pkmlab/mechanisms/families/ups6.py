@@ -49,7 +49,7 @@ def working_sides(mech) -> np.ndarray:
     return np.where(sz < 0, -1.0, 1.0)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _ups_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, bx, by, bz, ux, uy, uz,
              side, qmin, qmax):
     """One leg: ``(length, status)``; ``side`` (±1) is its working-mode side, a leg on the

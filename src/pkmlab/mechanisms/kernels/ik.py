@@ -25,7 +25,7 @@ programming error of the family, never returned as data). The buffers hold at le
 rows, so a kernel written for six legs behind a smaller declaration stays inside them.
 
 For stage 2 to vectorise, ``one`` must be branch-free (conditional expressions that LLVM turns
-into selects, no early exit or ``continue``; helpers it calls are ``njit(inline="always")``),
+into selects, no early exit or ``continue``; helpers it calls must be inlined, see below),
 its loop over legs must be small enough for LLVM to unroll it (``g`` is then indexed by
 constants; see ``_luzi_one`` for a hand-unrolled one), and ``g``, the family's geometry, is
 passed as a tuple of floats, so its entries are constants to the loop rather than memory that
@@ -33,6 +33,13 @@ the output buffers might alias. The stage loops run from 0 (numba's negative-ind
 otherwise hides from LLVM that the indices are >= 0) over the block's poses rounded up to
 :data:`LANES`, so every pose goes through the same vector code, whatever its position in the
 batch: a pose's result does not depend on the batch it is part of.
+
+Helpers that a per-pose function calls (a leg, ``atan2``, :func:`stroke_status`) are declared
+``njit(cache=True, forceinline=True)``: numba compiles each once per signature and LLVM inlines
+it at every call site, so the legs loop still vectorises. numba's own ``inline="always"``
+instead copies and re-types the helper's IR at every call site, which made the crank kernels
+(six legs, each with an inlined ``atan2``) compile 3-4x longer for bit-identical code (issue
+28, session 6).
 
 Poses with a non-finite coordinate (and, in the Euler driver, poses with an angle beyond
 :data:`TRIG_MAX`, whose rotation is then taken from ``math.sin``/``math.cos``) take a scalar
@@ -120,7 +127,7 @@ LANES = 64
 TRIG_MAX = 1e5
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def stroke_status(q, qmin, qmax):
     if q < qmin:
         return BELOW_STROKE
@@ -145,7 +152,7 @@ _C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015
 _C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _sincos(x):
     """``(sin x, cos x)`` for ``|x| <= TRIG_MAX``, branch-free."""
     fn = np.floor(x * _INVPIO2 + 0.5)          # nearest multiple of π/2, as a float
@@ -168,7 +175,7 @@ def _sincos(x):
     return sin_x, cos_x
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _euler_matrix(sx, cx, sy, cy, sz, cz):
     """Entries ``r00, r01, ..., r22`` of R = Rz·Ry·Rx from the angles' sines and cosines."""
     return (cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx,
@@ -176,7 +183,7 @@ def _euler_matrix(sx, cx, sy, cy, sz, cz):
             -sy, cy * sx, cy * cx)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _store_matrix(T, j, r):
     """Rotation entries ``r`` (9-tuple) into rows 3-11 of the block buffer ``T`` at pose ``j``."""
     T[3 * ROW + j] = r[0]
@@ -190,7 +197,7 @@ def _store_matrix(T, j, r):
     T[11 * ROW + j] = r[8]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _width(m):
     """``m`` rounded up to a multiple of LANES (the low bits are then known zero to LLVM)."""
     return (m + LANES - 1) & ~(LANES - 1)
