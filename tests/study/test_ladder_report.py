@@ -90,8 +90,29 @@ def test_the_pareto_plot_draws_pruned_candidates_at_their_coarse_values(tmp_path
     study_report._plot(tmp_path / "pareto.png", s, [ok, dom], [ok])
     key = next(k for k in drawn if k and k.startswith("pruned"))
     assert drawn[key] == ([24.0], [70.0])
-    assert drawn["infeasible"] == ([], [])
+    # no candidate is infeasible: no such group, and none in the legend
+    assert "infeasible" not in drawn
     assert (tmp_path / "pareto.png").stat().st_size > 0
+
+
+def test_the_pareto_legend_lists_only_groups_with_points(tmp_path, monkeypatch):
+    s = _study(tmp_path)
+    labels = []
+    real = Axes.legend
+
+    def legend(self, *args, **kw):
+        labels.append(self.get_legend_handles_labels()[1])
+        return real(self, *args, **kw)
+
+    monkeypatch.setattr(Axes, "legend", legend)
+    ok = {"status": "ok", "role": "candidate", "seq": 2, "notes": {},
+          "metrics": {"orientation_capability": 30.0, "needed_stroke": 50.0}}
+    study_report._plot(tmp_path / "pareto.png", s, [ok], [ok])
+    assert labels[0] == ["feasible", "Pareto (all objectives)"]
+    low = {"status": "ok", "role": "candidate", "seq": 3, "notes": {},
+           "metrics": {"orientation_capability": 10.0, "needed_stroke": 50.0}}
+    study_report._plot(tmp_path / "pareto.png", s, [low], [])
+    assert labels[1] == ["infeasible"]
 
 
 def test_the_browser_report_groups_pruning_reasons_and_draws_pruned_candidates(tmp_path):
