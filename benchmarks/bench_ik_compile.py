@@ -1,8 +1,10 @@
-"""Compile cost and bit-identity of the six-leg IK kernels (issue 28, session 6).
+"""Compile cost and bit-identity of the IK kernels (issue 28, session 6).
 
 The IK (Euler and frame inputs) and the Jacobian of each shipped six-leg instance, the
 family's own kernels and the generic ``SixLeg`` declaration, on 5,000 fixed random poses per
-instance (NaN poses and angles beyond the fast sine range among them). Prints the CPU seconds
+instance (NaN poses and angles beyond the fast sine range among them); then the IK and
+Jacobian of every other shipped mechanism on 3,000 random poses of its own coordinates
+(±20 % of the nominal pose, NaN poses among them). Prints the CPU seconds
 this takes, most of it compiling when ``NUMBA_CACHE_DIR`` is empty, and saves every output to
 an ``.npz``; ``--compare A.npz B.npz`` then checks that two such files are bit-identical (NaN
 equal to NaN), e.g. before and after a change of how the kernels are compiled.
@@ -35,6 +37,8 @@ def compare(a_path: str, b_path: str) -> None:
 
 FILES = ("hopkins-williams-6psu", "gough-stewart-6ups", "instructables-servo-6rss",
          "hexaglide-6pus")
+OTHERS = ("clavel-delta3", "klipper-example-ldelta3", "luzi-3chain", "planar-3rpr",
+          "tripod-3prs", "fivebar-scara", "paradex-6pus")
 
 
 def _poses(mech, rng, n=5000):
@@ -60,8 +64,19 @@ def main(path: str) -> None:
             out[f"{key}-q"], out[f"{key}-st"], out[f"{key}-r"] = r.q, r.leg_status, r.reason
             out[f"{key}-q2"], out[f"{key}-r2"] = r2.q, r2.reason
             out[f"{key}-J"] = np.asarray(m.jacobian(X[:300]))
+    c1 = time.process_time()
     print(f"the six-leg IK and Jacobians of {len(FILES)} instances, dedicated and generic: "
-          f"{time.process_time() - c0:.1f} s CPU")
+          f"{c1 - c0:.1f} s CPU")
+    for name in OTHERS:
+        m = pkmlab.load_mechanism(ROOT / f"{name}.yaml")
+        x0 = np.asarray(m.nominal_pose, dtype=float)
+        X = x0 + rng.uniform(-0.2, 0.2, (3000, x0.size)) * np.maximum(np.abs(x0), 1.0)
+        X[::97] = np.nan
+        r = m.inverse(X)
+        out[f"{name}-q"], out[f"{name}-st"], out[f"{name}-r"] = r.q, r.leg_status, r.reason
+        out[f"{name}-J"] = np.asarray(m.jacobian(X[:200]))
+    print(f"the IK and Jacobians of {len(OTHERS)} other mechanisms: "
+          f"{time.process_time() - c1:.1f} s CPU")
     np.savez(path, **out)
 
 if __name__ == "__main__":

@@ -45,6 +45,7 @@ from dataclasses import dataclass
 from typing import ClassVar, Literal
 
 import numpy as np
+from numba import njit
 from numba.extending import register_jitable
 from pydantic import Field
 
@@ -69,7 +70,7 @@ _ANGLES = tuple(math.radians(a) for a in (90.0, 210.0, 330.0))
 # threshold 39-41, branch 42-44, motor axes n 45-53, b·sin(cone) 54-56
 
 
-@register_jitable(inline="always")
+@njit(cache=True, forceinline=True)
 def _delta_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, i, qmin, qmax):
     v, s = _rss_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22,
                     g[3 * i], g[3 * i + 1], g[3 * i + 2], g[9 + 3 * i], g[10 + 3 * i],

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 from typing import ClassVar, Literal
 
 import numpy as np
+from numba import njit
 from numba.extending import register_jitable
 from pydantic import Field
 
@@ -58,7 +59,7 @@ _ANGLES = tuple(math.radians(a) for a in (210.0, 330.0, 90.0))     # Klipper's A
 # g layout: B 0-8, tool points 9-17, rails e 18-26, l² 27-29, (l sin limit)² 30-32
 
 
-@register_jitable(inline="always")
+@njit(cache=True, forceinline=True)
 def _ldelta_leg(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, i, qmin, qmax):
     tx, ty, tz = g[9 + 3 * i], g[10 + 3 * i], g[11 + 3 * i]
     ex, ey, ez = g[18 + 3 * i], g[19 + 3 * i], g[20 + 3 * i]

@@ -63,7 +63,7 @@ def working_branches(mech) -> np.ndarray:
     return np.where(np.einsum("ki,ki->k", n, r) >= 0, 1.0, -1.0)
 
 
-@njit(inline="always")
+@njit(cache=True, forceinline=True)
 def _luzi_chain(px, py, pz, r00, r01, r02, r10, r11, r12, r20, r21, r22, g, i):
     """Chain ``i``: lengths ``(q_i1, q_i2)`` of its legs, False where the chain is degenerate
     (its plane parallel to the platform normal, |k × u_i| ≈ 0; the lengths are then garbage),

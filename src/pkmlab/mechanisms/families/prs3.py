@@ -43,6 +43,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
+from numba import njit
 from numba.extending import register_jitable
 from pydantic import Field
 
@@ -66,7 +67,7 @@ _FREE, _DEP = [2, 3, 4], [0, 1, 5]
 _A, _D, _N, _B, _L, _S, _P, _K, _H = 0, 9, 18, 27, 36, 39, 42, 48, 51
 
 
-@register_jitable(inline="always")
+@njit(cache=True, forceinline=True)
 def _w(g, i, cb, sb, ca, sa):
     """``w_i = Ry·Rx·b_i`` and its ``A_i``, ``B_i`` (module docstring)."""
     bx, by, bz = g[_B + 3 * i], g[_B + 3 * i + 1], g[_B + 3 * i + 2]
@@ -77,7 +78,7 @@ def _w(g, i, cb, sb, ca, sa):
     return wx, wy, wz, nx * wx + ny * wy, ny * wx - nx * wy
 
 
-@register_jitable(inline="always")
+@njit(cache=True, forceinline=True)
 def _leg(g, i, x, y, pz, cg, sg, wx, wy, wz, qmin, qmax, okc, q, st, j):
     Dx = x + cg * wx - sg * wy - g[_A + 3 * i]
     Dy = y + sg * wx + cg * wy - g[_A + 3 * i + 1]
