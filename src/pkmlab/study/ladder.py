@@ -56,7 +56,7 @@ import numpy as np
 from ..errors import NumericalError, ParameterError
 from ..units import parse_angle, parse_length
 from .definition import FINE, Tolerances
-from .evaluators import EVALUATORS
+from .evaluators import EVALUATORS, kept
 from .evaluators.dexterity import worst_metrics
 from .evaluators.registry import Context
 from .metrics import METRICS, metrics_of
@@ -216,6 +216,10 @@ def refine_design(space, params, evaluation, seed: int, names: tuple[str, ...]) 
     try:
         mech = space.decode(params)
         ctx = Context(evaluation, seed, choices=dict(space.evaluation_choices(params)))
+        hit = kept.take(mech, evaluation.request)
+        if hit is not None:         # the coarse rung's mechanism and workspace (.evaluators.kept)
+            mech, ctx.result = hit
+            run = [n for n in run if n in names or n != "workspace"]
         for name in run:
             if name in names:
                 metrics.update(_REFINE.get(name, EVALUATORS[name])(mech, ctx))
