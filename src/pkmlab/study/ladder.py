@@ -57,7 +57,7 @@ from ..errors import NumericalError, ParameterError
 from ..units import parse_angle, parse_length
 from .definition import FINE, Tolerances
 from .evaluators import EVALUATORS, kept
-from .evaluators.dexterity import worst_metrics
+from .evaluators.dexterity import SAMPLED_FORCE, sampled_force, worst_metrics
 from .evaluators.registry import Context
 from .metrics import METRICS, metrics_of
 from .objectives import feasible, objective_matrix
@@ -143,6 +143,11 @@ _BOUNDS = {m: b for ms in LADDERED.values() for m, b in ms.items()}
 #: coarse rung can leave them to the re-certification when no objective or constraint reads
 #: their metrics (:func:`deferred`)
 _STANDALONE = {"trajectory": (), "task": ("motions",)}
+#: metrics computed apart within a laddered evaluator, each with that evaluator: the coarse
+#: rung leaves them to the re-certification (which runs the evaluator anyway) when no objective
+#: or constraint reads them, and the re-certification computes them (:data:`_APART`)
+_PARTS = {SAMPLED_FORCE: "dexterity"}
+_APART = {SAMPLED_FORCE: sampled_force}
 #: the note of a deferred metric: before the re-certification, and on a pruned candidate
 PENDING = "computed when the candidate is re-certified at the fine tolerance (tolerance ladder)"
 NOT_COMPUTED = ("not computed: the candidate was pruned before its re-certification (tolerance "
@@ -174,21 +179,25 @@ def deferred(study) -> tuple[str, ...]:
     """The evaluators of ``study`` that its ladder's coarse rung leaves to the
     re-certification, in evaluation order: standalone ones (:data:`_STANDALONE`) whose
     metrics no objective or constraint reads and that no other evaluator of the study waits
-    for. A pruned candidate needs only what proves it pruned; a re-certified one gets them
-    computed exactly as a run without the ladder does."""
+    for; then the metrics computed apart within a re-certified evaluator (:data:`_PARTS`)
+    that no objective or constraint reads. A pruned candidate needs only what proves it
+    pruned; a re-certified one gets them computed exactly as a run without the ladder does."""
     ev = study.evaluation
     used = {o.metric for o in study.objectives} | {c.metric for c in study.constraints}
     runs = ev.evaluators
-    return tuple(n for n in runs if n in _STANDALONE and not used & set(metrics_of(n))
-                 and not any(r in runs for r in _STANDALONE[n])
-                 and not any(n in EVALUATORS[m].after or n in EVALUATORS[m].requires
-                             for m in runs))
+    whole = tuple(n for n in runs if n in _STANDALONE and not used & set(metrics_of(n))
+                  and not any(r in runs for r in _STANDALONE[n])
+                  and not any(n in EVALUATORS[m].after or n in EVALUATORS[m].requires
+                              for m in runs))
+    again = laddered(ev, study.tolerance_ladder) if study.tolerance_ladder else []
+    return whole + tuple(m for m, n in _PARTS.items()
+                         if n in again and m in ev.metrics and m not in used)
 
 
 def deferred_metrics(study) -> list[str]:
     """The metrics of :func:`deferred` evaluators that the study's evaluation writes."""
     d = deferred(study)
-    return [m for m in study.evaluation.metrics if METRICS[m].evaluator in d]
+    return [m for m in study.evaluation.metrics if METRICS[m].evaluator in d or m in d]
 
 
 def coarse_evaluation(study):
@@ -223,6 +232,9 @@ def refine_design(space, params, evaluation, seed: int, names: tuple[str, ...]) 
         for name in run:
             if name in names:
                 metrics.update(_REFINE.get(name, EVALUATORS[name])(mech, ctx))
+                for part in names:
+                    if _PARTS.get(part) == name:
+                        metrics.update(_APART[part](mech, ctx))
             else:
                 EVALUATORS[name](mech, ctx)
         notes = ctx.notes
@@ -267,7 +279,8 @@ def refine(study, runner, store) -> dict:
     ladder = study.tolerance_ladder
     later = deferred(study)
     evaluators = tuple(n for n in study.evaluation.evaluators
-                       if n in laddered(study.evaluation, ladder) or n in later)
+                       if n in laddered(study.evaluation, ladder) or n in later) + tuple(
+        m for m in later if m in _PARTS)
     names = [m for n in evaluators if n in LADDERED for m in LADDERED[n]]
     pending = deferred_metrics(study)
     ok = [r for r in store.all() if r["status"] == "ok"]
