@@ -72,3 +72,23 @@ def test_trajectory_metrics_equal_the_full_check_without_its_svd_and_force_solve
         assert out["paper_motion_fits"] == fits
         assert out["paper_motion_margin"] == margin         # identical, not close
         assert out["paper_motion_angle_margin"] is None
+
+
+def test_the_evaluator_s_motion_poses_are_the_paper_motion_s(designs):
+    """Session 6: the evaluator builds the paper motion's times and poses only
+    (``paper_motion_poses``, no rates or twists): the same arrays as ``paper_motion``, bit for
+    bit, on the demo's designs and on a lower mobility (the Clavel delta: only x, y, z move),
+    with other timings."""
+    from pkmlab import load_mechanism
+    from pkmlab.motion.paper import paper_motion_poses
+
+    _, mechs = designs
+    delta = load_mechanism(STUDY.parent / "mechanisms" / "clavel-delta3.yaml")
+    cases = [(m, {}) for m in mechs[:4]] + [
+        (mechs[0], {"segment_time": 0.7, "dwell": 0.0, "rate_hz": 60.0}), (delta, {})]
+    for mech, kw in cases:
+        mo = paper_motion(mech, **kw)
+        t, X = paper_motion_poses(mech, **kw)
+        assert np.array_equal(t, mo.t) and np.array_equal(X, mo.poses)
+    moved = paper_motion_poses(delta)[1] != delta.nominal_pose
+    assert moved[:, :3].any() and not moved[:, 3:].any()      # a lower mobility: x, y, z only
