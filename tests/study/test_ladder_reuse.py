@@ -7,6 +7,7 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 from scipy.stats import qmc
@@ -114,3 +115,21 @@ def test_a_plain_run_keeps_nothing(ladder_study):
     kept.clear()
     evaluate_design(study.space, _designs(study, 1)[0], study.evaluation, study.seed)
     assert not kept._KEPT
+
+
+def test_the_kept_workspaces_are_bounded_in_bytes(ladder_study, monkeypatch):
+    space = ladder_study.space
+    mechs = [space.decode(p) for p in _designs(ladder_study, 3)]
+
+    class Big:
+        def __init__(self, n):
+            self.lo = np.zeros(n)       # n · 8 bytes
+    monkeypatch.setattr(kept, "KEEP_BYTES", 1000)
+    kept.clear()
+    kept.keep(mechs[0], {}, Big(200))                     # 1,600 bytes: not kept
+    assert not kept._KEPT
+    kept.keep(mechs[0], {}, Big(60))
+    kept.keep(mechs[1], {}, Big(60))                      # 960 bytes in all
+    kept.keep(mechs[2], {}, Big(60))                      # the oldest leaves
+    assert kept.take(mechs[0], {}) is None and kept.take(mechs[1], {}) is not None
+    kept.clear()

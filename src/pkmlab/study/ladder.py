@@ -19,10 +19,14 @@ worst case replaced by certified bounds from a subset of its samples
 objective or constraint reads (the paper motion, the task) is not run on the coarse rung: the
 optimiser and the pruning never read it. Its metrics are null with a note until the candidate
 is re-certified, where it runs exactly as in a run without the ladder; a pruned candidate
-keeps them null, noted as not computed.
+keeps them null, noted as not computed. The same holds for a metric computed apart within a
+laddered evaluator (:data:`_PARTS`: the dexterity's ``sampled_min_force``) when nothing reads
+it: the re-certification, which runs that evaluator anyway, computes it.
 
 **Refinement** (:func:`refine`, after the optimiser). The stored candidates are re-certified at
-the fine tolerances (the study's own: exactly what a run without the ladder computes), front by
+the fine tolerances (the study's own: exactly what a run without the ladder computes; the
+coarse rung's mechanism and workspace are reused when this process kept them,
+:mod:`.evaluators.kept`), front by
 front of their coarse values, best first, one batch of workers at a time (within a front, the
 candidates whose certified worst case dominates the most others' best cases first). Only the
 laddered metrics (:data:`LADDERED`; the dexterity's worst-case metrics alone) and the deferred
@@ -340,6 +344,7 @@ def refine(study, runner, store) -> dict:
                 dominators.append(rec)
             counts["refined"] += 1
         todo = keep
+    kept.clear()                        # what this process kept and did not re-certify
     return counts
 
 

@@ -9,8 +9,9 @@ them again: the same mechanism (equal by geometry, :meth:`Mechanism.__eq__`) und
 workspace request (equal pickles) gives the same workspace, so the re-certification's values
 are those it would compute. A miss recomputes them.
 
-At most :data:`KEEP` candidates are kept (the least recently kept leave first); a kept one
-leaves when it is taken.
+At most :data:`KEEP` candidates and :data:`KEEP_BYTES` of their workspaces' arrays are kept
+(the least recently kept leave first; a larger workspace is not kept); a kept one leaves when
+it is taken, and :func:`pkmlab.study.ladder.refine` clears the rest.
 """
 
 from __future__ import annotations
@@ -22,8 +23,17 @@ __all__ = ["KEEP", "keep", "take", "clear"]
 
 #: candidates kept at most (a demo-sized workspace is 10–60 kB)
 KEEP = 256
+#: bytes of the kept workspaces' arrays at most
+KEEP_BYTES = 64 << 20
 
-_KEPT: OrderedDict = OrderedDict()
+_KEPT: OrderedDict = OrderedDict()      # key → (mechanism, workspace, bytes)
+
+
+def _bytes(result) -> int:
+    """The bytes of ``result``'s arrays (fields and computed properties)."""
+    held = getattr(result, "__dict__", {}).values()
+    return sum(int(getattr(v, "nbytes", 0)) for v in held if isinstance(getattr(v, "nbytes", 0),
+                                                                          int))
 
 
 def _key(mech, request) -> tuple:
@@ -34,16 +44,20 @@ def keep(mech, request: dict, result) -> None:
     """Keep ``mech`` (the instance the coarse rung evaluated) and its workspace ``result``
     computed with ``request``."""
     key = _key(mech, request)
-    _KEPT[key] = (mech, result)
-    _KEPT.move_to_end(key)
-    while len(_KEPT) > KEEP:
+    size = _bytes(result)
+    _KEPT.pop(key, None)
+    if size > KEEP_BYTES:
+        return
+    _KEPT[key] = (mech, result, size)
+    while len(_KEPT) > KEEP or sum(v[2] for v in _KEPT.values()) > KEEP_BYTES:
         _KEPT.popitem(last=False)
 
 
 def take(mech, request: dict):
     """``(mechanism, workspace)`` kept for a mechanism equal to ``mech`` under ``request``
     (removed from the store), or None."""
-    return _KEPT.pop(_key(mech, request), None)
+    hit = _KEPT.pop(_key(mech, request), None)
+    return None if hit is None else hit[:2]
 
 
 def clear() -> None:
