@@ -245,3 +245,18 @@ def test_the_re_certification_s_sampled_force_is_the_plain_evaluator_s(demo):
         assert left.pop("sampled_min_force") is None and "sampled_min_force" not in b.notes
         assert full.pop("sampled_min_force") == want["sampled_min_force"]
         assert full == left
+
+
+def test_the_sampled_force_waits_only_when_nothing_reads_it_and_the_dexterity_is_re_certified(
+        tmp_path):
+    from pkmlab.study.ladder import deferred, deferred_metrics
+
+    exact = _sobol_study(tmp_path, "exact", {"coarse": {"angle": "1 deg", "worst_case": "exact"}})
+    assert "sampled_min_force" not in deferred(exact)       # the dexterity is not re-certified
+    data = yaml.safe_load((tmp_path / "exact.yaml").read_text())
+    data["tolerance_ladder"] = {"coarse": {"angle": "1 deg"}}
+    data["constraints"].append({"sampled_min_force": {"min": 10}})
+    (tmp_path / "read.yaml").write_text(yaml.safe_dump(data))
+    read = load_study(tmp_path / "read.yaml")
+    assert "sampled_min_force" not in deferred(read)        # a constraint reads it
+    assert "sampled_min_force" not in deferred_metrics(read)
