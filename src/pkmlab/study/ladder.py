@@ -26,9 +26,9 @@ it: the re-certification, which runs that evaluator anyway, computes it.
 **Refinement** (:func:`refine`, after the optimiser). The stored candidates are re-certified at
 the fine tolerances (the study's own: exactly what a run without the ladder computes; the
 coarse rung's mechanism and workspace are reused when this process kept them,
-:mod:`.evaluators.kept`), front by
-front of their coarse values, best first, one batch of workers at a time (within a front, the
-candidates whose certified worst case dominates the most others' best cases first). Only the
+:mod:`.evaluators.kept`), front by front of their coarse values, best first, one batch of
+workers at a time (within a front, the candidates whose certified worst case dominates the
+most others' best cases first). Only the
 laddered metrics (:data:`LADDERED`; the dexterity's worst-case metrics alone) and the deferred
 evaluators' are computed; the fine values replace the coarse ones, and the coarse ones stay in
 the record as ``<metric>_coarse``. A failure at the fine tolerance (an invalid design, a

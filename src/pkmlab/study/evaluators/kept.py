@@ -19,6 +19,8 @@ from __future__ import annotations
 import pickle
 from collections import OrderedDict
 
+import numpy as np
+
 __all__ = ["KEEP", "keep", "take", "clear"]
 
 #: candidates kept at most (a demo-sized workspace is 10–60 kB)
@@ -32,8 +34,7 @@ _KEPT: OrderedDict = OrderedDict()      # key → (mechanism, workspace, bytes)
 def _bytes(result) -> int:
     """The bytes of ``result``'s arrays (fields and computed properties)."""
     held = getattr(result, "__dict__", {}).values()
-    return sum(int(getattr(v, "nbytes", 0)) for v in held if isinstance(getattr(v, "nbytes", 0),
-                                                                          int))
+    return sum(v.nbytes for v in held if isinstance(v, np.ndarray))
 
 
 def _key(mech, request) -> tuple:
