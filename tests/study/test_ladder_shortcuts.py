@@ -184,7 +184,8 @@ def test_a_deferred_evaluator_runs_only_for_re_certified_candidates(tmp_path, mo
     r0 = store.all()
     store.close()
     s1 = _sobol_study(tmp_path, "ladder", {"coarse": {"angle": "1 deg"}})
-    assert deferred(s1) == ("trajectory",)
+    # the paper motion, and the dexterity's sampled force (session 6) that nothing reads
+    assert deferred(s1) == ("trajectory", "sampled_min_force")
     assert "trajectory" not in coarse_evaluation(s1).evaluators
     runs = []
     traj = EVALUATORS["trajectory"]
@@ -204,12 +205,58 @@ def test_a_deferred_evaluator_runs_only_for_re_certified_candidates(tmp_path, mo
     pruned = [r for r in r1 if r["status"] == "pruned"]
     assert pruned and meta["pruned"] == len(pruned)
     for r in pruned:
-        assert r["metrics"]["paper_motion_fits"] is None
-        assert r["notes"]["paper_motion_fits"] == NOT_COMPUTED
+        for m in ("paper_motion_fits", "sampled_min_force"):
+            assert r["metrics"][m] is None
+            assert r["notes"][m] == NOT_COMPUTED
     for r in r1:
         if r["status"] == "ok":          # re-certified: the plain run's values and notes
             ref = fine[str(r["params"])]
-            for m in ("paper_motion_fits", "paper_motion_margin"):
+            assert r["metrics"]["sampled_min_force"] is not None
+            for m in ("paper_motion_fits", "paper_motion_margin", "sampled_min_force"):
                 assert r["metrics"][m] == ref["metrics"][m]
                 assert r["notes"].get(m) == ref["notes"].get(m)
     assert len(runs) == meta["refined"]   # baseline and re-certified candidates only
+
+
+def test_the_re_certification_s_sampled_force_is_the_plain_evaluator_s(demo):
+    """Session 6: the coarse rung leaves ``sampled_min_force`` (nothing reads it) to the
+    re-certification, which computes it apart (``dexterity.sampled_force``: the same
+    Monte-Carlo poses, the full singular rule): equal value and note to the plain evaluator's,
+    and the coarse rung's other dexterity metrics are unchanged by the deferral."""
+    from pkmlab.study.evaluators.dexterity import sampled_force
+
+    study, mechs = demo
+    ladder = ladder_from_spec({"coarse": {"angle": "0.1 deg"}}, study.evaluation)
+    coarse = study.evaluation.with_tolerances(ladder.coarse)
+    later = study.evaluation.with_tolerances(ladder.coarse, ("sampled_min_force",))
+    for mech, _ in mechs:
+        plain = Context(study.evaluation, 1, choices={})
+        EVALUATORS["workspace"](mech, plain)
+        want = EVALUATORS["dexterity"](mech, plain)
+        again = Context(study.evaluation, 1, choices={})
+        EVALUATORS["workspace"](mech, again)
+        got = sampled_force(mech, again)
+        assert got == {"sampled_min_force": want["sampled_min_force"]}
+        assert again.notes.get("sampled_min_force") == plain.notes.get("sampled_min_force")
+        a, b = (Context(ev, 1, choices={}) for ev in (coarse, later))
+        for ctx in (a, b):
+            EVALUATORS["workspace"](mech, ctx)
+        full, left = EVALUATORS["dexterity"](mech, a), EVALUATORS["dexterity"](mech, b)
+        assert left.pop("sampled_min_force") is None and "sampled_min_force" not in b.notes
+        assert full.pop("sampled_min_force") == want["sampled_min_force"]
+        assert full == left
+
+
+def test_the_sampled_force_waits_only_when_nothing_reads_it_and_the_dexterity_is_re_certified(
+        tmp_path):
+    from pkmlab.study.ladder import deferred, deferred_metrics
+
+    exact = _sobol_study(tmp_path, "exact", {"coarse": {"angle": "1 deg", "worst_case": "exact"}})
+    assert "sampled_min_force" not in deferred(exact)       # the dexterity is not re-certified
+    data = yaml.safe_load((tmp_path / "exact.yaml").read_text())
+    data["tolerance_ladder"] = {"coarse": {"angle": "1 deg"}}
+    data["constraints"].append({"sampled_min_force": {"min": 10}})
+    (tmp_path / "read.yaml").write_text(yaml.safe_dump(data))
+    read = load_study(tmp_path / "read.yaml")
+    assert "sampled_min_force" not in deferred(read)        # a constraint reads it
+    assert "sampled_min_force" not in deferred_metrics(read)

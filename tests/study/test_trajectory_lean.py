@@ -72,3 +72,26 @@ def test_trajectory_metrics_equal_the_full_check_without_its_svd_and_force_solve
         assert out["paper_motion_fits"] == fits
         assert out["paper_motion_margin"] == margin         # identical, not close
         assert out["paper_motion_angle_margin"] is None
+
+
+def test_the_evaluator_s_motion_poses_are_the_paper_motion_s(designs):
+    """Session 6: the evaluator builds the paper motion's times and poses only
+    (``paper_motion_poses``, no rates or twists): the same arrays as ``paper_motion``, bit for
+    bit, on the demo's designs, with other timings, and on a translational mobility (a stand-in
+    with a turned nominal pose: only x, y, z move; ``paper_motion`` reads nothing else)."""
+    from types import SimpleNamespace
+
+    from pkmlab.mechanisms.mobility import TRANSLATIONAL
+    from pkmlab.motion.paper import paper_motion_poses
+
+    _, mechs = designs
+    moving = SimpleNamespace(nominal_pose=np.array([1.0, -2.0, 300.0, 0.1, -0.2, 0.3]),
+                             mobility=TRANSLATIONAL)
+    cases = [(m, {}) for m in mechs[:4]] + [
+        (mechs[0], {"segment_time": 0.7, "dwell": 0.0, "rate_hz": 60.0}), (moving, {})]
+    for mech, kw in cases:
+        mo = paper_motion(mech, **kw)
+        t, X = paper_motion_poses(mech, **kw)
+        assert np.array_equal(t, mo.t) and np.array_equal(X, mo.poses)
+    moved = paper_motion_poses(moving)[1] != moving.nominal_pose
+    assert moved[:, :3].any() and not moved[:, 3:].any()      # x, y, z only

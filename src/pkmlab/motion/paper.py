@@ -27,7 +27,8 @@ from .motions import Motion, make_motion
 
 log = logging.getLogger(__name__)
 
-__all__ = ["PAPER_AXES", "MM_PER_IN", "lobe_profile", "paper_motion_phases", "paper_motion"]
+__all__ = ["PAPER_AXES", "MM_PER_IN", "lobe_profile", "paper_motion_phases", "paper_motion",
+           "paper_motion_poses"]
 
 #: Order of the paper's Cartesian test motions (Sect. 6): name and index into the pose vector.
 PAPER_AXES: tuple[tuple[str, int], ...] = (
@@ -133,6 +134,23 @@ def paper_motion(mech: Mechanism, amplitude_mm: float = 2.0 * MM_PER_IN,
         a :class:`Motion`: times ``(T,)`` in s starting at 0, tool poses ``(T, 6)`` (mm, rad)
         and their exact derivatives.
     """
+    t, poses, d1, d2 = _paper(mech, amplitude_mm, amplitude_rad, segment_time, dwell,
+                              rate_hz, True)
+    return make_motion(name, t, poses, d1, d2, "analytic")
+
+
+def paper_motion_poses(mech: Mechanism, amplitude_mm: float = 2.0 * MM_PER_IN,
+                       amplitude_rad: float = math.radians(30.0), segment_time: float = 1.0,
+                       dwell: float = 1.0, rate_hz: float = 100.0
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """The times ``(T,)`` and poses ``(T, 6)`` of :func:`paper_motion` (the same arrays),
+    without its derivatives and twists: what a stroke and singularity check reads
+    (:func:`pkmlab.motion.check.trajectory_fit`)."""
+    return _paper(mech, amplitude_mm, amplitude_rad, segment_time, dwell, rate_hz, False)[:2]
+
+
+def _paper(mech, amplitude_mm, amplitude_rad, segment_time, dwell, rate_hz, rates):
+    """``(t, poses, d1, d2)`` of :func:`paper_motion` (``rates`` False: d1, d2 None)."""
     amp_mm = _finite(amplitude_mm, "amplitude_mm", "mm")
     amp_rad = _finite(amplitude_rad, "amplitude_rad", "rad")
     rate = _positive(rate_hz, "rate_hz", "Hz")
@@ -151,7 +169,7 @@ def paper_motion(mech: Mechanism, amplitude_mm: float = 2.0 * MM_PER_IN,
 
     nominal = mech.nominal_pose
     poses = np.tile(nominal, (len(t), 1))
-    d1, d2 = np.zeros_like(poses), np.zeros_like(poses)
+    d1, d2 = (np.zeros_like(poses), np.zeros_like(poses)) if rates else (None, None)
     free = set(mech.mobility.coordinates)
     for (axis, t0, _t1), (_, idx) in zip(phases, PAPER_AXES):
         if axis not in free:        # a lower mobility: the axis keeps its nominal value
@@ -160,7 +178,8 @@ def paper_motion(mech: Mechanism, amplitude_mm: float = 2.0 * MM_PER_IN,
         inside = (t >= t0) & (t <= t0 + 4.0 * segment_time)
         s0, s1, s2 = _lobes(t[inside] - t0, amp, segment_time)
         poses[inside, idx] += s0
-        d1[inside, idx] = s1
-        d2[inside, idx] = s2
+        if rates:
+            d1[inside, idx] = s1
+            d2[inside, idx] = s2
     log.debug("paper motion: %d samples over %.3f s", len(t), t[-1])
-    return make_motion(name, t, poses, d1, d2, "analytic")
+    return t, poses, d1, d2

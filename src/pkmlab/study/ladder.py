@@ -19,12 +19,16 @@ worst case replaced by certified bounds from a subset of its samples
 objective or constraint reads (the paper motion, the task) is not run on the coarse rung: the
 optimiser and the pruning never read it. Its metrics are null with a note until the candidate
 is re-certified, where it runs exactly as in a run without the ladder; a pruned candidate
-keeps them null, noted as not computed.
+keeps them null, noted as not computed. The same holds for a metric computed apart within a
+laddered evaluator (:data:`_PARTS`: the dexterity's ``sampled_min_force``) when nothing reads
+it: the re-certification, which runs that evaluator anyway, computes it.
 
 **Refinement** (:func:`refine`, after the optimiser). The stored candidates are re-certified at
-the fine tolerances (the study's own: exactly what a run without the ladder computes), front by
-front of their coarse values, best first, one batch of workers at a time (within a front, the
-candidates whose certified worst case dominates the most others' best cases first). Only the
+the fine tolerances (the study's own: exactly what a run without the ladder computes; the
+coarse rung's mechanism and workspace are reused when this process kept them,
+:mod:`.evaluators.kept`), front by front of their coarse values, best first, one batch of
+workers at a time (within a front, the candidates whose certified worst case dominates the
+most others' best cases first). Only the
 laddered metrics (:data:`LADDERED`; the dexterity's worst-case metrics alone) and the deferred
 evaluators' are computed; the fine values replace the coarse ones, and the coarse ones stay in
 the record as ``<metric>_coarse``. A failure at the fine tolerance (an invalid design, a
@@ -56,8 +60,8 @@ import numpy as np
 from ..errors import NumericalError, ParameterError
 from ..units import parse_angle, parse_length
 from .definition import FINE, Tolerances
-from .evaluators import EVALUATORS
-from .evaluators.dexterity import worst_metrics
+from .evaluators import EVALUATORS, kept
+from .evaluators.dexterity import SAMPLED_FORCE, sampled_force, worst_metrics
 from .evaluators.registry import Context
 from .metrics import METRICS, metrics_of
 from .objectives import feasible, objective_matrix
@@ -143,6 +147,11 @@ _BOUNDS = {m: b for ms in LADDERED.values() for m, b in ms.items()}
 #: coarse rung can leave them to the re-certification when no objective or constraint reads
 #: their metrics (:func:`deferred`)
 _STANDALONE = {"trajectory": (), "task": ("motions",)}
+#: metrics computed apart within a laddered evaluator, each with that evaluator: the coarse
+#: rung leaves them to the re-certification (which runs the evaluator anyway) when no objective
+#: or constraint reads them, and the re-certification computes them (:data:`_APART`)
+_PARTS = {SAMPLED_FORCE: "dexterity"}
+_APART = {SAMPLED_FORCE: sampled_force}
 #: the note of a deferred metric: before the re-certification, and on a pruned candidate
 PENDING = "computed when the candidate is re-certified at the fine tolerance (tolerance ladder)"
 NOT_COMPUTED = ("not computed: the candidate was pruned before its re-certification (tolerance "
@@ -174,21 +183,25 @@ def deferred(study) -> tuple[str, ...]:
     """The evaluators of ``study`` that its ladder's coarse rung leaves to the
     re-certification, in evaluation order: standalone ones (:data:`_STANDALONE`) whose
     metrics no objective or constraint reads and that no other evaluator of the study waits
-    for. A pruned candidate needs only what proves it pruned; a re-certified one gets them
-    computed exactly as a run without the ladder does."""
+    for; then the metrics computed apart within a re-certified evaluator (:data:`_PARTS`)
+    that no objective or constraint reads. A pruned candidate needs only what proves it
+    pruned; a re-certified one gets them computed exactly as a run without the ladder does."""
     ev = study.evaluation
     used = {o.metric for o in study.objectives} | {c.metric for c in study.constraints}
     runs = ev.evaluators
-    return tuple(n for n in runs if n in _STANDALONE and not used & set(metrics_of(n))
-                 and not any(r in runs for r in _STANDALONE[n])
-                 and not any(n in EVALUATORS[m].after or n in EVALUATORS[m].requires
-                             for m in runs))
+    whole = tuple(n for n in runs if n in _STANDALONE and not used & set(metrics_of(n))
+                  and not any(r in runs for r in _STANDALONE[n])
+                  and not any(n in EVALUATORS[m].after or n in EVALUATORS[m].requires
+                              for m in runs))
+    again = laddered(ev, study.tolerance_ladder) if study.tolerance_ladder else []
+    return whole + tuple(m for m, n in _PARTS.items()
+                         if n in again and m in ev.metrics and m not in used)
 
 
 def deferred_metrics(study) -> list[str]:
     """The metrics of :func:`deferred` evaluators that the study's evaluation writes."""
     d = deferred(study)
-    return [m for m in study.evaluation.metrics if METRICS[m].evaluator in d]
+    return [m for m in study.evaluation.metrics if METRICS[m].evaluator in d or m in d]
 
 
 def coarse_evaluation(study):
@@ -216,9 +229,16 @@ def refine_design(space, params, evaluation, seed: int, names: tuple[str, ...]) 
     try:
         mech = space.decode(params)
         ctx = Context(evaluation, seed, choices=dict(space.evaluation_choices(params)))
+        hit = kept.take(mech, evaluation.request)
+        if hit is not None:         # the coarse rung's mechanism and workspace (.evaluators.kept)
+            mech, ctx.result = hit
+            run = [n for n in run if n in names or n != "workspace"]
         for name in run:
             if name in names:
                 metrics.update(_REFINE.get(name, EVALUATORS[name])(mech, ctx))
+                for part in names:
+                    if _PARTS.get(part) == name:
+                        metrics.update(_APART[part](mech, ctx))
             else:
                 EVALUATORS[name](mech, ctx)
         notes = ctx.notes
@@ -263,7 +283,8 @@ def refine(study, runner, store) -> dict:
     ladder = study.tolerance_ladder
     later = deferred(study)
     evaluators = tuple(n for n in study.evaluation.evaluators
-                       if n in laddered(study.evaluation, ladder) or n in later)
+                       if n in laddered(study.evaluation, ladder) or n in later) + tuple(
+        m for m in later if m in _PARTS)
     names = [m for n in evaluators if n in LADDERED for m in LADDERED[n]]
     pending = deferred_metrics(study)
     ok = [r for r in store.all() if r["status"] == "ok"]
@@ -323,6 +344,7 @@ def refine(study, runner, store) -> dict:
                 dominators.append(rec)
             counts["refined"] += 1
         todo = keep
+    kept.clear()                        # what this process kept and did not re-certify
     return counts
 
 

@@ -32,6 +32,7 @@ import traceback
 from ...errors import NumericalError, ParameterError
 from ...runtime.memory import BudgetError
 from ..metrics import metrics_of
+from . import kept
 from .registry import (
     EVALUATORS,
     MECHANISM_NEEDS,
@@ -85,6 +86,8 @@ def evaluate_mechanism(mech, evaluation, seed: int, choices: dict | None = None
             raise AssertionError(f"evaluator {name!r} wrote {sorted(out)}, declared "
                                  f"{sorted(declared)}")
         metrics.update(out)
+    if evaluation.coarse and ctx.result is not None:
+        kept.keep(mech, evaluation.request, ctx.result)   # for its re-certification (.kept)
     return metrics, ctx.notes
 
 

@@ -128,7 +128,6 @@ class Dexterity(Evaluator):
             out.update(dict.fromkeys(_OVER_WORKSPACE))
             return out
         out.update(worst_metrics(mech, ctx, length))
-        effort = effort_limit(mech.actuator_unit, plan.force_limit, plan.torque_limit)
         # one Monte-Carlo sample serves every sampled statistic
         p, R = dx.aggregate.sample_poses(res, plan.gci_samples,
                                          np.random.default_rng(ctx.seed))
@@ -136,21 +135,55 @@ class Dexterity(Evaluator):
         out["gci"] = g.gci if g.ok else None
         out["gci_std_error"] = finite(g.std_error) if g.ok else None
         out["sampled_max_kappa"] = finite(g.sampled_max_kappa) if g.ok else None
-        valid = mech.inverse((p, R)).valid
-        J = mech.jacobian((p[valid], R[valid]))
-        # the GCI found no singular pose among these (same poses, J and L): the force's
-        # singular rule need not compute the singular values again
-        known = np.zeros(len(J), bool) if g.ok and g.singular == 0 else None
-        F = dx.max_force_all_directions(J, plan.force_limit if effort is None else effort, L=L,
-                                        mobility=mech.mobility, singular=known)
-        out["sampled_min_force"] = float(np.min(F)) if len(F) and effort is not None else None
-        if effort is None:
-            ctx.notes["sampled_min_force"] = _SERVO
-        for n in ("gci", "gci_std_error", "sampled_max_kappa", "sampled_min_force"):
-            if out[n] is None:
+        if SAMPLED_FORCE in ctx.evaluation.deferred:    # a ladder's coarse rung (.ladder)
+            out[SAMPLED_FORCE] = None
+        else:
+            # the GCI found no singular pose among these (same poses, J and L): the force's
+            # singular rule need not compute the singular values again
+            out[SAMPLED_FORCE] = _sampled_force(mech, ctx, L, p, R, g.ok and g.singular == 0)
+        for n in ("gci", "gci_std_error", "sampled_max_kappa", SAMPLED_FORCE):
+            if out[n] is None and not (n == SAMPLED_FORCE and n in ctx.evaluation.deferred):
                 ctx.notes.setdefault(n, "a sampled pose is singular" if g.ok and
                                      n == "sampled_max_kappa" else "no valid Monte-Carlo pose")
         return out
+
+
+#: the metric a tolerance ladder's coarse rung can leave to the re-certification when no
+#: objective or constraint reads it (:func:`pkmlab.study.ladder.deferred`)
+SAMPLED_FORCE = "sampled_min_force"
+
+
+def _sampled_force(mech, ctx, L, p, R, regular: bool) -> float | None:
+    """``sampled_min_force`` over the Monte-Carlo poses ``(p, R)`` (and a servo's note);
+    ``regular``: the GCI over the same poses, J and L counted no singular pose (the force's
+    singular rule then skips its singular values: the same forces)."""
+    plan = ctx.evaluation.dexterity
+    effort = effort_limit(mech.actuator_unit, plan.force_limit, plan.torque_limit)
+    valid = mech.inverse((p, R)).valid
+    J = mech.jacobian((p[valid], R[valid]))
+    F = dx.max_force_all_directions(J, plan.force_limit if effort is None else effort, L=L,
+                                    mobility=mech.mobility,
+                                    singular=np.zeros(len(J), bool) if regular else None)
+    if effort is None:
+        ctx.notes[SAMPLED_FORCE] = _SERVO
+    return float(np.min(F)) if len(F) and effort is not None else None
+
+
+def sampled_force(mech, ctx) -> dict:
+    """``sampled_min_force`` (with its note) as :meth:`Dexterity.compute` writes it, after the
+    workspace evaluator (``ctx.result``): a tolerance ladder's re-certification computes it
+    when its coarse rung left it (:data:`SAMPLED_FORCE`). The same Monte-Carlo poses (the
+    seed's first draw), the force's full singular rule."""
+    plan, res = ctx.evaluation.dexterity, ctx.result
+    if res.empty:
+        ctx.notes[SAMPLED_FORCE] = "workspace empty"
+        return {SAMPLED_FORCE: None}
+    length = _length(mech, plan)
+    p, R = dx.aggregate.sample_poses(res, plan.gci_samples, np.random.default_rng(ctx.seed))
+    value = _sampled_force(mech, ctx, length.length, p, R, False)
+    if value is None:
+        ctx.notes.setdefault(SAMPLED_FORCE, "no valid Monte-Carlo pose")
+    return {SAMPLED_FORCE: value}
 
 
 _SERVO = ("servos need evaluate.dexterity.torque_limit (N·m): a linear force limit is never "

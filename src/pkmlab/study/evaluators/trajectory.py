@@ -8,8 +8,9 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from ...limits import MASS_MAX_KG, SEGMENT_TIME_S
-from ...motion import costs, paper_motion, trajectory_fit
+from ...motion import costs, trajectory_fit
 from ...motion.costs import paper_samples
+from ...motion.paper import paper_motion_poses
 from ...tolerances import TOL
 from ...units import actuator_display
 from .registry import Cost, Evaluator, finite, metric, register_evaluator
@@ -70,8 +71,8 @@ class Trajectory(Evaluator):
 
     def compute(self, mech, ctx) -> dict:
         plan = ctx.evaluation.trajectory
-        motion = paper_motion(mech, segment_time=plan.segment_time, rate_hz=PAPER_RATE_HZ)
-        t, X = motion.t, motion.poses
+        # the motion's times and poses (its rates and twists are not read here)
+        t, X = paper_motion_poses(mech, segment_time=plan.segment_time, rate_hz=PAPER_RATE_HZ)
         # check_trajectory's fits and margins only (no limits: the payload changes neither)
         rep = trajectory_fit(mech, t, X)
         margins = np.concatenate([rep.margin_low, rep.margin_high])
