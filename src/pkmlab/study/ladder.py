@@ -24,11 +24,9 @@ laddered evaluator (:data:`_PARTS`: the dexterity's ``sampled_min_force``) when 
 it: the re-certification, which runs that evaluator anyway, computes it.
 
 **Refinement** (:func:`refine`, after the optimiser). The stored candidates are re-certified at
-the fine tolerances (the study's own: exactly what a run without the ladder computes; the
-coarse rung's mechanism and workspace are reused when this process kept them,
-:mod:`.evaluators.kept`), front by front of their coarse values, best first, one batch of
-workers at a time (within a front, the candidates whose certified worst case dominates the
-most others' best cases first). Only the
+the fine tolerances (the study's own: exactly what a run without the ladder computes), front by
+front of their coarse values, best first, one batch of workers at a time (within a front, the
+candidates whose certified worst case dominates the most others' best cases first). Only the
 laddered metrics (:data:`LADDERED`; the dexterity's worst-case metrics alone) and the deferred
 evaluators' are computed; the fine values replace the coarse ones, and the coarse ones stay in
 the record as ``<metric>_coarse``. A failure at the fine tolerance (an invalid design, a
@@ -60,7 +58,7 @@ import numpy as np
 from ..errors import NumericalError, ParameterError
 from ..units import parse_angle, parse_length
 from .definition import FINE, Tolerances
-from .evaluators import EVALUATORS, kept
+from .evaluators import EVALUATORS
 from .evaluators.dexterity import SAMPLED_FORCE, sampled_force, worst_metrics
 from .evaluators.registry import Context
 from .metrics import METRICS, metrics_of
@@ -229,10 +227,6 @@ def refine_design(space, params, evaluation, seed: int, names: tuple[str, ...]) 
     try:
         mech = space.decode(params)
         ctx = Context(evaluation, seed, choices=dict(space.evaluation_choices(params)))
-        hit = kept.take(mech, evaluation.request)
-        if hit is not None:         # the coarse rung's mechanism and workspace (.evaluators.kept)
-            mech, ctx.result = hit
-            run = [n for n in run if n in names or n != "workspace"]
         for name in run:
             if name in names:
                 metrics.update(_REFINE.get(name, EVALUATORS[name])(mech, ctx))
@@ -344,7 +338,6 @@ def refine(study, runner, store) -> dict:
                 dominators.append(rec)
             counts["refined"] += 1
         todo = keep
-    kept.clear()                        # what this process kept and did not re-certify
     return counts
 
 

@@ -165,7 +165,8 @@ def _plot(path: Path, study: Study, records, front) -> None:
         ax.scatter(vals(base, mx), vals(base, my), marker="*", s=160, c="k", label="baseline")
     ax.set_xlabel(label(objs[0]))
     ax.set_ylabel(label(objs[1]) if my else "candidate")
-    ax.legend(fontsize=8)
+    if ax.get_legend_handles_labels()[1]:       # no empty legend box
+        ax.legend(fontsize=8)
     if len(objs) > 2:
         ax = axes[0, 1]
         names = [o.metric for o in objs]

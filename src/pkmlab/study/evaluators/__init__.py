@@ -32,7 +32,6 @@ import traceback
 from ...errors import NumericalError, ParameterError
 from ...runtime.memory import BudgetError
 from ..metrics import metrics_of
-from . import kept
 from .registry import (
     EVALUATORS,
     MECHANISM_NEEDS,
@@ -86,8 +85,6 @@ def evaluate_mechanism(mech, evaluation, seed: int, choices: dict | None = None
             raise AssertionError(f"evaluator {name!r} wrote {sorted(out)}, declared "
                                  f"{sorted(declared)}")
         metrics.update(out)
-    if evaluation.coarse and ctx.result is not None:
-        kept.keep(mech, evaluation.request, ctx.result)   # for its re-certification (.kept)
     return metrics, ctx.notes
 
 
