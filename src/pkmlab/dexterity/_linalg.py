@@ -262,7 +262,13 @@ def _sweep_pose(J, m, L, fmax, kup, force, det, A, B, G, T, piv):
     kup[m], force[m], det[m] = sweep_one(J[m], L, fmax, A, B, G, T, piv)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+# sweep_one, lu_force and sweep_core are compiled as functions of their own that the kernels
+# call, not inlined (issue 28, session 6): inlined, every kernel that uses them compiled the LU
+# and the two Gram bounds again (a parallel kernel at about twice a serial one's cost);
+# called, they compile once per process and load from the cache after. The demo's
+# warm-up went from 109 to 53 s of compile CPU, and the arithmetic is the same operation for
+# operation (docs/validation.md, "Issue 28 — compile time of the demo's kernels").
+@njit(cache=True, error_model="numpy")
 def sweep_one(Jm, L, fmax, A, B, G, T, piv):
     """``(kup, force, det)`` of one ``Jm (6, 6)`` (:func:`sweep_bounds`), with scratch
     ``A, B, G, T (6, 6)`` and ``piv (6,)`` int64."""
@@ -270,7 +276,7 @@ def sweep_one(Jm, L, fmax, A, B, G, T, piv):
     return (math.sqrt(la * lb) if la > 0.0 and lb > 0.0 else np.inf), fm, d
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def lu_force(Jm, fmax, A, B, piv):
     """The first half of :func:`sweep_core`: ``(ok, force, det)`` from one LU of ``Jm``
     (partial pivoting) and ``B = J⁻¹``; ``ok`` False for a non-finite ``Jm`` (force and det
@@ -344,7 +350,7 @@ def lu_force(Jm, fmax, A, B, piv):
     return True, fm, d
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def sweep_core(Jm, L, fmax, A, B, G, T, piv):
     """:func:`sweep_one`'s parts: ``(la, lb, force, det)`` with ``la >= λmax(J_hᵀJ_h)`` and
     ``lb >= λmax(J_h⁻ᵀJ_h⁻¹)`` (``-1`` for a non-finite or exactly singular ``Jm``); on
