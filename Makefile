@@ -26,10 +26,11 @@ $(STAMP): pyproject.toml uv.lock | $(UV)
 	@$(MAKE) --no-print-directory kernels
 	touch $(STAMP)
 
-# numba's disk cache of the demo study's kernels, filled once after installing (about 90 s of
-# CPU, compiled in two processes), so that the first `make demo` loads them instead of
-# compiling them in every worker; kernels are keyed by their source, so after an edit only
-# what changed compiles again
+# numba's disk cache of the demo study's kernels, filled once after installing (about 55 s of
+# CPU on a quiet machine, 110 s before issue 28's session 6; compiled in two processes;
+# docs/validation.md "compile time of the demo's kernels"), so that the first `make demo`
+# loads them instead of compiling them in every worker; kernels are keyed by their source, so
+# after an edit only what changed compiles again
 kernels:
 	@$(PY) -m pkmlab.study.warm || echo "note: the kernel cache was not warmed; the first run compiles"
 

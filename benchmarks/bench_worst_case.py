@@ -12,13 +12,22 @@ outputs are identical (the whole ``WorstCase.as_dict()`` but its wall time, comp
 ``==``, NaN equal to NaN; for the cells also without ``exact``, the count of exact κ
 evaluations, which pruning changes, and its mention in ``method``).
 
-    python benchmarks/bench_worst_case.py [--designs N] [--repeats R]
+``--compare SRC`` instead runs the default mode (cells, first-order bounds) in fresh processes
+with the sources in ``SRC`` (a baseline checkout's ``src``) and with this checkout's,
+alternately, twice each after a round that fills their kernel caches, and reports the median
+per-design ratio of the CPU times in that one run, the load average, and whether the two give
+the same ``WorstCase.as_dict()`` (but its wall time) for every design, compared with ``==``
+(session 6: the kernels call ``sweep_one`` instead of inlining it).
+
+    python benchmarks/bench_worst_case.py [--designs N] [--repeats R] [--compare SRC]
 """
 
 from __future__ import annotations
 
+import json
 import math
 import os
+import subprocess
 import sys
 import time
 import warnings
@@ -71,10 +80,7 @@ def _mode(name):
     worst.CELLS, _cells.LINEAR = MODES[name]
 
 
-def main() -> None:
-    n, repeats = _arg("--designs", 40), _arg("--repeats", 3)
-    single_thread_worker()
-    study = load_study(ROOT / "studies/hopkins-6psu-redesign.yaml")
+def _cases(study, n):
     space, request = study.space, study.evaluation.request
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)
@@ -89,6 +95,66 @@ def main() -> None:
         if res.empty:
             continue
         cases.append((res.mechanism, res, dx.resolve_length(res.mechanism)))
+    return cases
+
+
+def _json_run(n: int, repeats: int) -> None:
+    """The default mode on the designs, best of ``repeats``: one JSON line (CPU, summaries)."""
+    single_thread_worker()
+    cases = _cases(load_study(ROOT / "studies/hopkins-6psu-redesign.yaml"), n)
+    dx.worst_case(*cases[0], 150.0)                                  # compilation
+    cpu, out = [], []
+    for mech, res, L in cases:
+        t = []
+        for _ in range(repeats):
+            c0 = time.process_time()
+            wc = dx.worst_case(mech, res, L, 150.0)
+            t.append(time.process_time() - c0)
+        cpu.append(min(t))
+        out.append(summary(wc))
+    print(json.dumps({"cpu": cpu, "out": out}, default=repr))
+
+
+def compare(base_src: str, n: int, repeats: int) -> None:
+    here = str(ROOT / "src")
+    cpu = {"before": [], "now": []}
+    outs = {}
+    loads = [os.getloadavg()[0]]
+    for rep in range(3):                       # the first round only fills the kernel caches
+        for name, src in (("before", base_src), ("now", here)):
+            env = {**os.environ, "PYTHONPATH": src,
+                   "NUMBA_CACHE_DIR": f"/tmp/numba-bench-worst-{name}-{os.getuid()}"}
+            proc = subprocess.run([sys.executable, __file__, "--json-run", "--designs", str(n),
+                                   "--repeats", str(repeats)], env=env, capture_output=True,
+                                  text=True, check=True)
+            res = json.loads(proc.stdout.splitlines()[-1])
+            if rep:
+                cpu[name].append(res["cpu"])
+                outs[name] = res["out"]
+                loads.append(os.getloadavg()[0])
+    a = np.min(np.array(cpu["before"]), axis=0)          # per design, best of the runs
+    b = np.min(np.array(cpu["now"]), axis=0)
+    print(f"exact worst case (cells, first-order bounds), {len(a)} designs of the demo study, "
+          f"1 numba thread, CPU per design (best of {repeats} x 2 runs each, alternating); "
+          f"load average {min(loads):.2f}-{max(loads):.2f} (2 cores)")
+    print(f"  before ({base_src}): {1e3 * np.median(a):.1f} ms per design (median), "
+          f"{1e3 * a.sum():.0f} ms in all")
+    print(f"  now    ({here}): {1e3 * np.median(b):.1f} ms per design (median), "
+          f"{1e3 * b.sum():.0f} ms in all")
+    print(f"  ratio before/now: {np.median(a / b):.3f} per design (median; range "
+          f"{np.min(a / b):.2f}-{np.max(a / b):.2f}), {a.sum() / b.sum():.3f} in all")
+    print(f"  identical results (every field but the wall time), designs: "
+          f"{sum(same(x, y) for x, y in zip(outs['before'], outs['now']))} of {len(a)}")
+
+
+def main() -> None:
+    n, repeats = _arg("--designs", 40), _arg("--repeats", 3)
+    if "--json-run" in sys.argv:
+        return _json_run(n, repeats)
+    if "--compare" in sys.argv:
+        return compare(sys.argv[sys.argv.index("--compare") + 1], n, repeats)
+    single_thread_worker()
+    cases = _cases(load_study(ROOT / "studies/hopkins-6psu-redesign.yaml"), n)
     load0 = os.getloadavg()
     mech, res, L = cases[0]
     for name in MODES:                                             # warm-up (compilation)

@@ -7,6 +7,8 @@
 * the registry refuses a name twice and a weight that is not positive;
 * the built-in warmers that apply follow the mechanism's declaration: the worst case's cell
   kernels for the 6-PSU (a numba Jacobian with a box enclosure), not for a planar five-bar;
+* the kinematics warmer builds the drivers the IK and the Jacobian call (nothing compiles
+  after it);
 * a warm-up process that fails is reported, and the baseline's evaluation still fills the
   cache (the warm-up does not fail); the end-to-end check that a run after the warm-up
   compiles nothing is ``test_compile_once.py`` (which runs the warm-up in two processes).
@@ -61,10 +63,32 @@ def test_the_built_in_warmers_follow_the_declaration():
     warm._builtin_warmers()
     psu = {w.name for w in warmers.applicable(load_mechanism(MECH_DIR /
                                                              "hopkins-williams-6psu.yaml"))}
-    assert {"worst case: cell bounds", "worst case: cell pass", "capability search",
+    assert {"worst case: cell bounds", "worst case: cell pass",
+            "capability search, branch and bound, certification",
             "tiled columns (all)"} <= psu
     bar = {w.name for w in warmers.applicable(load_mechanism(MECH_DIR / "fivebar-scara.yaml"))}
     assert not {n for n in bar if n.startswith("worst case") or "columns" in n}
+
+
+def test_the_kinematics_warmer_builds_the_drivers_the_evaluation_calls():
+    """After the kinematics warmer, the IK (Euler poses and frames) and the Jacobian of the
+    6-PSU compile nothing: the warmer builds the very kernels they use (same factory, same
+    arguments), so the warm-up's parallel phase covers them."""
+    import numpy as np
+
+    from pkmlab.runtime.jit import compile_log
+
+    warm._builtin_warmers()
+    mech = load_mechanism(MECH_DIR / "hopkins-williams-6psu.yaml")
+    w = warmers.WARMERS["kinematics drivers (Euler, frames, Jacobian)"]
+    assert w.applies(mech)
+    w.build(mech)
+    X = np.tile(mech.nominal_pose, (3, 1))
+    with compile_log() as compiled:
+        mech.inverse(X)
+        mech.inverse(np.tile(np.eye(4), (3, 1, 1)))
+        mech.jacobian(X)
+    assert compiled.entries == []
 
 
 class _FailingPool:

@@ -89,7 +89,8 @@ def _singular_bound(Jm, L, A, B, G, T, piv, ones):
 
 
 # The two helpers are compiled into each family's loop as functions of their own, not inlined
-# (inlined, ``sweep_one`` alone took the loop's compile from 3.7 to 18.9 s of CPU), and not as
+# (inlined, ``sweep_one`` alone took the loop's compile from 3.7 to 18.9 s of CPU; its LU and
+# Gram bounds are now a function of their own everywhere, :func:`._linalg.sweep_core`), and not as
 # ``njit(cache=True)`` functions: their cache would be keyed by this file only, and would keep
 # stale code after an edit of ``_linalg``, which they inline. ``jitable`` names them after
 # ``_HELPERS``, which covers both (and, through them, ``_linalg``).

@@ -262,6 +262,14 @@ def _sweep_pose(J, m, L, fmax, kup, force, det, A, B, G, T, piv):
     kup[m], force[m], det[m] = sweep_one(J[m], L, fmax, A, B, G, T, piv)
 
 
+# sweep_core and lu_force are compiled as functions of their own that the kernels call, not
+# inlined (issue 28, session 6): inlined, every kernel that uses them compiled the LU and the
+# two Gram bounds again (a parallel kernel at about twice a serial one's cost); called, they
+# compile once per process and load from the cache after. Each is one function (the LU,
+# _lu_force, is inlined into both), so a pose costs one call; sweep_one, inlined, is only the
+# call and the square root. The demo's kernels went from 109 to about 55 s of compile CPU, the
+# arithmetic is the same operation for operation, and the worst case's run time changed by
+# about 2-3 % (docs/validation.md, "Issue 28 — compile time of the demo's kernels").
 @njit(cache=True, error_model="numpy", inline="always")
 def sweep_one(Jm, L, fmax, A, B, G, T, piv):
     """``(kup, force, det)`` of one ``Jm (6, 6)`` (:func:`sweep_bounds`), with scratch
@@ -270,8 +278,14 @@ def sweep_one(Jm, L, fmax, A, B, G, T, piv):
     return (math.sqrt(la * lb) if la > 0.0 and lb > 0.0 else np.inf), fm, d
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def lu_force(Jm, fmax, A, B, piv):
+    """:func:`_lu_force`, called."""
+    return _lu_force(Jm, fmax, A, B, piv)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _lu_force(Jm, fmax, A, B, piv):
     """The first half of :func:`sweep_core`: ``(ok, force, det)`` from one LU of ``Jm``
     (partial pivoting) and ``B = J⁻¹``; ``ok`` False for a non-finite ``Jm`` (force and det
     NaN) or an exactly zero pivot (both 0). :func:`sweep_core` calls it, so a caller that
@@ -344,12 +358,12 @@ def lu_force(Jm, fmax, A, B, piv):
     return True, fm, d
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def sweep_core(Jm, L, fmax, A, B, G, T, piv):
     """:func:`sweep_one`'s parts: ``(la, lb, force, det)`` with ``la >= λmax(J_hᵀJ_h)`` and
     ``lb >= λmax(J_h⁻ᵀJ_h⁻¹)`` (``-1`` for a non-finite or exactly singular ``Jm``); on
     return ``B`` holds ``J_h⁻¹`` and ``A`` its transpose."""
-    ok, fm, d = lu_force(Jm, fmax, A, B, piv)
+    ok, fm, d = _lu_force(Jm, fmax, A, B, piv)
     if not ok:
         return -1.0, -1.0, fm, d
     for i in range(6):                    # J_h = J·diag(1, 1, 1, 1/L, 1/L, 1/L)

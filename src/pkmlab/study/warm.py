@@ -88,15 +88,18 @@ def warm_study(path, jobs: int | None = None) -> tuple[float, list[str]]:
     jobs = default_jobs() if jobs is None else max(1, int(jobs))
     t0 = time.perf_counter()
     entries: list[tuple[str, float, str]] = []
+    # spawn: no numba state forked. The other processes start (and import pkmlab, about 2 s
+    # of CPU) while this one loads the study, whose checks compile the kinematics already
+    pool = (ProcessPoolExecutor(jobs - 1, mp_context=multiprocessing.get_context("spawn"))
+            if jobs > 1 else contextlib.nullcontext())
     with compile_log() as compiled:
-        study = load_study(Path(path))      # its checks compile the kinematics already
-        mech = study.space.decode(None)
-        here, *others = partition(applicable(mech), jobs)
-        others = [b for b in others if b]
-        # spawn: no numba state forked; no other process when every warmer stays here
-        pool = (ProcessPoolExecutor(len(others), mp_context=multiprocessing.get_context("spawn"))
-                if others else contextlib.nullcontext())
         with pool:
+            for _ in range(jobs - 1):
+                pool.submit(_builtin_warmers)
+            study = load_study(Path(path))
+            mech = study.space.decode(None)
+            here, *others = partition(applicable(mech), jobs)
+            others = [b for b in others if b]
             futures = [pool.submit(_build, study.space, [w.name for w in b]) for b in others]
             for w in here:
                 w.build(mech)
