@@ -113,6 +113,11 @@ def test_the_pareto_legend_lists_only_groups_with_points(tmp_path, monkeypatch):
            "metrics": {"orientation_capability": 10.0, "needed_stroke": 50.0}}
     study_report._plot(tmp_path / "pareto.png", s, [low], [])
     assert labels[1] == ["infeasible"]
+    # an invalid candidate has null metrics: nothing to draw, no legend entry
+    bad = {"status": "invalid", "role": "candidate", "seq": 4, "notes": {},
+           "metrics": {"orientation_capability": None, "needed_stroke": None}}
+    study_report._plot(tmp_path / "pareto.png", s, [ok, bad], [ok])
+    assert labels[2] == ["feasible", "Pareto (all objectives)"]
 
 
 def test_the_browser_report_groups_pruning_reasons_and_draws_pruned_candidates(tmp_path):

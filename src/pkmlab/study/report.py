@@ -147,15 +147,18 @@ def _plot(path: Path, study: Study, records, front) -> None:
     x = vals(cand, mx)
     y = vals(cand, my) if my else np.arange(len(cand))
     pruned = np.array([r["status"] == "pruned" for r in cand], dtype=bool)
-    # a group is drawn (and so in the legend) only when it has points
-    if (~ok & ~pruned).any():
-        ax.scatter(x[~ok & ~pruned], y[~ok & ~pruned], s=8, c="0.75", label="infeasible")
+    # a group is drawn (and so in the legend) only when it has points to draw: an invalid
+    # candidate's metrics are null
+    shown = np.isfinite(x) & np.isfinite(y)
+    rest = ~ok & ~pruned & shown
+    if rest.any():
+        ax.scatter(x[rest], y[rest], s=8, c="0.75", label="infeasible")
     if pruned.any():            # the tolerance ladder's: drawn at the coarse values it pruned
         coarse = [coarse_view(r) for r, p in zip(cand, pruned, strict=True) if p]
         ax.scatter(vals(coarse, mx), vals(coarse, my) if my else np.flatnonzero(pruned),
                    s=14, marker="x", c="0.45", linewidths=0.8,
                    label="pruned by the tolerance ladder (coarse values)")
-    if ok.any():
+    if (ok & shown).any():
         ax.scatter(x[ok], y[ok], s=10, c="tab:blue", label="feasible")
     if front:
         fx, fy = vals(front, mx), vals(front, my) if my else np.arange(len(front))
