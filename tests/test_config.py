@@ -108,6 +108,16 @@ def test_bad_geometry_names_field_range_and_value(base, change, field, allowed):
     assert allowed in msg and "; got " in msg, msg
 
 
+def test_swapped_radii_are_shown_with_their_unit():
+    """The value of the [inner, outer] error is shown in mm, short: a study's invalid
+    candidates list it ("got [58.2662 mm, 47.208 mm]", not the floats' 16 digits)."""
+    d = copy.deepcopy(spec("hopkins-williams-6psu"))
+    d["generator"]["platform_radii"] = [58.26622933814151, 47.207980628773704]
+    with pytest.raises(ParameterError) as info:
+        pkmlab.load_mechanism(d)
+    assert str(info.value).endswith("; got [58.2662 mm, 47.208 mm]"), str(info.value)
+
+
 @pytest.mark.parametrize("name", ["hopkins-williams-6psu", "gough-stewart-6ups", "luzi-3chain"])
 def test_explicit_point_errors(name):
     d = explicit(name) if name != "gough-stewart-6ups" else spec(name)

@@ -23,7 +23,7 @@ import numpy as np
 from numba import njit
 from numba.extending import register_jitable
 
-from ...errors import ParameterError
+from ...errors import ParameterError, Shown
 from ...quantities import LinkLengths
 from ...specbase import PairedCircles, _Common
 from ..base import NO_STROKE, Mechanism, as_points, as_positive, as_stroke, as_vector3
@@ -352,5 +352,6 @@ def _radii(value, field: str) -> tuple[float, float]:
     if arr.shape != (2,) or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
         raise ParameterError(field, "[inner, outer], two radii > 0 mm", value)
     if arr[0] > arr[1]:
-        raise ParameterError(field, "[inner, outer] with inner <= outer", arr.tolist())
+        raise ParameterError(field, "[inner, outer] with inner <= outer",
+                             Shown(f"[{arr[0]:.6g} mm, {arr[1]:.6g} mm]"))
     return float(arr[0]), float(arr[1])
