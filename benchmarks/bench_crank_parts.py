@@ -29,11 +29,11 @@ from __future__ import annotations
 import math
 import os
 import sys
-import time
 from pathlib import Path
 
 import numba
 import numpy as np
+from _timing import cpu_best
 from numba import njit
 from numba.extending import register_jitable
 
@@ -175,18 +175,6 @@ def _divider(a, out, mode):
                         + 0.1) * x + 0.3) * x + 0.2)
 
 
-def _best(fns, repeats=9):
-    for fn in fns.values():
-        fn()
-    best = dict.fromkeys(fns, math.inf)
-    for _ in range(repeats):
-        for key, fn in fns.items():
-            c = time.process_time()
-            fn()
-            best[key] = min(best[key], time.process_time() - c)
-    return best
-
-
 def main() -> None:
     numba.set_num_threads(1)
     fast = pkmlab.load_mechanism(ROOT / "instructables-servo-6rss.yaml")
@@ -216,7 +204,7 @@ def main() -> None:
         os.execve(sys.executable, [sys.executable, *sys.argv],
                   dict(os.environ, PKMLAB_BENCH_RERUN="1"))
     print(f"one thread, CPU time, least of 9; load average {os.getloadavg()}")
-    t = _best(fns)
+    t = cpu_best(fns, 9)
     for key, v in t.items():
         if key in ("x/y", "sqrt", "x/sqrt(x)", "16-op polynomial"):
             print(f"{key:28s} {v / (200 * len(a)) * 1e9:6.3f} ns per element")

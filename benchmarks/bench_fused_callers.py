@@ -29,6 +29,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from _timing import identical
 from scipy.stats import qmc
 
 from pkmlab import dexterity as dx
@@ -47,18 +48,6 @@ STUDIES = {"psu6": "studies/hopkins-6psu-redesign.yaml",
 
 def _arg(name, default):
     return int(sys.argv[sys.argv.index(name) + 1]) if name in sys.argv else default
-
-
-def _equal(a, b) -> bool:
-    if isinstance(a, dict):
-        return a.keys() == b.keys() and all(_equal(a[k], b[k]) for k in a)
-    if isinstance(a, tuple | list):
-        return len(a) == len(b) and all(_equal(x, y) for x, y in zip(a, b))
-    if isinstance(a, np.ndarray):
-        return a.shape == b.shape and bool(np.all((a == b) | (a != a) & (b != b)))
-    if isinstance(a, float) and isinstance(b, float) and a != a and b != b:
-        return True
-    return a == b
 
 
 def _callers(mech, res, length, poses, motion):
@@ -128,7 +117,7 @@ def main() -> None:
                     best[flag] = min(best[flag], time.process_time() - c0)
             for flag in (False, True):
                 cpu[fam, name, flag].append(best[flag])
-            same[fam, name] += _equal(out[False], out[True])
+            same[fam, name] += identical(out[False], out[True])
     _fused_exact.FUSED = True
     print(f"fused κ kernels vs the NumPy path: best of {repeats} per design and caller, "
           f"1 numba thread, CPU time; load average {load0[0]:.2f} -> "

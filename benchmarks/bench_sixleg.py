@@ -27,12 +27,11 @@ from __future__ import annotations
 import math
 import os
 import sys
-import time
 from pathlib import Path
 
 import numba
 import numpy as np
-from _timing import timed
+from _timing import cpu_best, timed
 from numba import njit, prange
 
 import pkmlab
@@ -67,20 +66,6 @@ def memory_floor(X):
 def _poses(mech, n, rng):
     return mech.nominal_pose + np.concatenate(
         [rng.uniform(-40, 40, (n, 3)), np.radians(rng.uniform(-15, 15, (n, 3)))], axis=1)
-
-
-def _cpu(fns: dict, repeats: int = 7) -> dict:
-    """Least CPU time of each of ``fns`` over ``repeats`` rounds, the functions timed in turn
-    within a round (so a change of load affects them alike), after one warm-up call each."""
-    for fn in fns.values():
-        fn()
-    best = dict.fromkeys(fns, math.inf)
-    for _ in range(repeats):
-        for key, fn in fns.items():
-            c = time.process_time()
-            fn()
-            best[key] = min(best[key], time.process_time() - c)
-    return best
 
 
 def _mixed_linear():
@@ -141,7 +126,7 @@ def cpu_mode() -> None:
                "in cache": _in_cache(gen, X)}
         if gen is not fast:
             fns["dedicated"] = lambda: fast.inverse(X)         # noqa: B023
-        t = _cpu(fns)
+        t = cpu_best(fns)
         tk = t.get("dedicated", math.nan)
         print(f"{name}: memory floor {t['floor'] * 1e3:5.1f} ms; dedicated "
               f"{tk / t['floor']:4.2f}x, generic {t['generic'] / t['floor']:4.2f}x the floor; "

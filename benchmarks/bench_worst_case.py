@@ -25,7 +25,6 @@ the same ``WorstCase.as_dict()`` (but its wall time) for every design, compared 
 from __future__ import annotations
 
 import json
-import math
 import os
 import subprocess
 import sys
@@ -34,6 +33,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from _timing import identical
 from scipy.stats import qmc
 
 from pkmlab import dexterity as dx
@@ -48,17 +48,6 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def _arg(name, default):
     return int(sys.argv[sys.argv.index(name) + 1]) if name in sys.argv else default
-
-
-def same(a, b) -> bool:
-    """Equal as JSON-like values, NaN equal to NaN, floats compared exactly."""
-    if isinstance(a, dict):
-        return a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
-    if isinstance(a, list | tuple):
-        return len(a) == len(b) and all(same(x, y) for x, y in zip(a, b))
-    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
-        return True
-    return a == b
 
 
 def summary(wc, exact=True) -> dict:
@@ -144,7 +133,7 @@ def compare(base_src: str, n: int, repeats: int) -> None:
     print(f"  ratio before/now: {np.median(a / b):.3f} per design (median; range "
           f"{np.min(a / b):.2f}-{np.max(a / b):.2f}), {a.sum() / b.sum():.3f} in all")
     print(f"  identical results (every field but the wall time), designs: "
-          f"{sum(same(x, y) for x, y in zip(outs['before'], outs['now']))} of {len(a)}")
+          f"{sum(identical(x, y) for x, y in zip(outs['before'], outs['now']))} of {len(a)}")
 
 
 def main() -> None:
@@ -174,9 +163,9 @@ def main() -> None:
                 t[name].append(time.process_time() - c0)
         for name in t:
             cpu[name].append(min(t[name]))
-        identical["cells"] += same(summary(out["before"], False), summary(out["cells"], False))
-        identical["cells, every field"] += same(summary(out["before"]), summary(out["cells"]))
-        identical["interval"] += same(summary(out["before"], False),
+        identical["cells"] += identical(summary(out["before"], False), summary(out["cells"], False))
+        identical["cells, every field"] += identical(summary(out["before"]), summary(out["cells"]))
+        identical["interval"] += identical(summary(out["before"], False),
                                       summary(out["interval"], False))
         sizes.append(out["before"].poses)
     _mode("cells")

@@ -9,8 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import yaml
-from conftest import MECH_DIR
-from conftest import same_result as _same
+from conftest import MECH_DIR, same_result
 
 import pkmlab
 from pkmlab import dexterity as dx
@@ -135,16 +134,6 @@ def _callers(mech, res, length, t, X):
     return out
 
 
-def _equal(a, b) -> bool:
-    if isinstance(a, dict):
-        return a.keys() == b.keys() and all(_equal(a[k], b[k]) for k in a)
-    if isinstance(a, tuple | list):
-        return len(a) == len(b) and all(_equal(x, y) for x, y in zip(a, b))
-    if isinstance(a, np.ndarray):
-        return a.shape == b.shape and bool(np.all((a == b) | (a != a) & (b != b)))
-    return _same(a, b)
-
-
 @MECHS
 def test_callers_fused_and_unfused_are_identical(mech):
     res = _workspace(mech)
@@ -159,7 +148,7 @@ def test_callers_fused_and_unfused_are_identical(mech):
         fe.FUSED = True
     assert out[True].keys() == out[False].keys()
     for key in out[True]:
-        assert _equal(out[False][key], out[True][key]), key
+        assert same_result(out[False][key], out[True][key]), key
     cond, force, status, _ = out[True]["check"]
     assert np.isinf(cond[50]) and np.isnan(force[50]).all() and "non-finite" in status[50]
     assert "stroke" in status[60] and status[0] == "ok"
@@ -187,7 +176,7 @@ def test_the_fused_path_is_taken(monkeypatch):
     monkeypatch.setattr(maps, "sweep_bounds", unfused)
     got = _callers(mech, res, length, t, X)
     for key in want:
-        assert _equal(want[key], got[key]), key
+        assert same_result(want[key], got[key]), key
     fe.FUSED = False
     try:
         with pytest.raises(AssertionError, match="unfused path"):
