@@ -220,3 +220,23 @@ def test_a_long_title_wraps_inside_the_figure_and_above_the_panels(small):
         top = max(ax.get_tightbbox(r).y1 for ax in fig.axes if ax.get_visible())
         assert box.y0 >= top - 1, (box.y0, top)
         assert box.y1 <= fig.bbox.height
+
+
+def test_the_colour_bar_label_fits_a_small_figure(small):
+    """A design whose dexterous workspace has two sections got a 2-panel kappa_slices.png
+    whose colour bar label ran beyond the figure's top and bottom edges (seen in a 6-RSS
+    study). The label now wraps to the bar's length and stays inside the figure."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    label = "worst κ (homogenised condition number), L = 66.42 mm"
+    values = np.ones((len(small.xs), len(small.ys), len(small.zs)))
+    values[0, 0, 0] = 3.0
+    for panels in (2, 9):
+        fig = slice_figure(small, values=values, label=label, max_panels=panels)
+        FigureCanvasAgg(fig).draw()
+        r = fig.canvas.get_renderer()
+        bar = fig.axes[-1]
+        box = bar.yaxis.label.get_window_extent(r)
+        assert 0 <= box.y0 and box.y1 <= fig.bbox.height, (panels, box, fig.bbox)
+        assert 0 <= box.x0 and box.x1 <= fig.bbox.width, (panels, box, fig.bbox)
+        assert bar.get_ylabel().replace("\n", " ") == label

@@ -124,6 +124,7 @@ class _Sections:
         # where the panels are before a colour bar shrinks and re-anchors them
         self._places = [(ax.get_position(original=True), ax.get_anchor())
                         for ax in self.axes.ravel()]
+        self._width = self.fig.get_figwidth()    # inches, without a colour bar
 
     def paint(self, values, cmap: str, label: str) -> None:
         """Draw the sections coloured by ``values`` (``None``: grey), replacing the previous
@@ -131,6 +132,7 @@ class _Sections:
         if self._bar is not None:             # before its image, which it refers to
             self._bar.remove()
             self._bar = None
+            self.fig.set_figwidth(self._width)
             for ax, (pos, anchor) in zip(self.axes.ravel(), self._places):
                 ax.set_position(pos)
                 ax.set_anchor(anchor)
@@ -161,8 +163,32 @@ class _Sections:
             note = {"neither": "", "max": "\n(colours capped at the 99th percentile)",
                     "min": "\n(colours floored at the 1st percentile)",
                     "both": "\n(colours: 1st to 99th percentile)"}[extend]
-            self._bar = self.fig.colorbar(im, ax=self.axes, shrink=0.6, extend=extend,
-                                          label=label + note)
+            self._bar = self._colour_bar(im, extend, label + note)
+
+    def _colour_bar(self, im, extend: str, label: str):
+        """A colour bar in :data:`BAR_IN` inches added to the figure's right, its label
+        wrapped to the bar's length (0.6 of the panels' height; about 0.55 em per character):
+        a bar taken from the panels' width had no room for its ticks and label on a grid of
+        one or two columns, and the label ran beyond the figure's edges."""
+        W, w = self._width, self._width + BAR_IN
+        self.fig.set_figwidth(w)
+        for ax, (pos, anchor) in zip(self.axes.ravel(), self._places):
+            ax.set_position([pos.x0 * W / w, pos.y0, pos.width * W / w, pos.height])
+            ax.set_anchor(anchor)
+        sp, fs = self.fig.subplotpars, 8
+        height = sp.top - sp.bottom
+        cax = self.fig.add_axes([(W - 0.05) / w, sp.bottom + 0.2 * height, 0.12 / w,
+                                 0.6 * height])
+        chars = max(int(0.6 * height * self.fig.get_figheight() * 72 / (0.55 * fs)), 12)
+        bar = self.fig.colorbar(im, cax=cax, extend=extend)
+        bar.set_label("\n".join(textwrap.fill(line, chars) for line in label.split("\n")),
+                      fontsize=fs)
+        bar.ax.tick_params(labelsize=7)
+        return bar
+
+
+#: inches added to a slice grid's right for its colour bar, the bar's ticks and its label
+BAR_IN = 1.1
 
 
 def _panel_grid(lay: SliceLayout, columns: int | None, size: float, top: float,
